@@ -1,0 +1,31 @@
+// The `dgmm` command: parses arguments with CLI11 and dispatches to the registered subcommands.
+// User-input problems arrive as exceptions and are printed as one line with a non-zero exit.
+#include <algorithm>
+#include <cstdio>
+#include <exception>
+#include <iostream>
+
+#include "app/command.h"
+#include "util/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App root{"dgmm: Dynamic Gaussian Mixture motion models for legged robots"};
+  root.require_subcommand(1);
+  root.set_help_all_flag("--help-all", "Help for every subcommand");
+  auto& registry = dgmm::app::CommandRegistry();
+  std::sort(registry.begin(), registry.end(),
+            [](const auto& a, const auto& b) { return a.name < b.name; });
+  for (const auto& command : registry) command.setup(root);
+  try {
+    root.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return root.exit(e);
+  } catch (const dgmm::InputError& e) {
+    std::cerr << "dgmm: error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "dgmm: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

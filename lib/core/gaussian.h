@@ -1,0 +1,61 @@
+#pragma once
+// A multivariate normal N(mean, covariance) with its Cholesky factor cached.
+#include <Eigen/Dense>
+#include <optional>
+#include <random>
+#include <vector>
+
+namespace dgmm {
+
+class Gaussian {
+ public:
+  Gaussian() = default;
+  // N(mean, covariance); covariance d x d must be symmetric positive definite (asserted).
+  Gaussian(Eigen::VectorXd mean, Eigen::MatrixXd covariance);
+  // Like the constructor but returns nullopt when the covariance does not factor.
+  static std::optional<Gaussian> Create(Eigen::VectorXd mean, Eigen::MatrixXd covariance);
+
+  int dim() const { return static_cast<int>(mean_.size()); }
+  const Eigen::VectorXd& mean() const { return mean_; }
+  const Eigen::MatrixXd& covariance() const { return covariance_; }
+  // Lower factor L with covariance = L L^T.
+  const Eigen::MatrixXd& cholesky_l() const { return l_; }
+  // log det(covariance) = 2 sum log L_ii.
+  double log_det() const { return log_det_; }
+
+  // Replaces mean and covariance and refactors; returns false (and keeps the old state) if the
+  // covariance is not positive definite.
+  bool Set(Eigen::VectorXd mean, Eigen::MatrixXd covariance);
+
+  // m^2 = (x - mean)^T covariance^-1 (x - mean); x has dim() entries.
+  double SquaredMahalanobis(const Eigen::Ref<const Eigen::VectorXd>& x) const;
+  // log N(x; mean, covariance) = -1/2 (d log 2 pi + log det + m^2).
+  double LogDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const;
+  // log N for each column of X (d x n); returns n values.
+  Eigen::VectorXd LogDensity(const Eigen::Ref<const Eigen::MatrixXd>& X) const;
+  // The density scaled so that its maximum is 1: exp(-1/2 m^2), in [0, 1].
+  double ScaledDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const;
+
+  // Marginal over the listed dimensions (in that order): N(mean[dims], covariance[dims, dims]).
+  Gaussian Marginal(const std::vector<int>& dims) const;
+  // Conditional of the other dimensions (ascending order) given x[given_dims] = values:
+  // mean_a + S_ab S_bb^-1 (values - mean_b), S_aa - S_ab S_bb^-1 S_ba (Schur complement).
+  Gaussian Conditional(const std::vector<int>& given_dims,
+                       const Eigen::Ref<const Eigen::VectorXd>& values) const;
+  // y = A x + b maps N(m, S) to N(A m + b, A S A^T); A is d' x d.
+  Gaussian Affine(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) const;
+
+  // One draw mean + L e, e ~ N(0, I).
+  Eigen::VectorXd Sample(std::mt19937_64& rng) const;
+
+ private:
+  Eigen::VectorXd mean_;
+  Eigen::MatrixXd covariance_;
+  Eigen::MatrixXd l_;
+  double log_det_ = 0.0;
+};
+
+// Indices 0..dim-1 that are not in `dims`, ascending.
+std::vector<int> ComplementDims(int dim, const std::vector<int>& dims);
+
+}  // namespace dgmm

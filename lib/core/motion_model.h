@@ -1,0 +1,84 @@
+#pragma once
+// A motion model: for every discrete command c a mixture over y = x || z (pose change, then
+// terrain); p(x | c) is its marginal over x and p(x | c, z) its conditional (eq. 15).
+#include <Eigen/Dense>
+#include <cstdint>
+#include <map>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "core/dgmm.h"
+#include "core/mixture.h"
+#include "core/sample_set.h"
+
+namespace dgmm {
+
+struct MotionModel {
+  std::string kind = "dgmm";  // "dgmm", "em", "corrected", ...
+  int pose_dim = 0;
+  int terrain_dim = 0;        // 0 when fitted without terrain
+  std::vector<std::string> pose_names, pose_units, terrain_names;
+  std::vector<std::string> command_dim_names;
+  std::map<int, Eigen::VectorXd> command_values;  // command id -> its row of the command table
+  std::map<int, std::string> command_labels;
+  std::map<int, Mixture> mixtures;                // command id -> mixture over y (dim pose+terrain)
+  DgmmOptions dgmm_options;                       // when kind == "dgmm"
+  std::uint64_t seed = 0;
+  Standardization transform;                      // of y, copied from the training set
+  std::map<std::string, std::string> metadata;    // free-form (e.g. EM options as JSON)
+
+  int dim() const { return pose_dim + terrain_dim; }
+  bool HasCommand(int command) const { return mixtures.count(command) > 0; }
+  // The command's mixture; throws InputError "unknown command <c>" when absent.
+  const Mixture& MixtureFor(int command) const;
+  // log p(x | c): marginal over the pose dimensions.
+  double LogLikelihood(int command, const Eigen::Ref<const Eigen::VectorXd>& x) const;
+  // log p(x | c, z) (eq. 15); requires terrain_dim > 0.
+  double LogLikelihood(int command, const Eigen::Ref<const Eigen::VectorXd>& x,
+                       const Eigen::Ref<const Eigen::VectorXd>& z) const;
+  // p(x | c, z) as a mixture over x.
+  Mixture Conditional(int command, const Eigen::Ref<const Eigen::VectorXd>& z) const;
+};
+
+// Options for learning one DGMM per command from a sample set.
+struct MotionModelOptions {
+  DgmmOptions dgmm;
+  bool with_terrain = true;  // model y = x || z (if the set has terrain) or x alone
+  std::uint64_t seed = 1;
+};
+
+// Streaming learner: one Dgmm per command, fed one sample at a time (no history kept), e.g. from
+// a chunked HDF5 reader. `header` carries dims, names, command table and transform.
+class MotionModelLearner {
+ public:
+  MotionModelLearner(MotionModel header, const MotionModelOptions& options);
+  // y = x || z when the header has terrain_dim > 0, else x alone.
+  void Add(int command, const Eigen::Ref<const Eigen::VectorXd>& y);
+  // The model so far (mixtures copied from the learners).
+  MotionModel Finish() const;
+  const std::map<int, Dgmm>& learners() const { return learners_; }
+
+ private:
+  MotionModel header_;
+  MotionModelOptions options_;
+  std::mt19937_64 rng_;
+  std::map<int, Dgmm> learners_;
+};
+
+// Streams the samples in set order through one Dgmm per command (a command with no samples has
+// no model). The rng is seeded once from options.seed, so same seed, same model.
+MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options);
+
+// Total log-likelihood of the set under the model: sum_i log p(x_i | c_i [, z_i]), using the
+// terrain when the model has it. Always in the raw units of x: when the model carries a
+// standardisation, raw sets are standardised first and log|scale_x| is subtracted. Throws
+// InputError on dimension mismatch, unknown command or a transform that differs from the set's.
+struct ScoreSummary {
+  double total_log_likelihood = 0;
+  double mean_log_likelihood = 0;
+  int samples = 0;
+};
+ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set);
+
+}  // namespace dgmm
