@@ -18,8 +18,16 @@ int main(int argc, char** argv) {
   for (const auto& command : registry) command.setup(root);
   try {
     root.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
+  } catch (const CLI::CallForHelp& e) {
     return root.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return root.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return root.exit(e);
+  } catch (const CLI::ParseError& e) {
+    // One line, like every other user error (CLI11's own exit() adds a second line).
+    std::cerr << "dgmm: error: " << e.what() << " (see dgmm --help)\n";
+    return e.get_exit_code() != 0 ? e.get_exit_code() : 2;
   } catch (const dgmm::InputError& e) {
     std::cerr << "dgmm: error: " << e.what() << "\n";
     return 2;

@@ -23,7 +23,10 @@ struct DgmmOptions {
   // Floor added to keep covariances positive definite (see docs/dgmm.md for where it applies).
   double covariance_floor = 1e-6;
 
+  // k finite and > 0, floor finite and >= 0, initial diagonal (if given) positive and finite.
   bool IsValid(std::string* error) const;
+  // As above, and the initial diagonal (if given) has `dim` entries.
+  bool IsValid(int dim, std::string* error) const;
 };
 
 // Sufficient statistics of one component: n samples, their mean and scatter
@@ -36,9 +39,10 @@ struct DgmmComponentStats {
 
 // What ADDSAMPLE did with one sample.
 struct AddSampleResult {
-  bool merged = false;   // false: a new component was started.
-  int component = -1;    // index of the component that received the sample.
-  double threshold = 0;  // t
+  bool merged = false;             // false: a new component was started.
+  int component = -1;              // index of the component that received the sample.
+  double threshold = 0;            // t; when d was not needed, the lower bound 1 - exp(-k n) <= t
+  bool density_evaluated = false;  // whether d = p(x) / max p was computed for this sample
 };
 
 class Dgmm {
@@ -59,12 +63,45 @@ class Dgmm {
   // ADDSAMPLE (Algorithm 2) for x (dim entries, finite: asserted).
   AddSampleResult AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng);
 
+  // Covariance the model uses for a component with these statistics (docs/dgmm.md, "floor"):
+  // (M2 + nu S0) / (n - 1 + nu) + floor I with nu = max(0, dim + 1 - n), S0 the initial
+  // covariance; equals S0 + floor I for n = 1 and M2 / (n - 1) + floor I once n > dim.
+  Eigen::MatrixXd FlooredCovariance(const DgmmComponentStats& stats) const;
+  // log max_x p(x) (cached until the components change); -inf when empty.
+  double MaxLogDensity() const;
+  // Upper bound log sum_i w_i max_x N_i(x) / W >= log max p, O(k).
+  double PeakLogDensityBound() const;
+
  private:
+  // Algorithm 2 as written (options_.variant == kFaithful).
+  AddSampleResult AddSampleFaithful(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                    std::mt19937_64& rng);
+  // The improved variant (lib/core/dgmm_improved.cc).
+  AddSampleResult AddSampleImproved(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                    std::mt19937_64& rng);
+  // New component: mean x, initial covariance, weight 1. Returns its index.
+  int StartComponent(const Eigen::Ref<const Eigen::VectorXd>& x);
+  // Eqs. 11-13 for component i (Welford form), then refactors its Gaussian.
+  void MergeInto(int i, const Eigen::Ref<const Eigen::VectorXd>& x);
+  // Component index drawn with probability proportional to w_i exp(-1/2 m_i^2(x)).
+  int ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng);
+  // FlooredCovariance written into *cov (reusing its storage).
+  void FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const;
+  // Rebuilds mixture_ component i from stats_[i] with the floor.
+  void RefreshComponent(int i);
+
   int dim_;
   DgmmOptions options_;
   std::int64_t num_samples_ = 0;
   Mixture mixture_;
   std::vector<DgmmComponentStats> stats_;
+  Eigen::VectorXd initial_diagonal_;  // S0's diagonal, resolved (ones by default)
+  mutable bool max_valid_ = false;    // max_log_density_ is up to date
+  mutable double max_log_density_ = 0.0;
+  mutable Eigen::VectorXd last_mode_;   // argmax of the last mode search (a lower bound)
+  std::vector<double> log_choice_;      // scratch for ChooseComponent
+  Eigen::MatrixXd covariance_scratch_;  // scratch for RefreshComponent
+  Eigen::VectorXd delta_scratch_;       // scratch for MergeInto
 };
 
 }  // namespace dgmm

@@ -26,6 +26,10 @@ class Gaussian {
   // Replaces mean and covariance and refactors; returns false (and keeps the old state) if the
   // covariance is not positive definite.
   bool Set(Eigen::VectorXd mean, Eigen::MatrixXd covariance);
+  // Same as Set, reusing this object's storage (no heap allocation once sizes are stable);
+  // used by the DGMM update on every merged sample.
+  bool SetInPlace(const Eigen::Ref<const Eigen::VectorXd>& mean,
+                  const Eigen::Ref<const Eigen::MatrixXd>& covariance);
 
   // m^2 = (x - mean)^T covariance^-1 (x - mean); x has dim() entries.
   double SquaredMahalanobis(const Eigen::Ref<const Eigen::VectorXd>& x) const;
@@ -33,6 +37,18 @@ class Gaussian {
   double LogDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const;
   // log N for each column of X (d x n); returns n values.
   Eigen::VectorXd LogDensity(const Eigen::Ref<const Eigen::MatrixXd>& X) const;
+
+  // Any Eigen vector or matrix expression: picks the single-point overload for a column
+  // vector (compile-time one column) and the batch overload otherwise, so that calls with a
+  // VectorXd, MatrixXd, .col(j), .tail(n) ... are never ambiguous.
+  template <typename Derived>
+  auto LogDensity(const Eigen::MatrixBase<Derived>& x) const {
+    if constexpr (Derived::ColsAtCompileTime == 1) {
+      return LogDensity(Eigen::Ref<const Eigen::VectorXd>(x));
+    } else {
+      return LogDensity(Eigen::Ref<const Eigen::MatrixXd>(x));
+    }
+  }
   // The density scaled so that its maximum is 1: exp(-1/2 m^2), in [0, 1].
   double ScaledDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const;
 
@@ -53,6 +69,7 @@ class Gaussian {
   Eigen::MatrixXd covariance_;
   Eigen::MatrixXd l_;
   double log_det_ = 0.0;
+  Eigen::MatrixXd scratch_;  // factor under construction in SetInPlace
 };
 
 // Indices 0..dim-1 that are not in `dims`, ascending.

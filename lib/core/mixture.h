@@ -34,11 +34,25 @@ class Mixture {
   void Add(double weight, Gaussian g);
   void SetWeight(int i, double weight) { weights_[i] = weight; }
   void SetComponent(int i, Gaussian g) { components_[i] = std::move(g); }
+  // In-place access for updates that must not reallocate (Dgmm::AddSample).
+  Gaussian& mutable_component(int i) { return components_[i]; }
 
   // log p(x) by log-sum-exp over components.
   double LogDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const;
   // log p for each column of X (d x n).
   Eigen::VectorXd LogDensity(const Eigen::Ref<const Eigen::MatrixXd>& X) const;
+
+  // Any Eigen vector or matrix expression: picks the single-point overload for a column
+  // vector (compile-time one column) and the batch overload otherwise, so that calls with a
+  // VectorXd, MatrixXd, .col(j), .tail(n) ... are never ambiguous.
+  template <typename Derived>
+  auto LogDensity(const Eigen::MatrixBase<Derived>& x) const {
+    if constexpr (Derived::ColsAtCompileTime == 1) {
+      return LogDensity(Eigen::Ref<const Eigen::VectorXd>(x));
+    } else {
+      return LogDensity(Eigen::Ref<const Eigen::MatrixXd>(x));
+    }
+  }
   // log(w_i N_i(x)) - log p(x) for each i: responsibilities in log space.
   Eigen::VectorXd LogResponsibilities(const Eigen::Ref<const Eigen::VectorXd>& x) const;
 

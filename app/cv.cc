@@ -1,0 +1,177 @@
+// `dgmm cv`: repeated stratified K-fold cross-validation of a sample set (Table I of the paper):
+// held-out log-likelihood of the DGMM with and without terrain and of an EM-BIC baseline.
+#include <fmt/format.h>
+
+#include <cmath>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "app/command.h"
+#include "io/sample_set_io.h"
+#include "tune/cross_validation.h"
+#include "tune/dimensions.h"
+#include "util/error.h"
+
+namespace dgmm::app {
+namespace {
+
+struct CvArgs {
+  std::string path;
+  double k = 0.7;
+  int folds = 10;
+  int repeats = 10;
+  std::uint64_t seed = 1;
+  int threads = 0;
+  bool shuffle_training = false;
+  bool no_em = false;
+  int em_max_components = 5;
+  int em_n_init = 3;
+  std::string variant = "faithful";
+  std::vector<double> init_cov;
+  std::vector<std::string> pose_dims, terrain_dims;
+  bool json = false;
+};
+
+nlohmann::json ScoreJson(const CvScore& s) {
+  return {{"mean", s.mean},
+          {"sd", s.sd},
+          {"standard_error", s.standard_error},
+          {"mean_per_sample", s.mean_per_sample},
+          {"per_repeat", s.per_repeat},
+          {"mean_components", s.mean_components}};
+}
+
+void RunCv(const CvArgs& args) {
+  if (!(args.k > 0) || !std::isfinite(args.k)) {
+    throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
+  }
+  if (args.folds < 2) throw MakeInputError("", "--folds", "must be >= 2");
+  if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
+  const SampleSet set =
+      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
+  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
+  CvOptions options;
+  options.dgmm.k = args.k;
+  options.dgmm.variant = args.variant == "improved" ? DgmmOptions::Variant::kImproved
+                                                    : DgmmOptions::Variant::kFaithful;
+  if (!args.init_cov.empty()) {
+    const int dim = set.pose_dim() + set.terrain_dim();
+    if (static_cast<int>(args.init_cov.size()) != dim && args.init_cov.size() != 1) {
+      throw MakeInputError(
+          "", "--init-cov",
+          fmt::format("needs 1 or {} values (x || z), got {}", dim, args.init_cov.size()));
+    }
+    // One value applies to every dimension; the without-terrain model uses the x part.
+    options.dgmm.initial_covariance_diagonal =
+        args.init_cov.size() == 1
+            ? Eigen::VectorXd::Constant(dim, args.init_cov[0])
+            : Eigen::Map<const Eigen::VectorXd>(args.init_cov.data(), dim).eval();
+  }
+  options.folds = args.folds;
+  options.repeats = args.repeats;
+  options.seed = args.seed;
+  options.threads = args.threads;
+  options.shuffle_training = args.shuffle_training;
+  options.em_baseline = !args.no_em;
+  options.em_max_components = args.em_max_components;
+  options.em.n_init = args.em_n_init;
+  options.progress = [](int done, int total) { ReportProgress("cv folds", done, total); };
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "options", error);
+  const CvSummary summary = CrossValidate(set, options);
+
+  struct Row {
+    const char* key;
+    const char* label;
+    const CvScore* score;
+  };
+  const Row rows[] = {
+      {"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain},
+      {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain},
+      {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain},
+      {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain}};
+  if (args.json) {
+    nlohmann::json out = {{"file", args.path},
+                          {"samples", summary.samples},
+                          {"commands", summary.commands},
+                          {"folds", summary.folds},
+                          {"repeats", summary.repeats},
+                          {"k", args.k},
+                          {"seed", args.seed},
+                          {"shuffle_training", args.shuffle_training},
+                          {"has_terrain", summary.has_terrain},
+                          {"scored_per_repeat", summary.scored_per_repeat},
+                          {"unscored_per_repeat", summary.unscored_per_repeat},
+                          {"seconds", summary.seconds}};
+    for (const Row& row : rows) {
+      if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
+    }
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  std::cout << fmt::format(
+      "{}: {} samples, {} commands; {} x {}-fold cross-validation, k = {}, seed {} ({:.1f} s)\n",
+      args.path, summary.samples, summary.commands, summary.repeats, summary.folds, args.k,
+      args.seed, summary.seconds);
+  if (summary.unscored_per_repeat > 0) {
+    std::cout << fmt::format(
+        "note: {} held-out samples per repeat not scored (their command has no other sample)\n",
+        summary.unscored_per_repeat);
+  }
+  std::cout << "held-out log-likelihood, summed over all validation folds of a repeat\n";
+  std::cout << fmt::format("{:<24}{:>22}{:>12}{:>12}{:>10}\n", "model", "mean +- sd (repeats)",
+                           "std. error", "per sample", "mean K");
+  for (const Row& row : rows) {
+    if (!row.score->evaluated) continue;
+    const CvScore& s = *row.score;
+    const std::string k = s.mean_components > 0 ? fmt::format("{:.2f}", s.mean_components) : "";
+    std::cout << fmt::format("{:<24}{:>22}{:>12.1f}{:>12.3f}{:>10}\n", row.label,
+                             fmt::format("{:.1f} +- {:.1f}", s.mean, s.sd), s.standard_error,
+                             s.mean_per_sample, k);
+  }
+  if (!summary.has_terrain) std::cout << "(the set has no terrain: no with-terrain rows)\n";
+}
+
+void SetupCv(CLI::App& root) {
+  auto args = std::make_shared<CvArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "cv",
+      "Cross-validated held-out log-likelihood (Table I): DGMM and EM-BIC, with and "
+      "without terrain");
+  cmd->add_option("set", args->path, "Sample set (.h5)")->required();
+  cmd->add_option("--k", args->k, "DGMM merge rate k > 0")->capture_default_str();
+  cmd->add_option("--folds", args->folds, "Folds (stratified by command), >= 2")
+      ->capture_default_str();
+  cmd->add_option("--repeats", args->repeats, "Repeats with new folds")->capture_default_str();
+  cmd->add_option("--seed", args->seed, "Seed of folds and merges")->capture_default_str();
+  cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")
+      ->capture_default_str();
+  cmd->add_flag("--shuffle-training", args->shuffle_training,
+                "Stream each training fold in a seeded random order (default: recorded order)");
+  cmd->add_flag("--no-em", args->no_em, "Skip the EM-BIC baseline");
+  cmd->add_option("--em-max-components", args->em_max_components,
+                  "EM-BIC: largest number of components tried per command")
+      ->capture_default_str();
+  cmd->add_option("--em-n-init", args->em_n_init, "EM restarts per fit")->capture_default_str();
+  cmd->add_option("--variant", args->variant, "DGMM variant")
+      ->check(CLI::IsMember({"faithful", "improved"}))
+      ->capture_default_str();
+  cmd->add_option("--init-cov", args->init_cov,
+                  "Initial covariance diagonal of new components (1 value or one per x||z dim)")
+      ->delimiter(',');
+  cmd->add_option("--pose-dims", args->pose_dims,
+                  "Pose dimensions to model, by name (default: all)")
+      ->delimiter(',');
+  cmd->add_option("--terrain-dims", args->terrain_dims,
+                  "Terrain dimensions to condition on, by name (default: all)")
+      ->delimiter(',');
+  cmd->add_flag("--json", args->json, "Print JSON");
+  cmd->callback([args] { RunCv(*args); });
+}
+
+}  // namespace
+
+DGMM_REGISTER_COMMAND("cv", SetupCv);
+
+}  // namespace dgmm::app

@@ -1,0 +1,144 @@
+// `dgmm fit`: one DGMM per command (Algorithm 2, ADDSAMPLE), streamed from a sample set file
+// chunk by chunk, so memory does not grow with the file.
+#include <fmt/format.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "app/command.h"
+#include "io/model_io.h"
+#include "io/sample_stream.h"
+#include "io/streaming.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace dgmm::app {
+namespace {
+
+struct FitArgs {
+  std::string set, output, variant = "faithful";
+  double k = 0.7;
+  double floor = DgmmOptions{}.covariance_floor;
+  std::vector<double> init_cov;
+  std::uint64_t seed = 1;
+  bool without_terrain = false;
+  int chunk_rows = 65536;
+  bool json = false;
+};
+
+// DGMM options from the flags, checked against the set's dimension.
+MotionModelOptions Options(const FitArgs& args) {
+  if (!std::isfinite(args.k) || args.k <= 0) {
+    throw MakeInputError(args.set, "--k",
+                         fmt::format("must be a finite number > 0, got {}", args.k));
+  }
+  if (!std::isfinite(args.floor) || args.floor < 0) {
+    throw MakeInputError(args.set, "--floor", "must be a finite number >= 0");
+  }
+  MotionModelOptions o;
+  o.dgmm.k = args.k;
+  o.dgmm.covariance_floor = args.floor;
+  o.seed = args.seed;
+  o.with_terrain = !args.without_terrain;
+  if (args.variant == "improved") {
+    o.dgmm.variant = DgmmOptions::Variant::kImproved;
+  } else if (args.variant != "faithful") {
+    throw MakeInputError(args.set, "--variant",
+                         "'" + args.variant + "', expected faithful or improved");
+  }
+  const SampleSet header = SampleSetReader(args.set).header();
+  const int dim = header.pose_dim() + (o.with_terrain ? header.terrain_dim() : 0);
+  if (args.init_cov.size() == 1) {
+    o.dgmm.initial_covariance_diagonal = Eigen::VectorXd::Constant(dim, args.init_cov[0]);
+  } else if (!args.init_cov.empty()) {
+    if (static_cast<int>(args.init_cov.size()) != dim) {
+      throw MakeInputError(args.set, "--init-cov",
+                           std::to_string(args.init_cov.size()) + " values for " +
+                               std::to_string(dim) + " dimensions (give 1 or " +
+                               std::to_string(dim) + ")");
+    }
+    o.dgmm.initial_covariance_diagonal =
+        Eigen::Map<const Eigen::VectorXd>(args.init_cov.data(), dim);
+  }
+  std::string error;
+  if (!o.dgmm.IsValid(dim, &error)) throw MakeInputError(args.set, "options", error);
+  return o;
+}
+
+void Run(const FitArgs& args) {
+  { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
+  const MotionModelOptions options = Options(args);
+  const auto start = std::chrono::steady_clock::now();
+  MotionModel model = LearnMotionModelFromFile(
+      args.set, options, args.chunk_rows,
+      [](long long done, long long total) { ReportProgress("fit", done, total); });
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  model.metadata["training_set"] = std::filesystem::path(args.set).filename().string();
+  WriteModel(model, args.output);
+
+  long long samples = 0;
+  nlohmann::json commands = nlohmann::json::array();
+  for (const auto& [id, mixture] : model.mixtures) {
+    auto label = model.command_labels.find(id);
+    const long long n = std::llround(mixture.total_weight());
+    samples += n;
+    commands.push_back({{"command", id},
+                        {"label", label == model.command_labels.end() ? "" : label->second},
+                        {"components", mixture.size()},
+                        {"samples", n}});
+  }
+  if (args.json) {
+    nlohmann::json out = {{"set", args.set},     {"model", args.output}, {"kind", model.kind},
+                          {"k", args.k},         {"seed", args.seed},    {"variant", args.variant},
+                          {"dim", model.dim()},  {"samples", samples},   {"seconds", seconds},
+                          {"commands", commands}};
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  std::printf(
+      "fitted a DGMM per command (k = %g, seed %llu, %s, d = %d) on %lld samples in %.2f s\n",
+      args.k, static_cast<unsigned long long>(args.seed), args.variant.c_str(), model.dim(),
+      samples, seconds);
+  for (const auto& c : commands) {
+    std::printf("  command %d '%s': %d components from %lld samples\n", c["command"].get<int>(),
+                c["label"].get<std::string>().c_str(), c["components"].get<int>(),
+                c["samples"].get<long long>());
+  }
+  std::printf("wrote %s\n", args.output.c_str());
+}
+
+void Setup(CLI::App& root) {
+  auto args = std::make_shared<FitArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "fit",
+      "Fit one Dynamic Gaussian Mixture Model per command (Edgington et al. 2009, Algorithm 2) "
+      "by streaming the sample set chunk by chunk; y = x||z unless --without-terrain.");
+  cmd->add_option("set", args->set, "sample set file (.h5)")->required();
+  cmd->add_option("-o,--output", args->output, "model file to write (.h5)")->required();
+  cmd->add_option("--k", args->k, "merge rate k > 0 in t = 1 - (1 - d) exp(-k n)")
+      ->capture_default_str();
+  cmd->add_option("--seed", args->seed, "seed of the random generator")->capture_default_str();
+  cmd->add_flag("--without-terrain", args->without_terrain, "model x alone, ignoring z");
+  cmd->add_option("--init-cov", args->init_cov,
+                  "diagonal of a new component's covariance: one value for every dimension or "
+                  "one per dimension, comma-separated (default: identity)")
+      ->delimiter(',');
+  cmd->add_option("--floor", args->floor, "covariance floor (docs/dgmm.md)")->capture_default_str();
+  cmd->add_option("--variant", args->variant, "faithful (the paper's Algorithm 2) or improved")
+      ->capture_default_str();
+  cmd->add_option("--chunk-rows", args->chunk_rows, "samples read per chunk")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--json", args->json, "print the summary as JSON");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace
+DGMM_REGISTER_COMMAND("fit", Setup);
+}  // namespace dgmm::app

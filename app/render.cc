@@ -1,0 +1,236 @@
+// `dgmm render`: density heat maps of a model (PNG, VTK offscreen) and, with --diff, the
+// three-panel comparison of two models laid out like Figure 3 of Edgington et al.
+#include <fmt/format.h>
+
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "app/command.h"
+#include "core/mise.h"
+#include "io/model_io.h"
+#include "io/sample_set_io.h"
+#include "render/density_grid.h"
+#include "render/display.h"
+#include "render/heat_map.h"
+#include "render/model_slice.h"
+#include "util/error.h"
+
+namespace dgmm::app {
+namespace {
+
+struct RenderArgs {
+  std::vector<std::string> models;
+  std::string output;
+  bool diff = false;
+  SliceSpec slice;
+  std::vector<std::string> conditions;
+  std::string data;
+  int contours = 6;
+  std::string size = "800x640";
+  int grid = 200;
+  std::string title;
+  std::vector<std::string> labels;
+  bool json = false;
+};
+
+std::pair<int, int> ParseSize(const std::string& text) {
+  int w = 0, h = 0;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
+    throw MakeInputError("", "--size", "expected WIDTHxHEIGHT, got '" + text + "'");
+  }
+  return {w, h};
+}
+
+std::vector<std::pair<std::string, double>> ParseConditions(const std::vector<std::string>& in) {
+  std::vector<std::pair<std::string, double>> out;
+  for (const std::string& c : in) {
+    auto eq = c.find('=');
+    size_t used = 0;
+    double value = 0;
+    bool ok = eq != std::string::npos && eq > 0;
+    if (ok) {
+      try {
+        value = std::stod(c.substr(eq + 1), &used);
+        ok = used == c.size() - eq - 1;
+      } catch (const std::exception&) {
+        ok = false;
+      }
+    }
+    if (!ok) throw MakeInputError("", "--condition", "expected name=value, got '" + c + "'");
+    out.emplace_back(c.substr(0, eq), value);
+  }
+  return out;
+}
+
+std::string Basename(const std::string& path) {
+  return std::filesystem::path(path).filename().string();
+}
+
+nlohmann::json LayoutJson(const PlotLayout& l) {
+  return {{"range", {l.range.x_min, l.range.x_max, l.range.y_min, l.range.y_max}},
+          {"plot_area_px", {{"left", l.left}, {"bottom", l.bottom}, {"right", l.right},
+                            {"top", l.top}}}};
+}
+
+nlohmann::json ModeJson(const Mixture& mixture, const PlotLayout& layout) {
+  Mixture::Mode mode = mixture.MaxDensity();
+  Eigen::Vector2d px = layout.ToPixel(mode.x(0), mode.x(1));
+  return {{"x", mode.x(0)}, {"y", mode.x(1)}, {"density", std::exp(mode.log_density)},
+          {"pixel", {px(0), px(1)}}};
+}
+
+// A window that shows every slice and the data (padded by 5% when data widen it).
+PlotRange CombinedRange(const std::vector<const ModelSlice*>& slices,
+                        const Eigen::MatrixX2d& points) {
+  PlotRange range = MixtureRange(slices.front()->mixture);
+  for (const ModelSlice* s : slices) {
+    PlotRange r = MixtureRange(s->mixture);
+    range.Include(r.x_min, r.y_min);
+    range.Include(r.x_max, r.y_max);
+  }
+  if (points.rows() > 0) {
+    for (Eigen::Index i = 0; i < points.rows(); ++i) range.Include(points(i, 0), points(i, 1));
+    const double px = 0.05 * (range.x_max - range.x_min), py = 0.05 * (range.y_max - range.y_min);
+    range = {range.x_min - px, range.x_max + px, range.y_min - py, range.y_max + py};
+  }
+  return range;
+}
+
+void Run(const RenderArgs& args) {
+  // Before any VTK call: a missing display is one clear line, never a crash.
+  RequireDisplay();
+  if (args.diff != (args.models.size() == 2)) {
+    throw MakeInputError("", "models", args.diff ? "--diff needs exactly two model files"
+                                                 : "give one model file (or two with --diff)");
+  }
+  if (args.contours < 0 || args.contours > 50) {
+    throw MakeInputError("", "--contours", "must be between 0 and 50");
+  }
+  if (args.grid < 10 || args.grid > 2000) {
+    throw MakeInputError("", "--grid", "must be between 10 and 2000");
+  }
+  auto [width, height] = ParseSize(args.size);
+  SliceSpec spec = args.slice;
+  spec.conditions = ParseConditions(args.conditions);
+
+  std::vector<MotionModel> models;
+  std::vector<ModelSlice> slices;
+  for (const std::string& path : args.models) {
+    models.push_back(ReadModel(path));
+    slices.push_back(SliceModel(models.back(), spec, path));
+  }
+  if (args.diff && slices[0].mixture.dim() != slices[1].mixture.dim()) {
+    throw MakeInputError(args.models[1], "dimensions", "differs from " + args.models[0]);
+  }
+  Eigen::MatrixX2d points(0, 2);
+  if (!args.data.empty()) {
+    SampleSet set = ReadSampleSet(args.data);
+    points = SlicePoints(set, slices[0].command, slices[0].x_index, slices[0].y_index);
+  }
+  std::vector<const ModelSlice*> slice_ptrs;
+  for (const auto& s : slices) slice_ptrs.push_back(&s);
+  const PlotRange range = CombinedRange(slice_ptrs, points);
+  if (!range.IsValid()) throw MakeInputError(args.models[0], "", "cannot find a plot window");
+
+  nlohmann::json report = {{"output", args.output}, {"width", width}, {"height", height}};
+  if (!args.diff) {
+    const ModelSlice& s = slices[0];
+    HeatMapSpec map;
+    map.background = MixtureDensityGrid(s.mixture, range, args.grid, args.grid);
+    if (args.contours > 0) map.contours.push_back({map.background, args.contours, {200, 200, 200}});
+    map.points = points;
+    map.title = args.title.empty() ? fmt::format("{} model {}: {}", models[0].kind,
+                                                 Basename(args.models[0]), s.description)
+                                   : args.title;
+    map.x_label = s.x_label;
+    map.y_label = s.y_label;
+    map.width = width;
+    map.height = height;
+    PlotLayout layout = RenderHeatMap(map, args.output);
+    report["panels"] = {LayoutJson(layout)};
+    report["panels"][0]["mode"] = ModeJson(s.mixture, layout);
+    report["description"] = s.description;
+  } else {
+    std::vector<std::string> labels = args.labels;
+    for (size_t i = labels.size(); i < 2; ++i) {
+      labels.push_back(models[i].kind + " " + Basename(args.models[i]));
+    }
+    std::vector<DensityGrid> grids;
+    for (const auto& s : slices) grids.push_back(MixtureDensityGrid(s.mixture, range, args.grid, args.grid));
+    std::vector<HeatMapSpec> panels(3);
+    const std::array<unsigned char, 3> kA{0, 0, 0}, kB{0, 150, 60}, kGrey{200, 200, 200};
+    for (int i = 0; i < 2; ++i) {
+      panels[i].background = grids[i];
+      if (args.contours > 0) panels[i].contours.push_back({grids[i], args.contours, kGrey});
+      panels[i].title = fmt::format("{}: {}", i == 0 ? "A" : "B", labels[i]);
+    }
+    HeatMapSpec& d = panels[2];
+    d.background = grids[0];
+    d.background.values = grids[0].values - grids[1].values;
+    d.palette = HeatMapSpec::Palette::kDiverging;
+    d.value_label = "density difference A - B";
+    if (args.contours > 0) {
+      d.contours.push_back({grids[0], args.contours, kA, 1.5f, labels[0]});
+      d.contours.push_back({grids[1], args.contours, kB, 1.5f, labels[1]});
+    }
+    d.title = args.title.empty() ? "A - B (red: A higher); contours A black, B green" : args.title;
+    for (auto& p : panels) {
+      p.points = points;
+      p.x_label = slices[0].x_label;
+      p.y_label = slices[0].y_label;
+      p.width = width;
+      p.height = height;
+    }
+    std::vector<PlotLayout> layouts = RenderHeatMapRow(panels, args.output);
+    report["width"] = layouts.front().width;
+    for (int i = 0; i < 3; ++i) report["panels"].push_back(LayoutJson(layouts[i]));
+    for (int i = 0; i < 2; ++i) report["panels"][i]["mode"] = ModeJson(slices[i].mixture, layouts[i]);
+    report["description"] = slices[0].description;
+    report["ise_of_slices"] = IntegratedSquaredError(slices[0].mixture, slices[1].mixture);
+  }
+  if (args.json) {
+    std::cout << report.dump(2) << "\n";
+  } else {
+    std::cout << "wrote " << args.output << " (" << report["width"].get<int>() << "x" << height
+              << "): " << report["description"].get<std::string>() << "\n";
+  }
+}
+
+void Setup(CLI::App& root) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "render",
+      "Density heat map of a model as PNG (or, with --diff, model A, model B and their "
+      "difference side by side). Needs an X display: run under `xvfb-run -a`.");
+  cmd->add_option("models", args->models, "model file (two with --diff)")
+      ->required()->expected(1, 2)->check(CLI::ExistingFile);
+  cmd->add_option("-o,--output", args->output, "PNG to write")->required();
+  cmd->add_flag("--diff", args->diff, "compare two models: A, B and A - B (like Figure 3)");
+  cmd->add_option("--command", args->slice.command, "command id or label (default: the only one)");
+  cmd->add_option("--x-dim", args->slice.x_dim, "dimension on the x axis (default: the first)");
+  cmd->add_option("--y-dim", args->slice.y_dim, "dimension on the y axis (default: the second)");
+  cmd->add_option("--condition", args->conditions,
+                  "name=value (raw units): condition on a dimension, e.g. pitch=0.1 (repeatable)");
+  cmd->add_flag("--marginalise,--marginalize", args->slice.marginalise,
+                "integrate out dimensions that are neither shown nor conditioned");
+  cmd->add_option("--data", args->data, "sample set whose points are overlaid")
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--contours", args->contours, "number of contour lines (0: none)")
+      ->capture_default_str();
+  cmd->add_option("--size", args->size, "WIDTHxHEIGHT of the image (of each panel with --diff)")
+      ->capture_default_str();
+  cmd->add_option("--grid", args->grid, "grid points per axis")->capture_default_str();
+  cmd->add_option("--title", args->title, "title (default: what is shown)");
+  cmd->add_option("--labels", args->labels, "names of models A and B for --diff")->expected(0, 2);
+  cmd->add_flag("--json", args->json, "print output, plot windows, pixel layout and modes as JSON");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace
+
+DGMM_REGISTER_COMMAND("render", Setup);
+
+}  // namespace dgmm::app

@@ -1,0 +1,119 @@
+// `dgmm sim2real`: where the simulation fails on real recordings, what physics it left out, the
+// corrected model, and how much of the gap it closes (lib/sim2real, docs/sim2real.md).
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "app/command.h"
+#include "io/model_io.h"
+#include "io/sample_set_io.h"
+#include "sim2real/corrected_model.h"
+#include "sim2real/figures.h"
+#include "sim2real/pipeline.h"
+#include "sim2real/recalibrate.h"
+#include "sim2real/report.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace dgmm::app {
+namespace {
+
+struct Sim2RealArgs {
+  std::string sim, real, out, sim_config;
+  std::uint64_t seed = 1;
+  int bootstrap = 20;
+  int permutations = 1000;
+  bool json = false;
+  bool no_figures = false;
+};
+
+void WriteText(const std::filesystem::path& path, const std::string& text) {
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temp_path(), std::ios::binary);
+    out << text;
+    if (!out) throw MakeInputError(path.string(), "", "cannot write");
+  }
+  file.Commit();
+}
+
+void Run(const Sim2RealArgs& args) {
+  namespace fs = std::filesystem;
+  const SampleSet sim = ReadSampleSet(args.sim);
+  const SampleSet real = ReadSampleSet(args.real);
+  std::error_code ec;
+  fs::create_directories(args.out, ec);
+  if (ec || !fs::is_directory(args.out)) {
+    throw MakeInputError(args.out, "-o", "cannot create the output folder");
+  }
+  if (!args.sim_config.empty() && !fs::exists(args.sim_config)) {
+    throw MakeInputError(args.sim_config, "--sim-config", "no such file");
+  }
+  sim2real::Sim2RealOptions options;
+  options.seed = args.seed;
+  options.selection.bootstrap_selection = args.bootstrap;
+  options.locate.mmd.permutations = args.permutations;
+  if (ShowProgress()) std::cerr << "sim2real: analysing " << real.size() << " real vs " << sim.size() << " sim samples\n";
+  const sim2real::Sim2RealResult result = sim2real::RunSim2Real(sim, real, options);
+
+  sim2real::ReportContext ctx;
+  ctx.sim_path = args.sim;
+  ctx.real_path = args.real;
+  ctx.corrected_model_file = "corrected_model.h5";
+  ctx.sim_model_file = "sim_model.h5";
+  WriteModel(sim2real::BuildCorrectedModel(result, sim), (fs::path(args.out) / ctx.corrected_model_file).string());
+  WriteModel(sim2real::BuildSimModel(result, sim), (fs::path(args.out) / ctx.sim_model_file).string());
+  if (!args.sim_config.empty()) {
+    if (ShowProgress()) std::cerr << "sim2real: re-simulating with fitted physical parameters\n";
+    sim2real::RecalibrationOptions recal;
+    recal.sim_config_path = args.sim_config;
+    recal.seed = args.seed;
+    ctx.recalibration_json = sim2real::Recalibrate(result, real, recal);
+  }
+  if (args.no_figures) {
+    ctx.notes.push_back("figures skipped: --no-figures");
+  } else {
+    std::string note;
+    ctx.figures = sim2real::RenderFigures(result, sim, real, args.out, &note);
+    if (!note.empty()) ctx.notes.push_back(note);
+  }
+  const std::string json = sim2real::ReportJson(result, ctx);
+  WriteText(fs::path(args.out) / "report.json", json);
+  WriteText(fs::path(args.out) / "report.html", sim2real::ReportHtml(result, ctx, args.out));
+  if (args.json) {
+    std::cout << json;
+    return;
+  }
+  std::cout << result.conclusion << "\n";
+  for (const auto& n : ctx.notes) std::cout << "note: " << n << "\n";
+  std::cout << "report: " << (fs::path(args.out) / "report.html").string() << "\n";
+}
+
+void Setup(CLI::App& root) {
+  auto args = std::make_shared<Sim2RealArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "sim2real",
+      "Compare a simulated and a real sample set: locate where the sim-trained model fails "
+      "(terrain, sequence, command), name the physics the simulation left out (slip, traction, "
+      "payload offset, actuator asymmetry, latency, compliance, bias, noise), write the corrected "
+      "model and show how much of the gap it closes. Writes report.html, report.json, "
+      "corrected_model.h5, sim_model.h5 and PNGs into -o.");
+  cmd->add_option("--sim", args->sim, "simulated sample set (.h5)")->required();
+  cmd->add_option("--real", args->real, "real sample set (.h5)")->required();
+  cmd->add_option("-o,--output", args->out, "output folder")->required();
+  cmd->add_option("--seed", args->seed, "seed of folds, bootstrap and permutations")->capture_default_str();
+  cmd->add_option("--sim-config", args->sim_config, "simulation config of the sim set (JSON)");
+  cmd->add_option("--bootstrap", args->bootstrap, "bootstrap resamples of the effect selection")
+      ->capture_default_str()->check(CLI::Range(0, 1000));
+  cmd->add_option("--permutations", args->permutations, "permutations per two-sample test")
+      ->capture_default_str()->check(CLI::Range(1, 100000));
+  cmd->add_flag("--no-figures", args->no_figures, "skip the PNG figures");
+  cmd->add_flag("--json", args->json, "print report.json to stdout instead of the conclusion");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace
+DGMM_REGISTER_COMMAND("sim2real", Setup);
+}  // namespace dgmm::app

@@ -1,0 +1,245 @@
+#include "core/dgmm.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+namespace dgmm {
+namespace {
+
+constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+
+bool Fail(std::string* error, const std::string& message) {
+  if (error) *error = message;
+  return false;
+}
+
+}  // namespace
+
+bool DgmmOptions::IsValid(std::string* error) const {
+  if (!std::isfinite(k) || !(k > 0)) {
+    return Fail(error, "k must be a finite number > 0, got " + std::to_string(k));
+  }
+  if (!std::isfinite(covariance_floor) || covariance_floor < 0) {
+    return Fail(
+        error, "covariance floor must be finite and >= 0, got " + std::to_string(covariance_floor));
+  }
+  for (int i = 0; i < initial_covariance_diagonal.size(); ++i) {
+    const double v = initial_covariance_diagonal[i];
+    if (!std::isfinite(v) || !(v > 0)) {
+      return Fail(error, "initial covariance diagonal entry " + std::to_string(i) +
+                             " must be finite and > 0, got " + std::to_string(v));
+    }
+  }
+  return true;
+}
+
+bool DgmmOptions::IsValid(int dim, std::string* error) const {
+  if (!IsValid(error)) return false;
+  if (initial_covariance_diagonal.size() != 0 && initial_covariance_diagonal.size() != dim) {
+    return Fail(error, "initial covariance diagonal has " +
+                           std::to_string(initial_covariance_diagonal.size()) +
+                           " entries, the model has " + std::to_string(dim) + " dimensions");
+  }
+  return true;
+}
+
+Dgmm::Dgmm(int dim, DgmmOptions options) : dim_(dim), options_(std::move(options)), mixture_(dim) {
+  assert(dim > 0);
+  assert(options_.IsValid(dim, nullptr));
+  initial_diagonal_ = options_.initial_covariance_diagonal.size() == dim
+                          ? options_.initial_covariance_diagonal
+                          : Eigen::VectorXd::Ones(dim);
+}
+
+Eigen::MatrixXd Dgmm::SampleCovariance(int i) const {
+  const DgmmComponentStats& s = stats_[i];
+  assert(s.count >= 2);
+  return s.scatter / static_cast<double>(s.count - 1);
+}
+
+Eigen::MatrixXd Dgmm::FlooredCovariance(const DgmmComponentStats& stats) const {
+  Eigen::MatrixXd cov;
+  FloorInto(stats, &cov);
+  return cov;
+}
+
+void Dgmm::FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const {
+  const double n = static_cast<double>(stats.count);
+  const double nu = std::max(0.0, dim_ + 1.0 - n);  // prior pseudo-samples of S0
+  const double scale = 1.0 / (n - 1.0 + nu);
+  cov->resize(dim_, dim_);  // no reallocation when already dim x dim
+  *cov = stats.scatter * scale;
+  for (int i = 0; i < dim_; ++i) {
+    (*cov)(i, i) =
+        (stats.scatter(i, i) + nu * initial_diagonal_[i]) * scale + options_.covariance_floor;
+  }
+}
+
+double Dgmm::MaxLogDensity() const {
+  if (!max_valid_) {
+    if (mixture_.empty()) {
+      max_log_density_ = kNegInf;
+    } else {
+      Mixture::Mode mode = mixture_.MaxDensity();
+      max_log_density_ = mode.log_density;
+      last_mode_ = std::move(mode.x);
+    }
+    max_valid_ = true;
+  }
+  return max_log_density_;
+}
+
+double Dgmm::PeakLogDensityBound() const {
+  // p(x) <= sum_i w_i/W max N_i = sum_i w_i/W (2 pi)^(-d/2) det(S_i)^(-1/2).
+  constexpr double kLog2Pi = 1.8378770664093454835606594728112;
+  double m = kNegInf;
+  const int k = mixture_.size();
+  for (int i = 0; i < k; ++i) {
+    m = std::max(m, std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det());
+  }
+  double s = 0.0;
+  for (int i = 0; i < k; ++i) {
+    s += std::exp(std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det() - m);
+  }
+  return m + std::log(s) - std::log(mixture_.total_weight()) - 0.5 * dim_ * kLog2Pi;
+}
+
+AddSampleResult Dgmm::AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng) {
+  assert(x.size() == dim_ && x.allFinite());
+  if (options_.variant == DgmmOptions::Variant::kImproved) return AddSampleImproved(x, rng);
+  return AddSampleFaithful(x, rng);
+}
+
+AddSampleResult Dgmm::AddSampleFaithful(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        std::mt19937_64& rng) {
+  AddSampleResult result;
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double r = uniform(rng);
+  const double decay = std::exp(-options_.k * static_cast<double>(num_samples_));
+  if (mixture_.empty()) {
+    // p(x) = 0 for an empty model: d = 0 and t = 1 - exp(0) = 0, so r < t never holds.
+    result.threshold = 0.0;
+    result.density_evaluated = true;
+  } else {
+    // t = 1 - (1 - d) exp(-k n) >= 1 - exp(-k n) for any d in [0, 1]: below that bound the
+    // sample merges whatever d is, so d (and the max-density search) is computed only above it.
+    result.threshold = 1.0 - decay;
+    if (!(r < result.threshold)) {
+      const double log_p = mixture_.LogDensity(x);
+      // Bounds lo <= log max p <= hi decide most samples without the mode search (exactly:
+      // t is increasing in d): lo = log p at the last mode found (or at x itself), hi = log of
+      // the sum of each component's peak w_i N_i(mu_i) / W.
+      double decided = -1.0;  // the threshold bound that decides, or -1
+      if (!max_valid_) {
+        double lo = log_p;
+        if (last_mode_.size() == dim_) lo = std::max(lo, mixture_.LogDensity(last_mode_));
+        const double hi = PeakLogDensityBound();
+        const double t_lo = 1.0 - (1.0 - std::clamp(std::exp(log_p - hi), 0.0, 1.0)) * decay;
+        const double t_hi = 1.0 - (1.0 - std::clamp(std::exp(log_p - lo), 0.0, 1.0)) * decay;
+        if (r < t_lo) decided = t_lo;
+        if (!(r < t_hi)) decided = t_hi;
+      }
+      if (decided >= 0) {
+        result.threshold = decided;
+      } else {
+        const double d = std::clamp(std::exp(log_p - MaxLogDensity()), 0.0, 1.0);
+        result.threshold = 1.0 - (1.0 - d) * decay;
+        result.density_evaluated = true;
+      }
+    }
+    result.merged = r < result.threshold;
+  }
+  if (result.merged) {
+    result.component = ChooseComponent(x, rng);
+    MergeInto(result.component, x);
+  } else {
+    result.component = StartComponent(x);
+  }
+  ++num_samples_;
+  return result;
+}
+
+int Dgmm::StartComponent(const Eigen::Ref<const Eigen::VectorXd>& x) {
+  DgmmComponentStats s;
+  s.count = 1;
+  s.mean = x;
+  s.scatter = Eigen::MatrixXd::Zero(dim_, dim_);
+  stats_.push_back(std::move(s));
+  Eigen::MatrixXd cov = FlooredCovariance(stats_.back());
+  mixture_.Add(1.0, Gaussian(x, std::move(cov)));
+  max_valid_ = false;
+  return mixture_.size() - 1;
+}
+
+void Dgmm::MergeInto(int i, const Eigen::Ref<const Eigen::VectorXd>& x) {
+  // Eqs. 11-13 with w = n the sample count: w' = w + 1, mu' = mu + (x - mu) / w',
+  // S' = (w - 1)/w S + (x - mu)(x - mu)^T / w'. Kept as count, mean and scatter
+  // M2 = (n - 1) S, updated M2' = M2 + (w / w') delta delta^T (Welford), which is the same
+  // recursion multiplied by w and keeps M2 exactly symmetric and positive semi-definite.
+  DgmmComponentStats& s = stats_[i];
+  const double w = static_cast<double>(s.count);
+  const double w_next = w + 1.0;
+  delta_scratch_ = x - s.mean;
+  s.mean.noalias() += delta_scratch_ / w_next;
+  // Lower triangle computed once and mirrored: the scatter stays bitwise symmetric.
+  const double c = w / w_next;
+  for (int col = 0; col < dim_; ++col) {
+    const double dc = c * delta_scratch_[col];
+    for (int row = col; row < dim_; ++row) {
+      s.scatter(row, col) += dc * delta_scratch_[row];
+      s.scatter(col, row) = s.scatter(row, col);
+    }
+  }
+  s.count += 1;
+  mixture_.SetWeight(i, static_cast<double>(s.count));
+  RefreshComponent(i);
+}
+
+void Dgmm::RefreshComponent(int i) {
+  FloorInto(stats_[i], &covariance_scratch_);
+  Gaussian& g = mixture_.mutable_component(i);
+  max_valid_ = false;
+  if (g.SetInPlace(stats_[i].mean, covariance_scratch_)) return;
+  // Round-off (or floor = 0 with degenerate samples): add a growing multiple of S0's diagonal.
+  for (double jitter = 1e-12; jitter <= 1.0; jitter *= 10) {
+    Eigen::MatrixXd c = covariance_scratch_;
+    c.diagonal() += jitter * initial_diagonal_;
+    if (g.SetInPlace(stats_[i].mean, c)) return;
+  }
+  // Cannot happen for finite inputs (jitter 1 * S0 alone is PD); keep S0 as a last resort.
+  g.SetInPlace(stats_[i].mean, initial_diagonal_.asDiagonal().toDenseMatrix());
+}
+
+int Dgmm::ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng) {
+  // P(i) = w_i g_i(x) / sum_j w_j g_j(x), g_i = exp(-1/2 m_i^2) (max-normalised, Algorithm 2),
+  // in log space so that a sample far from every component still picks the nearest one.
+  const int k = mixture_.size();
+  log_choice_.resize(k);
+  double m = kNegInf;
+  for (int i = 0; i < k; ++i) {
+    log_choice_[i] =
+        std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).SquaredMahalanobis(x);
+    m = std::max(m, log_choice_[i]);
+  }
+  double total = 0.0;
+  for (int i = 0; i < k; ++i) {
+    log_choice_[i] = std::exp(log_choice_[i] - m);
+    total += log_choice_[i];
+  }
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double u = uniform(rng) * total;
+  double cumulative = 0.0;
+  for (int i = 0; i < k; ++i) {
+    cumulative += log_choice_[i];
+    if (u < cumulative) return i;
+  }
+  // u == total by round-off: the last component with non-zero probability.
+  for (int i = k - 1; i >= 0; --i) {
+    if (log_choice_[i] > 0) return i;
+  }
+  return k - 1;
+}
+
+}  // namespace dgmm

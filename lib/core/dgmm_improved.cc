@@ -1,0 +1,98 @@
+// The improved single-pass ADDSAMPLE (DgmmOptions::Variant::kImproved; docs/reproduction.md,
+// section old-faithful, has the evidence). Same spirit as Algorithm 2: one pass, no sample
+// history, new components started by the paper's rule t = 1 - (1 - d) exp(-k n) with
+// d = p(x) / max p, so k keeps its meaning and the number of Gaussians stays data-driven.
+// Three changes address the contamination of components by early merges, which is what keeps the
+// faithful variant's MISE high on Old Faithful:
+//  1. The receiving component is the most likely one, argmax_i N_i(x) (normalised density, no
+//     weight, no random draw). The paper's draw proportional to w_i exp(-1/2 m_i^2) ignores the
+//     determinant and favours the heaviest component, so one broad early component keeps
+//     absorbing samples of both clusters.
+//  2. Recency weighting: the m-th sample a component receives has weight m, so the samples it got
+//     while young (before it found its cluster) fade as (m / n)^2. With weights 1..n the
+//     totals W = n(n+1)/2 and S2 = n(n+1)(2n+1)/6 follow from n, so the statistics stay
+//     (count, mean, scatter): `mean` is the weighted mean, `scatter` = (n - 1) C_w where
+//     C_w = M2_w / (W - S2 / W) is the (reliability-weighted, unbiased) weighted covariance.
+//  3. The initial covariance S0 counts as one pseudo-sample for the component's whole life:
+//     covariance = ((n - 1) C_w + S0) / n + floor I. A component that received a few close
+//     samples is never so tight that it stops winning samples of its own cluster.
+// Mixture weights remain the sample counts n_i (eq. 3).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/dgmm.h"
+
+namespace dgmm {
+namespace {
+
+// Pseudo-samples of S0 in every improved covariance (change 3).
+constexpr double kPriorSamples = 1.0;
+
+}  // namespace
+
+AddSampleResult Dgmm::AddSampleImproved(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        std::mt19937_64& rng) {
+  AddSampleResult result;
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double r = uniform(rng);
+  const double decay = std::exp(-options_.k * static_cast<double>(num_samples_));
+  if (mixture_.empty()) {
+    result.threshold = 0.0;
+    result.density_evaluated = true;
+  } else {
+    // As in Algorithm 2 (and AddSampleFaithful): d is only needed when r >= 1 - exp(-k n).
+    result.threshold = 1.0 - decay;
+    if (!(r < result.threshold)) {
+      const double d = std::clamp(std::exp(mixture_.LogDensity(x) - MaxLogDensity()), 0.0, 1.0);
+      result.threshold = 1.0 - (1.0 - d) * decay;
+      result.density_evaluated = true;
+    }
+    result.merged = r < result.threshold;
+  }
+  if (!result.merged) {
+    result.component = StartComponent(x);
+    ++num_samples_;
+    return result;
+  }
+  // 1. The most likely component.
+  int best = 0;
+  double best_log_density = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < mixture_.size(); ++i) {
+    const double l = mixture_.component(i).LogDensity(x);
+    if (l > best_log_density) best_log_density = l, best = i;
+  }
+  result.component = best;
+
+  // 2. Weighted Welford step with weight a = m for the m-th sample of the component.
+  DgmmComponentStats& s = stats_[best];
+  const double n = static_cast<double>(s.count), m = n + 1.0;
+  const double w_prev = n * (n + 1.0) / 2.0, w_new = w_prev + m;
+  const double s2_prev = n * (n + 1.0) * (2.0 * n + 1.0) / 6.0, s2_new = s2_prev + m * m;
+  // M2_w from the stored (n - 1) C_w; zero for a single sample.
+  Eigen::MatrixXd m2 = Eigen::MatrixXd::Zero(dim_, dim_);
+  if (n > 1.0) m2 = s.scatter * ((w_prev - s2_prev / w_prev) / (n - 1.0));
+  const Eigen::VectorXd delta = x - s.mean;
+  s.mean += (m / w_new) * delta;
+  m2.noalias() += (m * w_prev / w_new) * delta * delta.transpose();
+  s.scatter = m2 * ((m - 1.0) / (w_new - s2_new / w_new));
+  s.scatter = 0.5 * (s.scatter + s.scatter.transpose()).eval();
+  s.count += 1;
+  mixture_.SetWeight(best, static_cast<double>(s.count));
+
+  // 3. Covariance with S0 as one pseudo-sample, plus the floor.
+  Eigen::MatrixXd covariance = s.scatter;
+  covariance.diagonal() += kPriorSamples * initial_diagonal_;
+  covariance /= (m - 1.0 + kPriorSamples);
+  covariance.diagonal().array() += options_.covariance_floor;
+  max_valid_ = false;
+  Gaussian& g = mixture_.mutable_component(best);
+  if (!g.Set(s.mean, covariance)) {
+    // Cannot happen for finite inputs (S0 / m alone is positive definite): keep S0.
+    g.Set(s.mean, initial_diagonal_.asDiagonal().toDenseMatrix());
+  }
+  ++num_samples_;
+  return result;
+}
+
+}  // namespace dgmm

@@ -1,0 +1,229 @@
+#include "core/motion_model.h"
+
+#include <cmath>
+#include <numeric>
+
+#include "util/error.h"
+
+namespace dgmm {
+namespace {
+
+std::vector<int> Range(int begin, int end) {
+  std::vector<int> v(std::max(0, end - begin));
+  std::iota(v.begin(), v.end(), begin);
+  return v;
+}
+
+// "0 ('fwd'), 2 ('turn')": the commands a model has a mixture for.
+std::string ListCommands(const MotionModel& model) {
+  std::string out;
+  for (const auto& [id, mixture] : model.mixtures) {
+    if (!out.empty()) out += ", ";
+    out += std::to_string(id);
+    if (auto it = model.command_labels.find(id); it != model.command_labels.end()) {
+      out += " ('" + it->second + "')";
+    }
+  }
+  return out.empty() ? "none" : out;
+}
+
+void CheckSize(const char* field, Eigen::Index got, int expected) {
+  if (got != expected) {
+    throw MakeInputError("", field,
+                         "has " + std::to_string(got) + " dimensions, the model expects " +
+                             std::to_string(expected));
+  }
+}
+
+// Relative equality of two transforms over their first `dims` entries.
+bool SameTransform(const Standardization& a, const Standardization& b, int dims) {
+  if (a.offset.size() < dims || b.offset.size() < dims) return false;
+  for (int j = 0; j < dims; ++j) {
+    const double tol = 1e-9 * std::max({1.0, std::abs(a.scale[j]), std::abs(a.offset[j])});
+    if (std::abs(a.offset[j] - b.offset[j]) > tol || std::abs(a.scale[j] - b.scale[j]) > tol) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+const Mixture& MotionModel::MixtureFor(int command) const {
+  if (auto it = mixtures.find(command); it != mixtures.end()) return it->second;
+  std::string which = std::to_string(command);
+  if (auto it = command_labels.find(command); it != command_labels.end()) {
+    which += " ('" + it->second + "')";
+  }
+  if (command_values.count(command) > 0) {
+    throw MakeInputError("", "command",
+                         "command " + which +
+                             " had no samples in the training set, so the model has no "
+                             "mixture for it (model has: " +
+                             ListCommands(*this) + ")");
+  }
+  throw MakeInputError("", "command",
+                       "unknown command " + which + " (model has: " + ListCommands(*this) + ")");
+}
+
+double MotionModel::LogLikelihood(int command, const Eigen::Ref<const Eigen::VectorXd>& x) const {
+  CheckSize("x", x.size(), pose_dim);
+  const Mixture& mixture = MixtureFor(command);
+  if (terrain_dim == 0) return mixture.LogDensity(x);
+  return mixture.Marginal(Range(0, pose_dim)).LogDensity(x);
+}
+
+double MotionModel::LogLikelihood(int command, const Eigen::Ref<const Eigen::VectorXd>& x,
+                                  const Eigen::Ref<const Eigen::VectorXd>& z) const {
+  CheckSize("x", x.size(), pose_dim);
+  return Conditional(command, z).LogDensity(x);
+}
+
+Mixture MotionModel::Conditional(int command, const Eigen::Ref<const Eigen::VectorXd>& z) const {
+  if (terrain_dim == 0) {
+    throw MakeInputError("", "terrain", "the model was fitted without terrain");
+  }
+  CheckSize("z", z.size(), terrain_dim);
+  return MixtureFor(command).Conditional(Range(pose_dim, dim()), z);
+}
+
+MotionModelLearner::MotionModelLearner(MotionModel header, const MotionModelOptions& options)
+    : header_(std::move(header)), options_(options), rng_(options.seed) {
+  std::string error;
+  if (!options_.dgmm.IsValid(header_.dim(), &error)) {
+    throw MakeInputError("", "dgmm options", error);
+  }
+  if (header_.dim() <= 0) throw MakeInputError("", "model", "has no dimensions");
+}
+
+void MotionModelLearner::Add(int command, const Eigen::Ref<const Eigen::VectorXd>& y) {
+  CheckSize("sample", y.size(), header_.dim());
+  if (!y.allFinite()) {
+    throw MakeInputError("", "sample",
+                         "has a NaN or infinite value (command " + std::to_string(command) + ")");
+  }
+  if (!header_.command_values.empty() && header_.command_values.count(command) == 0) {
+    throw MakeInputError(
+        "", "command",
+        "unknown command " + std::to_string(command) + " (not in the command table)");
+  }
+  auto it = learners_.find(command);
+  if (it == learners_.end()) {
+    it = learners_.try_emplace(command, header_.dim(), options_.dgmm).first;
+  }
+  it->second.AddSample(y, rng_);
+}
+
+MotionModel MotionModelLearner::Finish() const {
+  MotionModel model = header_;
+  model.kind = "dgmm";
+  model.dgmm_options = options_.dgmm;
+  model.seed = options_.seed;
+  model.mixtures.clear();
+  for (const auto& [command, learner] : learners_) model.mixtures[command] = learner.mixture();
+  return model;
+}
+
+MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options) {
+  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
+  const bool terrain = options.with_terrain && set.terrain_dim() > 0;
+  MotionModel header;
+  header.pose_dim = set.pose_dim();
+  header.terrain_dim = terrain ? set.terrain_dim() : 0;
+  header.pose_names = set.x_names;
+  header.pose_units = set.x_units;
+  if (terrain) header.terrain_names = set.z_names;
+  header.command_dim_names = set.command_dim_names;
+  for (int c = 0; c < set.num_commands(); ++c) {
+    header.command_values[c] = set.commands.row(c).transpose();
+    if (c < static_cast<int>(set.command_labels.size())) {
+      header.command_labels[c] = set.command_labels[c];
+    }
+  }
+  header.transform = set.transform;
+  if (!set.source.empty()) header.metadata["training_source"] = set.source;
+  MotionModelLearner learner(std::move(header), options);
+  Eigen::VectorXd y(learner.Finish().dim());
+  for (int i = 0; i < set.size(); ++i) {
+    y.head(set.pose_dim()) = set.x.row(i).transpose();
+    if (terrain) y.tail(set.terrain_dim()) = set.z.row(i).transpose();
+    learner.Add(set.command[i], y);
+  }
+  return learner.Finish();
+}
+
+ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set) {
+  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
+  CheckSize("x", set.pose_dim(), model.pose_dim);
+  const bool terrain = model.terrain_dim > 0;
+  if (terrain) CheckSize("z", set.terrain_dim(), model.terrain_dim);
+  const int dy = model.dim();
+  // Standardisation: score in the model's units, then subtract sum log scale over pose dims
+  // (the Jacobian of x_std = (x_raw - offset) / scale) to return raw-unit log densities.
+  bool standardize = false;
+  double log_jacobian = 0.0;
+  if (model.transform.empty()) {
+    if (!set.transform.empty()) {
+      throw MakeInputError("", "transform",
+                           "the set is standardised but the model was fitted on raw data");
+    }
+  } else {
+    if (model.transform.offset.size() < dy || model.transform.scale.size() < dy) {
+      throw MakeInputError("", "transform",
+                           "the model's transform has fewer entries than "
+                           "its dimensions");
+    }
+    if (set.transform.empty()) {
+      standardize = true;
+    } else if (!SameTransform(model.transform, set.transform, model.pose_dim) ||
+               (terrain && !SameTransform(model.transform, set.transform, dy))) {
+      throw MakeInputError("", "transform",
+                           "the set was standardised differently from the model's training set");
+    }
+    log_jacobian = model.transform.scale.head(model.pose_dim).array().log().sum();
+  }
+  // Command index in the set -> command id in the model: by label when both have labels.
+  auto resolve = [&](int index) {
+    if (set.command_labels.empty() || model.command_labels.empty()) return index;
+    const std::string& label = set.command_labels[index];
+    for (const auto& [id, l] : model.command_labels) {
+      if (l == label) return id;
+    }
+    throw MakeInputError(
+        "", "command", "unknown command '" + label + "' (model has: " + ListCommands(model) + ")");
+  };
+  // Per command: the mixture over y (or x) and, with terrain, its marginal over z, so that
+  // log p(x | z) = log p(x || z) - log p(z) (eq. 15 without forming the conditional).
+  struct Prepared {
+    const Mixture* joint = nullptr;
+    Mixture marginal;  // over x (no terrain in use) or over z (terrain)
+  };
+  std::map<int, Prepared> prepared;
+  ScoreSummary summary;
+  Eigen::VectorXd y(dy);
+  for (int i = 0; i < set.size(); ++i) {
+    const int id = resolve(set.command[i]);
+    auto it = prepared.find(id);
+    if (it == prepared.end()) {
+      Prepared p;
+      p.joint = &model.MixtureFor(id);
+      p.marginal = terrain ? p.joint->Marginal(Range(model.pose_dim, dy))
+                           : p.joint->Marginal(Range(0, model.pose_dim));
+      it = prepared.emplace(id, std::move(p)).first;
+    }
+    y.head(model.pose_dim) = set.x.row(i).transpose();
+    if (terrain) y.tail(model.terrain_dim) = set.z.row(i).transpose();
+    if (standardize) {
+      y = (y - model.transform.offset.head(dy)).cwiseQuotient(model.transform.scale.head(dy));
+    }
+    const double ll = terrain ? it->second.joint->LogDensity(y) -
+                                    it->second.marginal.LogDensity(y.tail(model.terrain_dim))
+                              : it->second.marginal.LogDensity(y);
+    summary.total_log_likelihood += ll - log_jacobian;
+  }
+  summary.samples = set.size();
+  summary.mean_log_likelihood = summary.total_log_likelihood / summary.samples;
+  return summary;
+}
+
+}  // namespace dgmm

@@ -1,0 +1,38 @@
+#pragma once
+// Fitting and scoring straight from a sample set file, chunk by chunk: memory is bounded by the
+// chunk size whatever the file size.
+#include <functional>
+#include <map>
+#include <string>
+
+#include "core/motion_model.h"
+
+namespace dgmm {
+
+// Called after each chunk with samples done and the total.
+using StreamProgress = std::function<void(long long done, long long total)>;
+
+// The model header (dims, names, command table, transform, source) that LearnMotionModel
+// builds for a set with these tables; terrain is used when with_terrain and the set has it.
+MotionModel ModelHeaderFor(const SampleSet& header, bool with_terrain);
+
+// Same model as LearnMotionModel(ReadSampleSet(path), options), streaming the samples through
+// a MotionModelLearner. Throws InputError naming the file.
+MotionModel LearnMotionModelFromFile(const std::string& path, const MotionModelOptions& options,
+                                     int chunk_rows = 65536, const StreamProgress& progress = {});
+
+// Score of one command of the set: sum log p(x | c [, z]) over its samples.
+struct CommandScore {
+  std::string label;
+  double total_log_likelihood = 0;
+  long long samples = 0;
+};
+struct FileScore {
+  ScoreSummary summary;                    // whole set, as ScoreSampleSet
+  std::map<int, CommandScore> by_command;  // set command index -> its share
+};
+// ScoreSampleSet over the file, chunk by chunk, with a per-command breakdown.
+FileScore ScoreSampleSetFile(const MotionModel& model, const std::string& path,
+                             int chunk_rows = 65536, const StreamProgress& progress = {});
+
+}  // namespace dgmm

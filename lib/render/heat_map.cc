@@ -1,0 +1,240 @@
+#include "render/heat_map.h"
+
+#include <vtkAxis.h>
+#include <vtkCellArray.h>
+#include <vtkChartHistogram2D.h>
+#include <vtkColorLegend.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkContextScene.h>
+#include <vtkContourFilter.h>
+#include <vtkDoubleArray.h>
+#include <vtkFloatArray.h>
+#include <vtkPlotLine.h>
+#include <vtkPlotPoints.h>
+#include <vtkPolyData.h>
+#include <vtkTable.h>
+#include <vtkTextProperty.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "render/vtk_image.h"
+#include "util/error.h"
+
+namespace dgmm {
+namespace {
+
+using render_internal::AppendHorizontally;
+using render_internal::CaptureView;
+using render_internal::MakeOffscreenView;
+using render_internal::WritePngAtomically;
+
+// Cell-centred raster: pixel (i, j) of the chart's image covers x_i +- dx/2, y_j +- dy/2.
+vtkSmartPointer<vtkImageData> ToImage(const DensityGrid& grid, bool cell_centred) {
+  const double dx = (grid.range.x_max - grid.range.x_min) / (grid.nx() - 1);
+  const double dy = (grid.range.y_max - grid.range.y_min) / (grid.ny() - 1);
+  auto image = vtkSmartPointer<vtkImageData>::New();
+  image->SetDimensions(grid.nx(), grid.ny(), 1);
+  if (cell_centred) {
+    image->SetOrigin(grid.range.x_min - dx / 2, grid.range.y_min - dy / 2, 0);
+  } else {
+    image->SetOrigin(grid.range.x_min, grid.range.y_min, 0);
+  }
+  image->SetSpacing(dx, dy, 1);
+  image->AllocateScalars(VTK_DOUBLE, 1);
+  for (int j = 0; j < grid.ny(); ++j) {
+    for (int i = 0; i < grid.nx(); ++i) {
+      *static_cast<double*>(image->GetScalarPointer(i, j, 0)) = grid.values(j, i);
+    }
+  }
+  return image;
+}
+
+// Inferno-like ramp (perceptually uniform, luminance increasing): the densest cell is the
+// brightest pixel of the plot area.
+vtkSmartPointer<vtkColorTransferFunction> SequentialColours(double max_value) {
+  static const double kStops[][4] = {
+      {0.00, 0, 0, 4},       {0.13, 31, 12, 72},   {0.25, 85, 15, 109},
+      {0.38, 136, 34, 106},  {0.50, 186, 54, 85},  {0.63, 227, 89, 51},
+      {0.75, 249, 140, 10},  {0.88, 249, 201, 50}, {1.00, 252, 255, 164}};
+  auto tf = vtkSmartPointer<vtkColorTransferFunction>::New();
+  for (const auto& s : kStops) tf->AddRGBPoint(s[0] * max_value, s[1] / 255, s[2] / 255, s[3] / 255);
+  return tf;
+}
+
+// Cool-warm diverging ramp symmetric about 0: blue (A < B), light grey (equal), red (A > B).
+vtkSmartPointer<vtkColorTransferFunction> DivergingColours(double max_abs) {
+  auto tf = vtkSmartPointer<vtkColorTransferFunction>::New();
+  tf->AddRGBPoint(-max_abs, 59 / 255.0, 76 / 255.0, 192 / 255.0);
+  tf->AddRGBPoint(0.0, 0.87, 0.87, 0.87);
+  tf->AddRGBPoint(max_abs, 180 / 255.0, 4 / 255.0, 38 / 255.0);
+  return tf;
+}
+
+// Contour segments of the grid as pairs of rows (x0,y0),(x1,y1) for a non-polyline vtkPlotLine.
+vtkSmartPointer<vtkTable> ContourSegments(const ContourOverlay& overlay) {
+  auto table = vtkSmartPointer<vtkTable>::New();
+  auto xs = vtkSmartPointer<vtkFloatArray>::New();
+  auto ys = vtkSmartPointer<vtkFloatArray>::New();
+  xs->SetName("x");
+  ys->SetName("y");
+  const double max_value = overlay.grid.values.maxCoeff();
+  if (max_value > 0 && overlay.levels > 0) {
+    auto contour = vtkSmartPointer<vtkContourFilter>::New();
+    contour->SetInputData(ToImage(overlay.grid, false));
+    for (int l = 1; l <= overlay.levels; ++l) {
+      contour->SetValue(l - 1, max_value * l / (overlay.levels + 1));
+    }
+    contour->Update();
+    vtkPolyData* lines = contour->GetOutput();
+    for (vtkIdType c = 0; c < lines->GetNumberOfCells(); ++c) {
+      vtkCell* cell = lines->GetCell(c);
+      for (vtkIdType k = 0; k + 1 < cell->GetNumberOfPoints(); ++k) {
+        for (vtkIdType e : {k, k + 1}) {
+          double p[3];
+          lines->GetPoint(cell->GetPointId(e), p);
+          xs->InsertNextValue(static_cast<float>(p[0]));
+          ys->InsertNextValue(static_cast<float>(p[1]));
+        }
+      }
+    }
+  }
+  table->AddColumn(xs);
+  table->AddColumn(ys);
+  return table;
+}
+
+struct RenderedPanel {
+  vtkSmartPointer<vtkImageData> image;
+  PlotLayout layout;
+};
+
+RenderedPanel RenderPanel(const HeatMapSpec& spec) {
+  if (std::string problem = spec.Validate(); !problem.empty()) {
+    throw MakeInputError("", "heat map", problem);
+  }
+  auto view = MakeOffscreenView(spec.width, spec.height);
+  auto chart = vtkSmartPointer<vtkChartHistogram2D>::New();
+  view->GetScene()->AddItem(chart);
+
+  const DensityGrid& bg = spec.background;
+  chart->SetInputData(ToImage(bg, true));
+  if (spec.palette == HeatMapSpec::Palette::kSequential) {
+    double max_value = std::max(bg.values.maxCoeff(), 1e-300);
+    chart->SetTransferFunction(SequentialColours(max_value));
+  } else {
+    double max_abs = std::max(bg.values.cwiseAbs().maxCoeff(), 1e-300);
+    chart->SetTransferFunction(DivergingColours(max_abs));
+  }
+  if (auto* legend = vtkColorLegend::SafeDownCast(chart->GetLegend())) {
+    legend->SetTitle(spec.value_label);
+  }
+  chart->SetShowLegend(true);
+  chart->SetTitle(spec.title);
+  chart->GetTitleProperties()->SetFontSize(15);
+  chart->GetTitleProperties()->SetBold(true);
+
+  for (const ContourOverlay& overlay : spec.contours) {
+    auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
+    line->SetInputData(ContourSegments(overlay), 0, 1);
+    line->SetPolyLine(false);
+    line->SetColor(overlay.rgb[0], overlay.rgb[1], overlay.rgb[2], 255);
+    line->SetWidth(overlay.width);
+    line->SetLabel(overlay.label);
+  }
+  if (spec.points.rows() > 0) {
+    auto table = vtkSmartPointer<vtkTable>::New();
+    auto xs = vtkSmartPointer<vtkDoubleArray>::New();
+    auto ys = vtkSmartPointer<vtkDoubleArray>::New();
+    xs->SetName("data x");
+    ys->SetName("data y");
+    for (Eigen::Index r = 0; r < spec.points.rows(); ++r) {
+      xs->InsertNextValue(spec.points(r, 0));
+      ys->InsertNextValue(spec.points(r, 1));
+    }
+    table->AddColumn(xs);
+    table->AddColumn(ys);
+    auto* points = vtkPlotPoints::SafeDownCast(chart->AddPlot(vtkChart::POINTS));
+    points->SetInputData(table, 0, 1);
+    points->SetMarkerStyle(vtkPlotPoints::CIRCLE);
+    points->SetMarkerSize(4);
+    points->SetColor(80, 200, 255, 255);
+  }
+
+  vtkAxis* x_axis = chart->GetAxis(vtkAxis::BOTTOM);
+  vtkAxis* y_axis = chart->GetAxis(vtkAxis::LEFT);
+  x_axis->SetTitle(spec.x_label);
+  y_axis->SetTitle(spec.y_label);
+  for (vtkAxis* axis : {x_axis, y_axis}) axis->SetBehavior(vtkAxis::FIXED);
+  x_axis->SetRange(bg.range.x_min, bg.range.x_max);
+  y_axis->SetRange(bg.range.y_min, bg.range.y_max);
+
+  RenderedPanel out;
+  out.image = CaptureView(view);
+  const int* p1 = chart->GetPoint1();
+  const int* p2 = chart->GetPoint2();
+  out.layout.range = bg.range;
+  out.layout.left = p1[0];
+  out.layout.bottom = p1[1];
+  out.layout.right = p2[0];
+  out.layout.top = p2[1];
+  out.layout.width = spec.width;
+  out.layout.height = spec.height;
+  return out;
+}
+
+bool AllFinite(const Eigen::MatrixXd& m) { return m.size() == 0 || m.allFinite(); }
+
+}  // namespace
+
+std::string HeatMapSpec::Validate() const {
+  if (width < 200 || height < 150 || width > 8000 || height > 8000) {
+    return "image size must be between 200x150 and 8000x8000 pixels";
+  }
+  if (background.nx() < 2 || background.ny() < 2) return "the grid needs at least 2x2 points";
+  if (!background.range.IsValid()) return "the plot range is empty or not finite";
+  if (!AllFinite(background.values)) return "the density grid has NaN or infinite values";
+  for (const auto& c : contours) {
+    if (c.grid.nx() < 2 || c.grid.ny() < 2 || !AllFinite(c.grid.values)) {
+      return "a contour grid is too small or not finite";
+    }
+  }
+  if (points.size() > 0 && !points.allFinite()) return "data points have NaN or infinite values";
+  return "";
+}
+
+Eigen::Vector2d PlotLayout::ToPixel(double x, double y) const {
+  const double u = (x - range.x_min) / (range.x_max - range.x_min);
+  const double v = (y - range.y_min) / (range.y_max - range.y_min);
+  return {left + u * (right - left), bottom + v * (top - bottom)};
+}
+
+PlotLayout RenderHeatMap(const HeatMapSpec& spec, const std::string& png_path) {
+  RenderedPanel panel = RenderPanel(spec);
+  WritePngAtomically(panel.image, png_path);
+  return panel.layout;
+}
+
+std::vector<PlotLayout> RenderHeatMapRow(const std::vector<HeatMapSpec>& panels,
+                                         const std::string& png_path) {
+  if (panels.empty()) throw MakeInputError(png_path, "", "nothing to render");
+  std::vector<vtkSmartPointer<vtkImageData>> images;
+  std::vector<PlotLayout> layouts;
+  double offset = 0;
+  for (const HeatMapSpec& spec : panels) {
+    if (spec.height != panels.front().height) {
+      throw MakeInputError(png_path, "", "panels of a row must have the same height");
+    }
+    RenderedPanel panel = RenderPanel(spec);
+    panel.layout.left += offset;
+    panel.layout.right += offset;
+    offset += spec.width;
+    images.push_back(panel.image);
+    layouts.push_back(panel.layout);
+  }
+  for (auto& layout : layouts) layout.width = static_cast<int>(offset);
+  WritePngAtomically(AppendHorizontally(images), png_path);
+  return layouts;
+}
+
+}  // namespace dgmm

@@ -1,0 +1,249 @@
+#include "sim/protocol.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <random>
+#include <sstream>
+
+#include "sim/pose.h"
+#include "sim/simulator.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+// One placement: where the robot stands, which command it repeats.
+struct Placement {
+  int command = 0;
+  double heading_rad = 0;  // slope frame, 0 = facing uphill
+  double x_m = 0, y_m = 0;
+};
+
+std::string FormatLevel(double v) {
+  if (v == 0) return "0";
+  char buf[16];
+  std::snprintf(buf, sizeof(buf), "%+.1f", v);
+  return buf;
+}
+
+// Protocol heading theta (0 = across the slope, +90 = looking downhill, -90 = uphill) to the
+// slope-frame yaw (0 = facing uphill).
+double HeadingFromTheta(double theta_deg) { return (theta_deg + 90.0) * kPi / 180.0; }
+
+// The command table {-0.5, 0, 0.5}^3 without the no-op, in lexicographic order.
+void FillCommandTable(SampleSet* set) {
+  set->command_dim_names = {"long", "lat", "turn"};
+  std::vector<Eigen::Vector3d> rows;
+  const double levels[3] = {-0.5, 0.0, 0.5};
+  for (double a : levels)
+    for (double b : levels)
+      for (double c : levels)
+        if (a != 0 || b != 0 || c != 0) rows.emplace_back(a, b, c);
+  set->commands.resize(static_cast<int>(rows.size()), 3);
+  for (int i = 0; i < static_cast<int>(rows.size()); ++i) {
+    set->commands.row(i) = rows[i].transpose();
+    set->command_labels.push_back(FormatLevel(rows[i][0]) + "," + FormatLevel(rows[i][1]) + "," +
+                                  FormatLevel(rows[i][2]));
+  }
+}
+
+std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_commands,
+                                      std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> position(-1.0, 1.0);  // m, anywhere on the plane
+  std::vector<int> order(num_commands);
+  std::vector<Placement> plan;
+  if (options.protocol == Protocol::kPaper) {
+    const int total = options.placements > 0 ? options.placements : 3 * num_commands;
+    for (int i = 0; i < num_commands; ++i) order[i] = i;
+    std::shuffle(order.begin(), order.end(), rng);  // drawn without replacement
+    const double thetas[3] = {0.0, 90.0, -90.0};
+    for (int i = 0; i < total; ++i) {
+      Placement p;
+      p.command = order[(i / 3) % num_commands];
+      p.heading_rad = HeadingFromTheta(thetas[i % 3]);
+      p.x_m = position(rng);
+      p.y_m = position(rng);
+      plan.push_back(p);
+    }
+  } else {
+    const int total = options.placements > 0 ? options.placements : 166;
+    std::uniform_real_distribution<double> heading(-kPi, kPi);
+    for (int i = 0; i < total; ++i) {
+      if (i % num_commands == 0) {  // a fresh shuffle of all commands every 26 placements
+        for (int c = 0; c < num_commands; ++c) order[c] = c;
+        std::shuffle(order.begin(), order.end(), rng);
+      }
+      Placement p;
+      p.command = order[i % num_commands];
+      p.heading_rad = heading(rng);
+      p.x_m = position(rng);
+      p.y_m = position(rng);
+      plan.push_back(p);
+    }
+  }
+  return plan;
+}
+
+// A tracker reading of the true pose: position and body-frame rotation perturbed.
+Pose TrackerReading(const Pose& truth, const NoiseConfig& noise, std::mt19937_64& rng) {
+  std::normal_distribution<double> n(0.0, 1.0);
+  Pose read = truth;
+  for (int k = 0; k < 3; ++k) read.position_m[k] += noise.tracker_position_sd_m * n(rng);
+  const double roll = noise.tracker_roll_sd_rad * n(rng);
+  const double pitch = noise.tracker_pitch_sd_rad * n(rng);
+  const double yaw = noise.tracker_yaw_sd_rad * n(rng);
+  read.rotation = truth.rotation * FromRollPitchYaw(roll, pitch, yaw);
+  return read;
+}
+
+}  // namespace
+
+std::string ProtocolName(Protocol protocol) {
+  return protocol == Protocol::kPaper ? "paper" : "paper-830";
+}
+
+Protocol ParseProtocol(const std::string& name) {
+  if (name == "paper") return Protocol::kPaper;
+  if (name == "paper-830") return Protocol::kPaper830;
+  throw MakeInputError("", "--protocol", "expected paper or paper-830, got \"" + name + "\"");
+}
+
+bool ProtocolOptions::IsValid(std::string* error) const {
+  auto fail = [&](const char* message) {
+    if (error) *error = message;
+    return false;
+  };
+  if (executions_per_placement < 1 || executions_per_placement > 1000)
+    return fail("executions_per_placement: expected 1..1000");
+  if (placements < 0 || placements > 100000) return fail("placements: expected 0..100000");
+  if (max_retries_per_placement < 0 || max_retries_per_placement > 100)
+    return fail("max_retries_per_placement: expected 0..100");
+  return true;
+}
+
+double SimSummary::SimulatedPerWallSecond() const {
+  return wall_seconds > 0 ? simulated_seconds / wall_seconds : 0;
+}
+double SimSummary::SamplesPerWallSecond() const {
+  return wall_seconds > 0 ? samples / wall_seconds : 0;
+}
+
+std::string SimSummary::BriefReport() const {
+  std::ostringstream out;
+  out.precision(3);
+  out << samples << " samples from " << placements << " placements, " << falls << " falls ("
+      << abandoned_placements << " placements abandoned); " << simulated_seconds
+      << " simulated s in " << wall_seconds << " wall s, " << cpu_seconds << " CPU s (" << SimulatedPerWallSecond()
+      << " sim s per wall s, " << SamplesPerWallSecond() << " samples/s)";
+  return out.str();
+}
+
+SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
+                           const ProgressFn& progress, SimSummary* summary) {
+  std::string error;
+  if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
+  if (!options.IsValid(&error)) throw MakeInputError("protocol options", "", error);
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
+  Simulator sim(config);
+  std::mt19937_64 rng(options.seed);
+
+  SampleSet set;
+  FillCommandTable(&set);
+  const std::vector<Placement> plan = PlanPlacements(options, set.num_commands(), rng);
+  const int reps = options.executions_per_placement;
+
+  std::vector<int> command, episode, step;
+  std::vector<Eigen::Matrix<double, 6, 1>> xs;
+  std::vector<Eigen::Vector2d> zs;
+  std::uniform_real_distribution<double> position(-1.0, 1.0);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  SimSummary sum;
+  for (int p = 0; p < static_cast<int>(plan.size()); ++p) {
+    Placement where = plan[p];
+    bool kept = false;
+    for (int attempt = 0; attempt <= options.max_retries_per_placement && !kept; ++attempt) {
+      if (attempt > 0) {  // re-place somewhere else on the slope, same heading and command
+        where.x_m = position(rng);
+        where.y_m = position(rng);
+      }
+      bool fell = sim.Place(where.x_m, where.y_m, where.heading_rad) != RunOutcome::kCompleted;
+      std::vector<Eigen::Matrix<double, 6, 1>> px;
+      std::vector<Eigen::Vector2d> pz;
+      const Eigen::Vector3d c = set.commands.row(where.command).transpose();
+      for (int r = 0; r < reps && !fell; ++r) {
+        const Eigen::Vector2d z_true = sim.TruePitchRoll();
+        pz.emplace_back(z_true[0] + config.noise.imu_pitch_sd_rad * unit(rng),
+                        z_true[1] + config.noise.imu_roll_sd_rad * unit(rng));
+        const Pose start = TrackerReading(sim.TorsoPose(), config.noise, rng);
+        fell = sim.RunCommand(c) != RunOutcome::kCompleted;
+        const Pose end = TrackerReading(sim.TorsoPose(), config.noise, rng);
+        px.push_back(DeltaPoseBody(start, end));
+      }
+      if (fell) {
+        ++sum.falls;
+        continue;
+      }
+      kept = true;
+      for (int r = 0; r < reps; ++r) {
+        command.push_back(where.command);
+        episode.push_back(p);
+        step.push_back(r);
+        xs.push_back(px[r]);
+        zs.push_back(pz[r]);
+      }
+    }
+    if (!kept) ++sum.abandoned_placements;
+    if (progress) progress(p + 1, static_cast<long long>(plan.size()));
+  }
+
+  const int n = static_cast<int>(xs.size());
+  set.command.resize(n);
+  set.episode.resize(n);
+  set.step.resize(n);
+  set.x.resize(n, 6);
+  set.z.resize(n, 2);
+  for (int i = 0; i < n; ++i) {
+    set.command[i] = command[i];
+    set.episode[i] = episode[i];
+    set.step[i] = step[i];
+    set.x.row(i) = xs[i].transpose();
+    set.z.row(i) = zs[i].transpose();
+  }
+  set.x_names = {"dx", "dy", "dz", "droll", "dpitch", "dyaw"};
+  set.x_units = {"m", "m", "m", "rad", "rad", "rad"};
+  set.z_names = {"pitch", "roll"};
+  set.z_units = {"rad", "rad"};
+  set.source = "sim";
+
+  sum.samples = n;
+  sum.placements = static_cast<int>(plan.size());
+  sum.simulated_seconds = sim.time_s();
+  sum.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  sum.wall_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  auto& meta = set.metadata;
+  meta["generator"] = "dgmm simulate";
+  meta["protocol"] = ProtocolName(options.protocol);
+  meta["seed"] = std::to_string(options.seed);
+  meta["executions_per_placement"] = std::to_string(reps);
+  meta["placements"] = std::to_string(sum.placements);
+  meta["falls"] = std::to_string(sum.falls);
+  meta["abandoned_placements"] = std::to_string(sum.abandoned_placements);
+  meta["simulated_seconds"] = std::to_string(sum.simulated_seconds);
+  meta["robot_mass_kg"] = std::to_string(sim.total_mass_kg());
+  meta["sim_config"] = SimConfigToJson(config);
+  meta["x_frame"] = "torso body frame at the start of each execution (x forward, y left, z up); "
+                    "angles ZYX Euler of the relative rotation";
+  meta["z_frame"] = "IMU pitch/roll relative to gravity before each execution; pitch > 0 nose "
+                    "down, roll > 0 left side up";
+  if (summary) *summary = sum;
+  return set;
+}
+
+}  // namespace dgmm::sim

@@ -1,0 +1,63 @@
+#pragma once
+// The paper's recording protocol (Edgington et al. 2009, section VI-B) run in simulation:
+// commands {-0.5, 0, 0.5}^3 without the no-op (26), each run 5 times in a row per placement on
+// the slope; x = change of pose in the body frame, z = <pitch, roll> from the IMU before.
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "core/sample_set.h"
+#include "sim/sim_config.h"
+
+namespace dgmm::sim {
+
+enum class Protocol {
+  // 26 commands drawn without replacement, one placement each per heading 0, +90, -90 deg
+  // (cycling), 5 executions: 26 * 3 * 5 = 390 samples.
+  kPaper,
+  // 166 placements at uniformly random heading and position on the slope, commands cycling
+  // through seeded shuffles of the 26, 5 executions: 830 samples.
+  kPaper830,
+};
+
+// "paper" / "paper-830"; ParseProtocol throws InputError for anything else.
+std::string ProtocolName(Protocol protocol);
+Protocol ParseProtocol(const std::string& name);
+
+struct ProtocolOptions {
+  Protocol protocol = Protocol::kPaper;
+  std::uint64_t seed = 0;
+  int executions_per_placement = 5;
+  // 0: the protocol's default number of placements (78 or 166); otherwise that many (for tests).
+  int placements = 0;
+  // A placement whose robot falls or flips is discarded and re-placed up to this many times.
+  int max_retries_per_placement = 3;
+
+  bool IsValid(std::string* error) const;
+};
+
+struct SimSummary {
+  int samples = 0;
+  int placements = 0;
+  int falls = 0;                 // falls/flips detected (each discarded its placement)
+  int abandoned_placements = 0;  // placements given up after max_retries_per_placement falls
+  double simulated_seconds = 0;
+  double wall_seconds = 0;
+  double cpu_seconds = 0;  // process CPU time while simulating (wall time suffers on a busy machine)
+
+  double SimulatedPerWallSecond() const;
+  double SamplesPerWallSecond() const;
+  std::string BriefReport() const;
+};
+
+// Progress callback: (placements done, placements total).
+using ProgressFn = std::function<void(long long done, long long total)>;
+
+// Runs the protocol; same config, options and seed give the same set. The set carries the
+// command table (long, lat, turn), x (dx, dy, dz [m]; droll, dpitch, dyaw [rad]), z (pitch, roll
+// [rad]), episode = placement, step = execution index, source "sim", metadata (config JSON,
+// protocol, seed, falls). Throws InputError for an invalid config/options or unloadable MJCF.
+SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
+                           const ProgressFn& progress = {}, SimSummary* summary = nullptr);
+
+}  // namespace dgmm::sim

@@ -1,0 +1,282 @@
+// JSON (nlohmann) loading and saving of SimConfig; strict: unknown keys and wrong types are errors.
+#include "sim/sim_config.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+using nlohmann::json;
+
+// Reads fields of one JSON object, remembering which keys were used so leftovers are reported.
+class ObjectReader {
+ public:
+  ObjectReader(const json& object, std::string path, const std::string& source)
+      : object_(object), path_(std::move(path)), source_(source) {
+    if (!object_.is_object()) Fail(path_.empty() ? "(root)" : path_, "expected a JSON object");
+  }
+
+  void Number(const char* key, double* value) {
+    const json* v = Find(key);
+    if (!v) return;
+    if (!v->is_number()) Fail(Field(key), "expected a number");
+    *value = v->get<double>();
+  }
+  void String(const char* key, std::string* value) {
+    const json* v = Find(key);
+    if (!v) return;
+    if (!v->is_string()) Fail(Field(key), "expected a string");
+    *value = v->get<std::string>();
+  }
+  template <int n, typename Array>
+  void Numbers(const char* key, Array* values) {
+    const json* v = Find(key);
+    if (!v) return;
+    if (!v->is_array() || v->size() != n) Fail(Field(key), "expected an array of " +
+                                                               std::to_string(n) + " numbers");
+    for (int i = 0; i < n; ++i) {
+      if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of numbers");
+      (*values)[i] = (*v)[i].template get<double>();
+    }
+  }
+  // Returns the sub-object reader (absent key: an empty object).
+  ObjectReader Child(const char* key) {
+    const json* v = Find(key);
+    static const json kEmpty = json::object();
+    return ObjectReader(v ? *v : kEmpty, Field(key), source_);
+  }
+  void CheckNoUnknownKeys() const {
+    for (const auto& [key, unused] : object_.items()) {
+      if (!used_.count(key)) Fail(Field(key.c_str()), "unknown key");
+    }
+  }
+
+ private:
+  const json* Find(const char* key) {
+    used_.insert(key);
+    auto it = object_.find(key);
+    return it == object_.end() ? nullptr : &*it;
+  }
+  std::string Field(const char* key) const { return path_.empty() ? key : path_ + "." + key; }
+  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
+    throw MakeInputError(source_, field, problem);
+  }
+
+  const json& object_;
+  std::string path_;
+  const std::string& source_;
+  std::set<std::string> used_;
+};
+
+bool Check(bool ok, const std::string& message, std::string* error) {
+  if (!ok && error) *error = message;
+  return ok;
+}
+
+bool Finite(double v) { return std::isfinite(v); }
+
+}  // namespace
+
+bool SimConfig::IsValid(std::string* error) const {
+  const auto& f = friction;
+  const auto& m = masses;
+  const auto& a = actuators;
+  const auto& g = gait;
+  const auto& n = noise;
+  if (!Check(Finite(slope_deg) && slope_deg > -60 && slope_deg < 60,
+             "slope_deg: expected a finite angle in (-60, 60) degrees", error) ||
+      !Check(Finite(f.sliding) && f.sliding >= 0 && Finite(f.torsional) && f.torsional >= 0 &&
+                 Finite(f.rolling) && f.rolling >= 0,
+             "friction: expected finite non-negative coefficients", error) ||
+      !Check(Finite(m.torso_kg) && m.torso_kg > 0 && Finite(m.coxa_kg) && m.coxa_kg > 0 &&
+                 Finite(m.femur_kg) && m.femur_kg > 0 && Finite(m.tibia_kg) && m.tibia_kg > 0,
+             "masses: expected finite positive masses in kg", error) ||
+      !Check(Finite(payload.mass_kg) && payload.mass_kg >= 0 && payload.mass_kg < 100 &&
+                 payload.position_body_m.allFinite() &&
+                 payload.position_body_m.cwiseAbs().maxCoeff() <= 1.0,
+             "payload: expected mass in [0, 100) kg and position within 1 m of the torso", error) ||
+      !Check(Finite(a.kp_nm_per_rad) && a.kp_nm_per_rad > 0 && Finite(a.torque_limit_nm) &&
+                 a.torque_limit_nm > 0 && Finite(a.joint_damping_nms_per_rad) &&
+                 a.joint_damping_nms_per_rad >= 0,
+             "actuators: expected positive kp and torque limit, non-negative damping", error))
+    return false;
+  for (int i = 0; i < kNumLegs; ++i) {
+    if (!Check(Finite(a.leg_gain[i]) && a.leg_gain[i] > 0 && a.leg_gain[i] <= 10,
+               "actuators.leg_gain: expected 8 values in (0, 10]", error))
+      return false;
+  }
+  if (!Check(Finite(g.period_s) && g.period_s >= 0.1 && g.period_s <= 10 && Finite(g.stride_m) &&
+                 g.stride_m >= 0 && g.stride_m <= 0.3 && Finite(g.turn_rad) && g.turn_rad >= 0 &&
+                 g.turn_rad <= 1.0 && Finite(g.step_height_m) && g.step_height_m >= 0 &&
+                 g.step_height_m <= 0.15 && Finite(g.stance_height_m) &&
+                 g.stance_height_m >= 0.05 && g.stance_height_m <= 0.25,
+             "gait: period_s in [0.1, 10], stride_m in [0, 0.3], turn_rad in [0, 1], "
+             "step_height_m in [0, 0.15], stance_height_m in [0.05, 0.25]",
+             error) ||
+      !Check(Finite(n.tracker_position_sd_m) && n.tracker_position_sd_m >= 0 &&
+                 Finite(n.tracker_yaw_sd_rad) && n.tracker_yaw_sd_rad >= 0 &&
+                 Finite(n.tracker_roll_sd_rad) && n.tracker_roll_sd_rad >= 0 &&
+                 Finite(n.tracker_pitch_sd_rad) && n.tracker_pitch_sd_rad >= 0 &&
+                 Finite(n.imu_pitch_sd_rad) && n.imu_pitch_sd_rad >= 0 &&
+                 Finite(n.imu_roll_sd_rad) && n.imu_roll_sd_rad >= 0,
+             "noise: expected finite non-negative standard deviations", error) ||
+      !Check(Finite(timestep_s) && timestep_s >= 1e-4 && timestep_s <= 0.01,
+             "timestep_s: expected a value in [0.0001, 0.01] s", error) ||
+      !Check(Finite(settle_duration_s) && settle_duration_s >= 0 && settle_duration_s <= 60,
+             "settle_duration_s: expected a value in [0, 60] s", error))
+    return false;
+  const double cycles = command_duration_s / g.period_s;
+  if (!Check(Finite(command_duration_s) && command_duration_s > 0 && command_duration_s <= 60 &&
+                 std::abs(cycles - std::round(cycles)) < 1e-6 && std::round(cycles) >= 1,
+             "command_duration_s: expected a whole number (>= 1) of gait periods, at most 60 s",
+             error))
+    return false;
+  return Check(!names.torso_body.empty() && !names.floor_geom.empty() &&
+                   !names.actuator_prefix.empty(),
+               "names: torso_body, floor_geom and actuator_prefix must not be empty", error);
+}
+
+SimConfig SimConfigFromJson(const std::string& json_text, const std::string& source_name) {
+  json root;
+  try {
+    root = json::parse(json_text);
+  } catch (const json::parse_error& e) {
+    throw MakeInputError(source_name, "", std::string("not valid JSON: ") + e.what());
+  }
+  SimConfig c;
+  ObjectReader r(root, "", source_name);
+  r.Number("slope_deg", &c.slope_deg);
+  {
+    ObjectReader f = r.Child("friction");
+    f.Number("sliding", &c.friction.sliding);
+    f.Number("torsional", &c.friction.torsional);
+    f.Number("rolling", &c.friction.rolling);
+    f.CheckNoUnknownKeys();
+  }
+  {
+    ObjectReader m = r.Child("masses");
+    m.Number("torso_kg", &c.masses.torso_kg);
+    m.Number("coxa_kg", &c.masses.coxa_kg);
+    m.Number("femur_kg", &c.masses.femur_kg);
+    m.Number("tibia_kg", &c.masses.tibia_kg);
+    m.CheckNoUnknownKeys();
+  }
+  {
+    ObjectReader p = r.Child("payload");
+    p.Number("mass_kg", &c.payload.mass_kg);
+    p.Numbers<3>("position_body_m", &c.payload.position_body_m);
+    p.CheckNoUnknownKeys();
+  }
+  {
+    ObjectReader a = r.Child("actuators");
+    a.Number("kp_nm_per_rad", &c.actuators.kp_nm_per_rad);
+    a.Numbers<kNumLegs>("leg_gain", &c.actuators.leg_gain);
+    a.Number("joint_damping_nms_per_rad", &c.actuators.joint_damping_nms_per_rad);
+    a.Number("torque_limit_nm", &c.actuators.torque_limit_nm);
+    a.CheckNoUnknownKeys();
+  }
+  {
+    ObjectReader g = r.Child("gait");
+    g.Number("period_s", &c.gait.period_s);
+    g.Number("stride_m", &c.gait.stride_m);
+    g.Number("turn_rad", &c.gait.turn_rad);
+    g.Number("step_height_m", &c.gait.step_height_m);
+    g.Number("stance_height_m", &c.gait.stance_height_m);
+    g.CheckNoUnknownKeys();
+  }
+  {
+    ObjectReader n = r.Child("noise");
+    n.Number("tracker_position_sd_m", &c.noise.tracker_position_sd_m);
+    n.Number("tracker_yaw_sd_rad", &c.noise.tracker_yaw_sd_rad);
+    n.Number("tracker_roll_sd_rad", &c.noise.tracker_roll_sd_rad);
+    n.Number("tracker_pitch_sd_rad", &c.noise.tracker_pitch_sd_rad);
+    n.Number("imu_pitch_sd_rad", &c.noise.imu_pitch_sd_rad);
+    n.Number("imu_roll_sd_rad", &c.noise.imu_roll_sd_rad);
+    n.CheckNoUnknownKeys();
+  }
+  r.Number("timestep_s", &c.timestep_s);
+  r.Number("command_duration_s", &c.command_duration_s);
+  r.Number("settle_duration_s", &c.settle_duration_s);
+  r.String("mjcf_path", &c.mjcf_path);
+  {
+    ObjectReader n = r.Child("names");
+    n.String("torso_body", &c.names.torso_body);
+    n.String("floor_geom", &c.names.floor_geom);
+    n.String("actuator_prefix", &c.names.actuator_prefix);
+    n.CheckNoUnknownKeys();
+  }
+  r.CheckNoUnknownKeys();
+  std::string error;
+  if (!c.IsValid(&error)) throw MakeInputError(source_name, "", error);
+  return c;
+}
+
+SimConfig LoadSimConfig(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw MakeInputError(path, "", "cannot open the config file");
+  std::stringstream text;
+  text << in.rdbuf();
+  SimConfig c = SimConfigFromJson(text.str(), path);
+  if (!c.mjcf_path.empty() && std::filesystem::path(c.mjcf_path).is_relative()) {
+    c.mjcf_path = (std::filesystem::path(path).parent_path() / c.mjcf_path).lexically_normal();
+  }
+  return c;
+}
+
+std::string SimConfigToJson(const SimConfig& c) {
+  json j;
+  j["slope_deg"] = c.slope_deg;
+  j["friction"] = {{"sliding", c.friction.sliding},
+                   {"torsional", c.friction.torsional},
+                   {"rolling", c.friction.rolling}};
+  j["masses"] = {{"torso_kg", c.masses.torso_kg},
+                 {"coxa_kg", c.masses.coxa_kg},
+                 {"femur_kg", c.masses.femur_kg},
+                 {"tibia_kg", c.masses.tibia_kg}};
+  const auto& p = c.payload.position_body_m;
+  j["payload"] = {{"mass_kg", c.payload.mass_kg},
+                  {"position_body_m", {p.x(), p.y(), p.z()}}};
+  j["actuators"] = {{"kp_nm_per_rad", c.actuators.kp_nm_per_rad},
+                    {"leg_gain", c.actuators.leg_gain},
+                    {"joint_damping_nms_per_rad", c.actuators.joint_damping_nms_per_rad},
+                    {"torque_limit_nm", c.actuators.torque_limit_nm}};
+  j["gait"] = {{"period_s", c.gait.period_s},
+               {"stride_m", c.gait.stride_m},
+               {"turn_rad", c.gait.turn_rad},
+               {"step_height_m", c.gait.step_height_m},
+               {"stance_height_m", c.gait.stance_height_m}};
+  j["noise"] = {{"tracker_position_sd_m", c.noise.tracker_position_sd_m},
+                {"tracker_yaw_sd_rad", c.noise.tracker_yaw_sd_rad},
+                {"tracker_roll_sd_rad", c.noise.tracker_roll_sd_rad},
+                {"tracker_pitch_sd_rad", c.noise.tracker_pitch_sd_rad},
+                {"imu_pitch_sd_rad", c.noise.imu_pitch_sd_rad},
+                {"imu_roll_sd_rad", c.noise.imu_roll_sd_rad}};
+  j["timestep_s"] = c.timestep_s;
+  j["command_duration_s"] = c.command_duration_s;
+  j["settle_duration_s"] = c.settle_duration_s;
+  j["mjcf_path"] = c.mjcf_path;
+  j["names"] = {{"torso_body", c.names.torso_body},
+                {"floor_geom", c.names.floor_geom},
+                {"actuator_prefix", c.names.actuator_prefix}};
+  return j.dump(2) + "\n";
+}
+
+void SaveSimConfig(const SimConfig& config, const std::string& path) {
+  AtomicFile file(path);
+  {
+    std::ofstream out(file.temp_path());
+    out << SimConfigToJson(config);
+    if (!out) throw MakeInputError(path, "", "cannot write the config file");
+  }
+  file.Commit();
+}
+
+}  // namespace dgmm::sim

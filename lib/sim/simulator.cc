@@ -1,0 +1,206 @@
+#include "sim/simulator.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "sim/mujoco_model.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+
+struct Simulator::Impl {
+  SimConfig config;
+  MjModelPtr model;
+  MjDataPtr data;
+  RobotParts parts;
+  Eigen::Vector3d up;
+  double time_s = 0;
+
+  // Sets the leg actuator targets to the joint angles reaching the given foot targets.
+  void SetFootTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) {
+    for (int leg = 0; leg < kNumLegs; ++leg) {
+      const LegAngles q = LegInverse(parts.legs[leg], feet[leg]);
+      for (int j = 0; j < 3; ++j) data->ctrl[parts.actuator[leg][j]] = q[j];
+    }
+  }
+  std::array<Eigen::Vector3d, kNumLegs> NominalFeet() const {
+    std::array<Eigen::Vector3d, kNumLegs> feet;
+    for (int leg = 0; leg < kNumLegs; ++leg) feet[leg] = NominalFoot(parts.legs[leg], config.gait);
+    return feet;
+  }
+  Pose Torso() const {
+    Pose pose;
+    const int b = parts.torso_body;
+    pose.position_m = Eigen::Vector3d(data->xpos[3 * b], data->xpos[3 * b + 1], data->xpos[3 * b + 2]);
+    pose.rotation = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(data->xmat + 9 * b);
+    return pose;
+  }
+  // One physics step; false on a MuJoCo warning (bad numbers, full contact buffers).
+  bool Step() {
+    mj_step(model.get(), data.get());
+    time_s += model->opt.timestep;
+    bool ok = true;
+    for (int w = 0; w < mjNWARNING; ++w) {
+      if (data->warning[w].number > 0) ok = false;
+      data->warning[w].number = 0;
+    }
+    return ok;
+  }
+  bool Fallen() const {
+    const Pose pose = Torso();
+    const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
+    const double kMinHeightShare = 0.4;  // of the stance height
+    return pose.rotation(2, 2) < kMaxTiltCos ||
+           pose.position_m.z() < kMinHeightShare * config.gait.stance_height_m;
+  }
+  // Runs `steps` steps with targets from `feet_at(step)`; stops at a fall or instability.
+  // `sample(s)` runs after every step.
+  template <typename FeetAt, typename Sample>
+  RunOutcome Run(int steps, FeetAt feet_at, Sample sample) {
+    for (int s = 0; s < steps; ++s) {
+      SetFootTargets(feet_at(s));
+      if (!Step()) return RunOutcome::kUnstable;
+      sample(s);
+      if (Fallen()) return RunOutcome::kFell;
+    }
+    return RunOutcome::kCompleted;
+  }
+};
+
+namespace {
+// MuJoCo's default warning handler prints to stdout and appends to MUJOCO_LOG.TXT in the working
+// directory. Warnings are read from mjData::warning instead (a step with one is kUnstable), so
+// unless someone (e.g. a test fixture) installed a handler, they are silenced.
+void QuietWarning(const char*) {}
+}  // namespace
+
+Simulator::Simulator(const SimConfig& config) : impl_(std::make_unique<Impl>()) {
+  if (mju_user_warning == nullptr) mju_user_warning = QuietWarning;
+  std::string error;
+  if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
+  const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
+  impl_->config = config;
+  impl_->model = LoadRobotModel(config);
+  impl_->parts = FindRobotParts(impl_->model.get(), config, source);
+  ApplyConfig(config, impl_->parts, impl_->model.get(), source);
+  impl_->data.reset(mj_makeData(impl_->model.get()));
+  mj_setConst(impl_->model.get(), impl_->data.get());
+  const double a = config.slope_deg * M_PI / 180;
+  impl_->up = Eigen::Vector3d(std::sin(a), 0, std::cos(a));
+}
+
+Simulator::~Simulator() = default;
+
+RunOutcome Simulator::Place(double x_m, double y_m, double heading_rad) {
+  Impl& s = *impl_;
+  mjModel* m = s.model.get();
+  mjData* d = s.data.get();
+  mj_resetData(m, d);
+  const auto feet = s.NominalFeet();
+  for (int leg = 0; leg < kNumLegs; ++leg) {
+    const LegAngles q = LegInverse(s.parts.legs[leg], feet[leg]);
+    for (int j = 0; j < 3; ++j) d->qpos[m->jnt_qposadr[s.parts.joint[leg][j]]] = q[j];
+  }
+  const int q0 = s.parts.torso_qpos;
+  const double kDropM = 0.005;  // released just above the ground
+  d->qpos[q0 + 0] = x_m;
+  d->qpos[q0 + 1] = y_m;
+  d->qpos[q0 + 2] = s.config.gait.stance_height_m + kDropM;
+  d->qpos[q0 + 3] = std::cos(heading_rad / 2);
+  d->qpos[q0 + 4] = 0;
+  d->qpos[q0 + 5] = 0;
+  d->qpos[q0 + 6] = std::sin(heading_rad / 2);
+  s.SetFootTargets(feet);
+  mj_forward(m, d);
+  return Stand(s.config.settle_duration_s);
+}
+
+RunOutcome Simulator::Stand(double seconds) {
+  Impl& s = *impl_;
+  const auto feet = s.NominalFeet();
+  const int steps = static_cast<int>(std::lround(seconds / s.model->opt.timestep));
+  return s.Run(steps, [&](int) { return feet; }, [](int) {});
+}
+
+RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command, std::vector<Pose>* trajectory,
+                                 int sample_every) {
+  return RunCommand(
+      command,
+      [trajectory](const Simulator& sim) {
+        if (trajectory) trajectory->push_back(sim.TorsoPose());
+      },
+      sample_every);
+}
+
+RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command,
+                                 const std::function<void(const Simulator&)>& observer,
+                                 int observe_every) {
+  Impl& s = *impl_;
+  const double dt = s.model->opt.timestep;
+  const double duration = s.config.command_duration_s;
+  const int steps = static_cast<int>(std::lround(duration / dt));
+  const Eigen::Vector3d c = command.cwiseMax(-1.0).cwiseMin(1.0);
+  std::array<Eigen::Vector3d, kNumLegs> feet;
+  return s.Run(
+      steps,
+      [&](int step) {
+        const double t = (step + 1) * dt;
+        for (int leg = 0; leg < kNumLegs; ++leg) {
+          feet[leg] = FootTarget(s.parts.legs[leg], leg, c, t, duration, s.config.gait);
+        }
+        return feet;
+      },
+      [&](int step) {
+        if (observer && (step + 1) % std::max(1, observe_every) == 0) observer(*this);
+      });
+}
+
+Pose Simulator::TorsoPose() const { return impl_->Torso(); }
+
+Eigen::Vector2d Simulator::TruePitchRoll() const {
+  return PitchRollFromGravity(impl_->Torso().rotation, impl_->up);
+}
+
+Eigen::Vector3d Simulator::Up() const { return impl_->up; }
+double Simulator::time_s() const { return impl_->time_s; }
+
+double Simulator::total_mass_kg() const {
+  double total = 0;
+  for (int b = 1; b < impl_->model->nbody; ++b) total += impl_->model->body_mass[b];
+  return total;
+}
+
+const std::array<LegGeometry, kNumLegs>& Simulator::legs() const { return impl_->parts.legs; }
+const SimConfig& Simulator::config() const { return impl_->config; }
+
+std::vector<GeomSnapshot> Simulator::Geometry() const {
+  const mjModel* m = impl_->model.get();
+  const mjData* d = impl_->data.get();
+  std::vector<GeomSnapshot> geoms;
+  for (int i = 0; i < m->ngeom; ++i) {
+    if (m->geom_rgba[4 * i + 3] <= 0) continue;
+    GeomSnapshot g;
+    switch (m->geom_type[i]) {
+      case mjGEOM_PLANE: g.type = GeomSnapshot::Type::kPlane; break;
+      case mjGEOM_SPHERE: g.type = GeomSnapshot::Type::kSphere; break;
+      case mjGEOM_CAPSULE: g.type = GeomSnapshot::Type::kCapsule; break;
+      case mjGEOM_CYLINDER: g.type = GeomSnapshot::Type::kCylinder; break;
+      case mjGEOM_BOX: g.type = GeomSnapshot::Type::kBox; break;
+      default: g.type = GeomSnapshot::Type::kOther; break;
+    }
+    for (int k = 0; k < 3; ++k) {
+      g.size[k] = m->geom_size[3 * i + k];
+      g.position_m[k] = d->geom_xpos[3 * i + k];
+    }
+    g.rotation = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(d->geom_xmat + 9 * i);
+    for (int k = 0; k < 4; ++k) g.rgba[k] = m->geom_rgba[4 * i + k];
+    geoms.push_back(g);
+  }
+  return geoms;
+}
+
+Eigen::Matrix3d SlopeToLevel(double slope_deg) {
+  return Eigen::AngleAxisd(-slope_deg * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+}
+
+}  // namespace dgmm::sim

@@ -1,0 +1,75 @@
+#pragma once
+// The eight-legged robot on its slope in MuJoCo, driven by the gait controller. MuJoCo stays
+// behind a pimpl: this header is plain Eigen. The world frame is the slope frame (z normal to
+// the plane, uphill = +x); the slope is made by tilting gravity, so "up" for the IMU is
+// (sin a, 0, cos a) for slope angle a.
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sim/gait.h"
+#include "sim/pose.h"
+#include "sim/sim_config.h"
+
+namespace dgmm::sim {
+
+// A drawable geometric primitive of the simulated scene, in the slope frame (for robot_view).
+struct GeomSnapshot {
+  enum class Type { kPlane, kSphere, kCapsule, kCylinder, kBox, kOther };
+  Type type = Type::kOther;
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();  // MuJoCo geom_size (half-sizes / radius, half-length)
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // geom -> slope frame
+  Eigen::Vector4d rgba = Eigen::Vector4d::Ones();
+};
+
+// Why a command execution ended.
+enum class RunOutcome { kCompleted, kFell, kUnstable };
+
+class Simulator {
+ public:
+  // Loads the built-in robot (or config.mjcf_path) and applies the config. Throws InputError for
+  // an invalid config, an unloadable MJCF or one that breaks the naming/kinematic conventions.
+  explicit Simulator(const SimConfig& config);
+  ~Simulator();
+  Simulator(const Simulator&) = delete;
+  Simulator& operator=(const Simulator&) = delete;
+
+  // Resets the robot to its standing pose at (x, y) on the slope, heading `heading_rad` (slope
+  // frame, 0 = facing uphill, +pi/2 = facing +y), then stands still for settle_duration_s.
+  // Returns kFell when it does not come to rest upright.
+  RunOutcome Place(double x_m, double y_m, double heading_rad);
+  // Runs the gait for command_duration_s. `trajectory` (optional) receives the torso pose every
+  // `sample_every` steps. Stops early on a fall/flip (torso tilted > 60 deg from the slope normal
+  // or its centre below 40% of the stance height) or numerical instability.
+  RunOutcome RunCommand(const Eigen::Vector3d& command, std::vector<Pose>* trajectory = nullptr,
+                        int sample_every = 10);
+  // As above, calling observer(*this) every `observe_every` steps (e.g. to take snapshots).
+  RunOutcome RunCommand(const Eigen::Vector3d& command,
+                        const std::function<void(const Simulator&)>& observer, int observe_every);
+  // Stands still (nominal stance) for the given time.
+  RunOutcome Stand(double seconds);
+
+  Pose TorsoPose() const;                // true torso pose in the slope frame
+  Eigen::Vector2d TruePitchRoll() const; // <pitch, roll> relative to gravity (rad)
+  Eigen::Vector3d Up() const;            // unit vector against gravity, slope frame
+  double time_s() const;                 // simulated time since construction
+  double total_mass_kg() const;
+  const std::array<LegGeometry, kNumLegs>& legs() const;
+  const SimConfig& config() const;
+
+  // Visible geoms (alpha > 0) at the current state, slope frame.
+  std::vector<GeomSnapshot> Geometry() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Rotation slope frame -> gravity-aligned frame (z up): Ry(-slope).
+Eigen::Matrix3d SlopeToLevel(double slope_deg);
+
+}  // namespace dgmm::sim

@@ -1,0 +1,58 @@
+#pragma once
+// Maximum-likelihood fit of a set of effects to real data under the corrected sim model
+//   x_i ~ N(u_i + sum_e D_e,i theta_e, tau^2 Sigma_i)
+// with Ceres (GradientProblem, L-BFGS) on the whitened form: with L_i L_i^T = Sigma_i,
+//   -log p = sum_i [ 1/2 tau^-2 |L_i^-1 (x_i - u_i) - L_i^-1 D_i theta|^2 + dx log tau ] + const.
+#include <Eigen/Dense>
+#include <string>
+#include <vector>
+
+#include "sim2real/effects.h"
+#include "sim2real/linear_gaussian.h"
+#include "sim2real/samples.h"
+
+namespace dgmm::sim2real {
+
+// Everything the fits need, precomputed once for the real samples under the sim model.
+struct FitProblem {
+  int n = 0, dx = 0;
+  std::vector<EffectSpec> library;
+  Eigen::MatrixXd r0;               // n x dx whitened residuals under the sim model
+  Eigen::VectorXd log_norm;         // n: -1/2 (dx log 2 pi + log det Sigma_i)
+  std::vector<Eigen::MatrixXd> g;   // per library effect: (n dx) x p_e whitened designs
+  std::vector<Eigen::MatrixXd> d;   // per library effect: (n dx) x p_e raw mean-shift designs
+  std::vector<int> episode;         // for grouped folds and the bootstrap
+  std::vector<int> command;
+};
+
+FitProblem MakeFitProblem(const Samples& real, const LinearGaussianModel& sim_model,
+                          const std::vector<EffectSpec>& library, const PoseLayout& layout);
+
+// Fitted parameters of a set of library effects (indices into FitProblem::library).
+struct EffectFit {
+  std::vector<int> effects;
+  std::vector<Eigen::VectorXd> theta;  // per entry of `effects` (the noise effect: log tau)
+  double log_tau = 0;                  // 0 unless the noise effect is in the set
+  double train_log_likelihood = 0;     // total over the training rows
+  bool converged = false;
+  int iterations = 0;
+};
+
+struct EffectFitOptions {
+  int max_iterations = 300;
+  double ridge = 1e-6;  // on the column-scaled parameters, keeps collinear designs solvable
+  bool IsValid(std::string* error) const;
+};
+
+// ML fit on `rows` (all when empty).
+EffectFit FitEffects(const FitProblem& problem, const std::vector<int>& effects,
+                     const std::vector<int>& rows, const EffectFitOptions& options = {});
+
+// log p(x_i) under the corrected model for each listed row (all when empty).
+Eigen::VectorXd CorrectedLogLikelihood(const FitProblem& problem, const EffectFit& fit,
+                                       const std::vector<int>& rows = {});
+
+// Whitened mean shift (n dx) of one fitted effect entry k of `fit` (for comparing effects).
+Eigen::VectorXd WhitenedShift(const FitProblem& problem, const EffectFit& fit, int k);
+
+}  // namespace dgmm::sim2real

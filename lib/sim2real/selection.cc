@@ -1,0 +1,230 @@
+#include "sim2real/selection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <set>
+
+namespace dgmm::sim2real {
+namespace {
+
+// z with P(Z > z) = p for a standard normal (bisection on erfc; p in (0, 1)).
+double UpperQuantile(double p) {
+  double lo = -10, hi = 10;
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (0.5 * std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+double Correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const double na = a.norm(), nb = b.norm();
+  if (na < 1e-300 || nb < 1e-300) return 0.0;
+  return a.dot(b) / (na * nb);  // uncentred: shifts are measured from the sim prediction
+}
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * (v.size() - 1);
+  const size_t i = static_cast<size_t>(pos);
+  const double f = pos - i;
+  return i + 1 < v.size() ? (1 - f) * v[i] + f * v[i + 1] : v[i];
+}
+
+}  // namespace
+
+bool SelectionOptions::IsValid(std::string* error) const {
+  if (folds < 2 || !(alpha > 0 && alpha < 1) || max_effects < 0 || bootstrap_selection < 0 ||
+      bootstrap_parameters < 0 || !(confusion_correlation > 0 && confusion_correlation <= 1)) {
+    if (error) *error = "folds >= 2, 0 < alpha < 1, non-negative counts, 0 < correlation <= 1";
+    return false;
+  }
+  return fit.IsValid(error);
+}
+
+std::vector<int> MakeFolds(const FitProblem& fp, const std::vector<int>& rows, int folds,
+                           std::mt19937_64& rng) {
+  // Episodes (by original id) per command, in order of first appearance, then shuffled.
+  std::map<int, std::vector<int>> episodes_of_command;
+  std::set<int> seen;
+  for (int i : rows) {
+    if (seen.insert(fp.episode[i]).second) episodes_of_command[fp.command[i]].push_back(fp.episode[i]);
+  }
+  std::map<int, int> fold_of_episode;
+  int offset = 0;
+  for (auto& [c, eps] : episodes_of_command) {
+    std::shuffle(eps.begin(), eps.end(), rng);
+    for (size_t k = 0; k < eps.size(); ++k) fold_of_episode[eps[k]] = (offset + k) % folds;
+    offset += static_cast<int>(eps.size());
+  }
+  std::vector<int> fold(rows.size());
+  for (size_t k = 0; k < rows.size(); ++k) fold[k] = fold_of_episode[fp.episode[rows[k]]];
+  return fold;
+}
+
+Eigen::VectorXd CrossValidate(const FitProblem& fp, const std::vector<int>& effects,
+                              const std::vector<int>& rows, const std::vector<int>& fold,
+                              const EffectFitOptions& options) {
+  Eigen::VectorXd ll = Eigen::VectorXd::Zero(rows.size());
+  const int folds = fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1;
+  if (effects.empty()) return CorrectedLogLikelihood(fp, EffectFit{}, rows);
+  for (int f = 0; f < folds; ++f) {
+    std::vector<int> train, test, test_pos;
+    for (size_t k = 0; k < rows.size(); ++k) {
+      if (fold[k] == f) {
+        test.push_back(rows[k]);
+        test_pos.push_back(static_cast<int>(k));
+      } else {
+        train.push_back(rows[k]);
+      }
+    }
+    if (test.empty() || train.empty()) continue;
+    EffectFit fit = FitEffects(fp, effects, train, options);
+    Eigen::VectorXd t = CorrectedLogLikelihood(fp, fit, test);
+    for (size_t k = 0; k < test.size(); ++k) ll(test_pos[k]) = t(k);
+  }
+  return ll;
+}
+
+void ClusteredMean(const Eigen::VectorXd& d, const std::vector<int>& cluster, double* mean,
+                   double* se) {
+  const double n = static_cast<double>(d.size());
+  *mean = n > 0 ? d.mean() : 0.0;
+  std::map<int, std::pair<double, int>> sums;
+  for (int i = 0; i < d.size(); ++i) {
+    sums[cluster[i]].first += d(i);
+    sums[cluster[i]].second += 1;
+  }
+  const double g = static_cast<double>(sums.size());
+  double v = 0;
+  for (const auto& [c, s] : sums) v += std::pow(s.first - s.second * *mean, 2);
+  *se = g > 1 ? std::sqrt(g / (g - 1) * v) / n : INFINITY;
+}
+
+SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows,
+                              const std::vector<int>& fold, const SelectionOptions& options) {
+  SelectionResult result;
+  std::vector<int> cluster;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    cluster.push_back(fp.episode[rows[k]]);  // duplicated episodes share a cluster
+  }
+  Eigen::VectorXd current = CrossValidate(fp, {}, rows, fold, options.fit);
+  result.heldout_sim = current;
+  std::vector<int> remaining(fp.library.size());
+  std::iota(remaining.begin(), remaining.end(), 0);
+  while (static_cast<int>(result.selected.size()) < options.max_effects && !remaining.empty()) {
+    SelectionStep step;
+    step.threshold_z = UpperQuantile(options.alpha / remaining.size());
+    std::map<int, Eigen::VectorXd> heldout;
+    for (int e : remaining) {
+      std::vector<int> trial = result.selected;
+      trial.push_back(e);
+      heldout[e] = CrossValidate(fp, trial, rows, fold, options.fit);
+      CandidateScore score;
+      score.effect = e;
+      ClusteredMean(heldout[e] - current, cluster, &score.gain, &score.se);
+      score.z = score.se > 0 ? score.gain / score.se : 0.0;
+      step.candidates.push_back(score);
+    }
+    std::sort(step.candidates.begin(), step.candidates.end(),
+              [](const auto& a, const auto& b) { return a.gain > b.gain; });
+    const CandidateScore& best = step.candidates.front();
+    if (!(best.z > step.threshold_z && best.gain > options.min_gain_nats)) {
+      result.steps.push_back(step);
+      break;
+    }
+    step.chosen = best.effect;
+    // Which runners-up the data cannot separate from the best: near-equal held-out gain (within
+    // one clustered SE of the paired difference) and strongly correlated fitted shifts.
+    std::vector<int> with_best = result.selected;
+    with_best.push_back(best.effect);
+    EffectFit fit_best = FitEffects(fp, with_best, rows, options.fit);
+    Eigen::VectorXd shift_best = WhitenedShift(fp, fit_best, static_cast<int>(with_best.size()) - 1);
+    for (size_t k = 1; k < step.candidates.size(); ++k) {
+      const CandidateScore& other = step.candidates[k];
+      double diff, diff_se;
+      ClusteredMean(heldout[best.effect] - heldout[other.effect], cluster, &diff, &diff_se);
+      if (diff > diff_se || other.gain <= 0) continue;
+      std::vector<int> with_other = result.selected;
+      with_other.push_back(other.effect);
+      EffectFit fit_other = FitEffects(fp, with_other, rows, options.fit);
+      double corr;
+      if (fp.library[best.effect].is_noise || fp.library[other.effect].is_noise) {
+        Eigen::VectorXd a = heldout[best.effect] - current, b = heldout[other.effect] - current;
+        corr = Correlation(a.array() - a.mean(), b.array() - b.mean());
+      } else {
+        corr = Correlation(shift_best,
+                           WhitenedShift(fp, fit_other, static_cast<int>(with_other.size()) - 1));
+      }
+      if (std::abs(corr) >= options.confusion_correlation) step.confusable.push_back(other.effect);
+    }
+    result.selected.push_back(best.effect);
+    current = heldout[best.effect];
+    remaining.erase(std::find(remaining.begin(), remaining.end(), best.effect));
+    result.steps.push_back(step);
+  }
+  result.heldout_corrected = current;
+  result.fit = FitEffects(fp, result.selected, rows, options.fit);
+  for (size_t k = 0; k < result.selected.size(); ++k) {
+    if (result.selected.size() == 1) {
+      result.importance.push_back((current - result.heldout_sim).mean());
+      continue;
+    }
+    std::vector<int> without = result.selected;
+    without.erase(without.begin() + k);
+    result.importance.push_back((current - CrossValidate(fp, without, rows, fold, options.fit)).mean());
+  }
+  return result;
+}
+
+BootstrapResult Bootstrap(const FitProblem& fp, const SelectionResult& selection,
+                          const SelectionOptions& options, std::mt19937_64& rng) {
+  BootstrapResult out;
+  out.inclusion.assign(fp.library.size(), 0.0);
+  std::map<int, std::vector<int>> rows_of_episode;
+  for (int i = 0; i < fp.n; ++i) rows_of_episode[fp.episode[i]].push_back(i);
+  std::vector<int> episodes;
+  for (const auto& [e, r] : rows_of_episode) episodes.push_back(e);
+  if (episodes.empty()) return out;
+  std::uniform_int_distribution<size_t> pick(0, episodes.size() - 1);
+  auto resample = [&]() {
+    std::vector<int> rows;
+    for (size_t k = 0; k < episodes.size(); ++k) {
+      const auto& r = rows_of_episode[episodes[pick(rng)]];
+      rows.insert(rows.end(), r.begin(), r.end());
+    }
+    return rows;
+  };
+  SelectionOptions quick = options;
+  for (int b = 0; b < options.bootstrap_selection; ++b) {
+    std::vector<int> rows = resample();
+    std::vector<int> fold = MakeFolds(fp, rows, options.folds, rng);
+    SelectionResult r = ForwardSelect(fp, rows, fold, quick);
+    for (int e : r.selected) out.inclusion[e] += 1.0 / options.bootstrap_selection;
+  }
+  const size_t k = selection.selected.size();
+  std::vector<std::vector<std::vector<double>>> draws(k);
+  for (size_t j = 0; j < k; ++j) draws[j].resize(selection.fit.theta[j].size());
+  for (int b = 0; b < options.bootstrap_parameters; ++b) {
+    EffectFit fit = FitEffects(fp, selection.selected, resample(), options.fit);
+    for (size_t j = 0; j < k; ++j) {
+      for (int q = 0; q < fit.theta[j].size(); ++q) draws[j][q].push_back(fit.theta[j](q));
+    }
+  }
+  for (size_t j = 0; j < k; ++j) {
+    const int p = static_cast<int>(selection.fit.theta[j].size());
+    Eigen::VectorXd lo(p), hi(p);
+    for (int q = 0; q < p; ++q) {
+      lo(q) = Percentile(draws[j][q], 0.025);
+      hi(q) = Percentile(draws[j][q], 0.975);
+    }
+    out.lower.push_back(lo);
+    out.upper.push_back(hi);
+  }
+  return out;
+}
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,323 @@
+#include "tune/cross_validation.h"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cassert>
+#include <chrono>
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <map>
+#include <mutex>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <thread>
+
+#include "util/error.h"
+
+namespace dgmm {
+namespace {
+
+// Rows of the table, in the order of CvSummary's members.
+enum Variant { kDgmmWithout = 0, kDgmmWith = 1, kEmWithout = 2, kEmWith = 3, kVariants = 4 };
+
+std::uint64_t SplitMix64(std::uint64_t x) {
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
+// What one (repeat, fold) task produced.
+struct FoldResult {
+  std::array<std::vector<double>, kVariants> per_sample;  // scored validation samples
+  std::array<double, kVariants> components{};             // EM: sum of chosen K over commands
+  int em_commands = 0;
+  int unscored = 0;
+};
+
+// Sum of log|scale| over the pose dimensions: the Jacobian that maps a log-density of
+// standardised x back to raw units (0 when the set is not standardised).
+double PoseLogJacobian(const SampleSet& set) {
+  if (set.transform.empty()) return 0.0;
+  return set.transform.scale.head(set.pose_dim()).array().abs().log().sum();
+}
+
+double HeldOut(const MotionModel& model, const SampleSet& set, int i, bool terrain) {
+  const Eigen::VectorXd x = set.x.row(i).transpose();
+  if (!terrain) return model.LogLikelihood(set.command(i), x);
+  const Eigen::VectorXd z = set.z.row(i).transpose();
+  return model.LogLikelihood(set.command(i), x, z);
+}
+
+// The EM baseline on the same training fold: one BIC-selected mixture per command, in the same
+// model header (dimensions, names, transform) as the DGMM so that scoring is identical.
+MotionModel FitEmModel(const SampleSet& train, const MotionModel& header, bool terrain,
+                       const CvOptions& options, std::uint64_t seed, double* components_sum,
+                       int* commands) {
+  MotionModel model = header;
+  model.kind = "em";
+  model.mixtures.clear();
+  std::map<int, std::vector<int>> rows_of;
+  for (int i = 0; i < train.size(); ++i) rows_of[train.command(i)].push_back(i);
+  const int d = train.pose_dim() + (terrain ? train.terrain_dim() : 0);
+  for (const auto& [c, rows] : rows_of) {
+    Eigen::MatrixXd Y(static_cast<int>(rows.size()), d);
+    for (int r = 0; r < Y.rows(); ++r) {
+      Y.row(r).head(train.pose_dim()) = train.x.row(rows[r]);
+      if (terrain) Y.row(r).tail(train.terrain_dim()) = train.z.row(rows[r]);
+    }
+    EmOptions em = options.em;
+    em.seed = DeriveSeed(seed, static_cast<std::uint64_t>(c));
+    int k = 0;
+    model.mixtures[c] = FitEmByBic(Y, em, options.em_max_components, &k);
+    *components_sum += k;
+    ++*commands;
+  }
+  return model;
+}
+
+FoldResult RunFold(const SampleSet& set, const std::vector<int>& fold_of, int repeat, int fold,
+                   const CvOptions& options, bool has_terrain) {
+  const std::uint64_t seed = DeriveSeed(options.seed, repeat, fold, 1);
+  std::vector<int> train_rows, valid_rows;
+  for (int i = 0; i < set.size(); ++i) (fold_of[i] == fold ? valid_rows : train_rows).push_back(i);
+  if (options.shuffle_training) {
+    std::mt19937_64 shuffle_rng(DeriveSeed(seed, 2));
+    std::shuffle(train_rows.begin(), train_rows.end(), shuffle_rng);
+  }
+  const SampleSet train = set.Subset(train_rows);
+  const double jacobian = PoseLogJacobian(set);
+
+  FoldResult result;
+  for (bool terrain : {false, true}) {
+    if (terrain ? !(options.with_terrain && has_terrain) : !options.without_terrain) continue;
+    MotionModelOptions model_options;
+    model_options.dgmm = options.dgmm;
+    // An initial covariance given for y = x || z applies to x alone without terrain.
+    Eigen::VectorXd& init = model_options.dgmm.initial_covariance_diagonal;
+    if (!terrain && init.size() == set.pose_dim() + set.terrain_dim() && set.terrain_dim() > 0) {
+      init = init.head(set.pose_dim()).eval();
+    }
+    model_options.with_terrain = terrain;
+    model_options.seed = seed;  // the same stream with and without terrain, and for every k
+    const MotionModel dgmm_model = LearnMotionModel(train, model_options);
+    MotionModel em_model;
+    const int em_variant = terrain ? kEmWith : kEmWithout;
+    if (options.em_baseline) {
+      em_model = FitEmModel(train, dgmm_model, terrain, options, DeriveSeed(seed, 3, terrain),
+                            &result.components[em_variant], &result.em_commands);
+    }
+    int unscored = 0;
+    for (int i : valid_rows) {
+      if (!dgmm_model.HasCommand(set.command(i))) {
+        ++unscored;
+        continue;
+      }
+      result.per_sample[terrain ? kDgmmWith : kDgmmWithout].push_back(
+          HeldOut(dgmm_model, set, i, terrain) - jacobian);
+      if (options.em_baseline) {
+        result.per_sample[em_variant].push_back(HeldOut(em_model, set, i, terrain) - jacobian);
+      }
+    }
+    result.unscored = unscored;
+  }
+  if (options.em_baseline && options.without_terrain && options.with_terrain && has_terrain) {
+    result.em_commands /= 2;  // counted once per terrain setting
+  }
+  return result;
+}
+
+double SampleSd(const std::vector<double>& v) {
+  if (v.size() < 2) return 0.0;
+  const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
+  double ss = 0;
+  for (double x : v) ss += (x - mean) * (x - mean);
+  return std::sqrt(ss / (v.size() - 1));
+}
+
+}  // namespace
+
+std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+  std::uint64_t h = SplitMix64(seed);
+  h = SplitMix64(h ^ a);
+  h = SplitMix64(h ^ (b + 0x632be59bd9b4e019ULL));
+  return SplitMix64(h ^ (c + 0x8cb92ba72f3d8dd7ULL));
+}
+
+std::vector<int> StratifiedFolds(const Eigen::VectorXi& command, int folds, std::mt19937_64& rng) {
+  assert(folds >= 1);
+  std::map<int, std::vector<int>> rows_of;  // ordered by command id: deterministic
+  for (int i = 0; i < command.size(); ++i) rows_of[command(i)].push_back(i);
+  std::vector<int> fold_of(command.size(), 0);
+  int next = 0;
+  for (auto& [c, rows] : rows_of) {
+    std::shuffle(rows.begin(), rows.end(), rng);
+    for (int i : rows) {
+      fold_of[i] = next;
+      next = (next + 1) % folds;
+    }
+  }
+  return fold_of;
+}
+
+bool CvOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& message) {
+    if (error) *error = message;
+    return false;
+  };
+  std::string dgmm_error;
+  if (!dgmm.IsValid(&dgmm_error)) return fail(dgmm_error);
+  if (folds < 2) return fail("folds must be >= 2, got " + std::to_string(folds));
+  if (repeats < 1) return fail("repeats must be >= 1, got " + std::to_string(repeats));
+  if (!without_terrain && !with_terrain) return fail("nothing to evaluate (no terrain setting)");
+  if (em_baseline) {
+    if (em_max_components < 1) return fail("em_max_components must be >= 1");
+    std::string em_error;
+    if (!em.IsValid(&em_error)) return fail(em_error);
+  }
+  if (threads < 0) return fail("threads must be >= 0");
+  return true;
+}
+
+Mixture FitEmByBic(const Eigen::MatrixXd& Y, const EmOptions& em, int max_components,
+                   int* components) {
+  const int n = static_cast<int>(Y.rows()), d = static_cast<int>(Y.cols());
+  std::optional<EmResult> best;
+  int best_k = 0;
+  for (int k = 1; k <= max_components && k <= n; ++k) {
+    if (k > 1 && MixtureParameterCount(k, d) > n) break;
+    EmOptions options = em;
+    options.components = k;
+    EmResult fit = FitEm(Y, options);
+    if (!std::isfinite(fit.summary.bic)) continue;
+    if (!best || fit.summary.bic < best->summary.bic) {
+      best = std::move(fit);
+      best_k = k;
+    }
+  }
+  if (!best) {  // every fit degenerate: fall back to one component
+    EmOptions options = em;
+    options.components = 1;
+    best = FitEm(Y, options);
+    best_k = 1;
+  }
+  if (components) *components = best_k;
+  return std::move(best->mixture);
+}
+
+CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "cross-validation", error);
+  if (set.size() == 0) throw MakeInputError("", "sample set", "is empty");
+  const std::string problem = set.Validate();
+  if (!problem.empty()) throw MakeInputError("", "sample set", problem);
+  const auto start = std::chrono::steady_clock::now();
+
+  CvSummary summary;
+  summary.samples = set.size();
+  summary.folds = options.folds;
+  summary.repeats = options.repeats;
+  summary.has_terrain = set.terrain_dim() > 0;
+  std::vector<int> distinct(set.command.data(), set.command.data() + set.size());
+  std::sort(distinct.begin(), distinct.end());
+  summary.commands =
+      static_cast<int>(std::unique(distinct.begin(), distinct.end()) - distinct.begin());
+
+  // Fold assignments first (serially), then every (repeat, fold) task on the worker threads.
+  std::vector<std::vector<int>> fold_of(options.repeats);
+  for (int r = 0; r < options.repeats; ++r) {
+    std::mt19937_64 rng(DeriveSeed(options.seed, r, 0, 0));
+    fold_of[r] = StratifiedFolds(set.command, options.folds, rng);
+  }
+  const int tasks = options.repeats * options.folds;
+  std::vector<FoldResult> results(tasks);
+  std::atomic<int> next{0}, done{0};
+  std::mutex mutex;
+  std::exception_ptr failure;
+  auto worker = [&] {
+    for (int t; (t = next.fetch_add(1)) < tasks;) {
+      try {
+        results[t] = RunFold(set, fold_of[t / options.folds], t / options.folds, t % options.folds,
+                             options, summary.has_terrain);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = tasks;
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      const int finished = ++done;
+      if (options.progress) options.progress(finished, tasks);
+    }
+  };
+  int threads =
+      options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::clamp(threads, 1, tasks);
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& thread : pool) thread.join();
+  if (failure) std::rethrow_exception(failure);
+
+  // Reduce in task order: the figures do not depend on the number of threads.
+  std::array<CvScore*, kVariants> scores = {&summary.dgmm_without_terrain,
+                                            &summary.dgmm_with_terrain, &summary.em_without_terrain,
+                                            &summary.em_with_terrain};
+  double components_total[kVariants] = {0, 0, 0, 0};
+  int em_commands = 0;
+  for (int v = 0; v < kVariants; ++v) {
+    scores[v]->per_fold = Eigen::MatrixXd::Zero(options.repeats, options.folds);
+  }
+  for (int r = 0; r < options.repeats; ++r) {
+    std::array<std::vector<double>, kVariants> all;
+    int unscored = 0;
+    for (int f = 0; f < options.folds; ++f) {
+      const FoldResult& fr = results[r * options.folds + f];
+      unscored += fr.unscored;
+      em_commands += fr.em_commands;
+      for (int v = 0; v < kVariants; ++v) {
+        scores[v]->per_fold(r, f) =
+            std::accumulate(fr.per_sample[v].begin(), fr.per_sample[v].end(), 0.0);
+        all[v].insert(all[v].end(), fr.per_sample[v].begin(), fr.per_sample[v].end());
+        components_total[v] += fr.components[v];
+      }
+    }
+    summary.unscored_per_repeat = unscored;
+    for (int v = 0; v < kVariants; ++v) {
+      if (all[v].empty()) continue;
+      scores[v]->evaluated = true;
+      scores[v]->per_repeat.push_back(scores[v]->per_fold.row(r).sum());
+      scores[v]->standard_error +=
+          std::sqrt(static_cast<double>(all[v].size())) * SampleSd(all[v]) / options.repeats;
+      summary.scored_per_repeat = static_cast<int>(all[v].size());
+    }
+  }
+  for (int v = 0; v < kVariants; ++v) {
+    CvScore& s = *scores[v];
+    if (!s.evaluated) continue;
+    s.mean = std::accumulate(s.per_repeat.begin(), s.per_repeat.end(), 0.0) / s.per_repeat.size();
+    s.sd = SampleSd(s.per_repeat);
+    s.mean_per_sample = summary.scored_per_repeat > 0 ? s.mean / summary.scored_per_repeat : 0;
+    if (v >= kEmWithout && em_commands > 0) s.mean_components = components_total[v] / em_commands;
+  }
+  summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return summary;
+}
+
+std::string CvSummary::BriefReport() const {
+  std::ostringstream out;
+  out << repeats << " x " << folds << "-fold cross-validation, " << samples << " samples, "
+      << commands << " commands";
+  auto row = [&](const char* name, const CvScore& s) {
+    if (s.evaluated) out << "; " << name << " " << s.mean << " +- " << s.sd;
+  };
+  row("DGMM without terrain", dgmm_without_terrain);
+  row("DGMM with terrain", dgmm_with_terrain);
+  row("EM-BIC without terrain", em_without_terrain);
+  row("EM-BIC with terrain", em_with_terrain);
+  return out.str();
+}
+
+}  // namespace dgmm

@@ -1,0 +1,104 @@
+// End-to-end tests of `dgmm cv` and `dgmm tune-k` on small synthetic sets written to HDF5.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "io/sample_set_io.h"
+#include "tests/app/run_dgmm.h"
+#include "tests/tune/synthetic.h"
+
+namespace dgmm::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+// A 3-command set whose pose change depends on the terrain, written once per test.
+std::string WriteTerrainSet(const fs::path& dir) {
+  const std::string path = (dir / "terrain.h5").string();
+  WriteSampleSet(MakeTerrainSet(3, 20, 1.0, 4), path);
+  return path;
+}
+
+TEST(CvCommand, JsonTableWithTerrainHelping) {
+  const fs::path dir = MakeTempDir("cv_json");
+  const std::string set = WriteTerrainSet(dir);
+  const RunResult r =
+      RunDgmm({"cv", set, "--k", "0.5", "--folds", "4", "--repeats", "2", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["samples"], 60);
+  EXPECT_EQ(j["folds"], 4);
+  for (const char* row : {"dgmm_without_terrain", "dgmm_with_terrain", "em_bic_without_terrain",
+                          "em_bic_with_terrain"}) {
+    ASSERT_TRUE(j["rows"].contains(row)) << row;
+    EXPECT_EQ(j["rows"][row]["per_repeat"].size(), 2u);
+  }
+  EXPECT_GT(j["rows"]["dgmm_with_terrain"]["mean"].get<double>(),
+            j["rows"]["dgmm_without_terrain"]["mean"].get<double>());
+  EXPECT_GT(j["rows"]["em_bic_with_terrain"]["mean"].get<double>(),
+            j["rows"]["em_bic_without_terrain"]["mean"].get<double>());
+  EXPECT_TRUE(r.err.empty()) << "no progress output when stderr is not a terminal: " << r.err;
+}
+
+TEST(CvCommand, TextTableAndThreadIndependence) {
+  const fs::path dir = MakeTempDir("cv_text");
+  const std::string set = WriteTerrainSet(dir);
+  const RunResult text = RunDgmm({"cv", set, "--folds", "3", "--repeats", "2", "--no-em"});
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("DGMM without terrain"), std::string::npos);
+  EXPECT_NE(text.out.find("DGMM with terrain"), std::string::npos);
+  EXPECT_EQ(text.out.find("EM-BIC"), std::string::npos);
+  std::vector<std::string> args = {"cv", set, "--folds", "3", "--repeats", "2", "--json"};
+  args.insert(args.end(), {"--threads", "1"});
+  const auto one = nlohmann::json::parse(RunDgmm(args).out);
+  args.back() = "2";
+  const auto two = nlohmann::json::parse(RunDgmm(args).out);
+  EXPECT_EQ(one["rows"], two["rows"]);
+}
+
+TEST(CvCommand, BadInputIsOneLineAndNonZero) {
+  const fs::path dir = MakeTempDir("cv_bad");
+  const std::string set = WriteTerrainSet(dir);
+  for (const std::vector<std::string>& args : {std::vector<std::string>{"cv", set, "--k", "0"},
+                                               {"cv", set, "--k", "-1"},
+                                               {"cv", set, "--k", "nan"},
+                                               {"cv", set, "--folds", "1"},
+                                               {"cv", set, "--repeats", "0"},
+                                               {"cv", (dir / "missing.h5").string()},
+                                               {"tune-k", set, "--folds", "1"},
+                                               {"tune-k", set, "--k-min", "0"},
+                                               {"tune-k", (dir / "missing.h5").string()}}) {
+    const RunResult r = RunDgmm(args);
+    EXPECT_NE(r.exit_code, 0) << args[1] << " " << (args.size() > 2 ? args[2] : "");
+    EXPECT_NE(r.exit_code, -1) << "crashed";
+    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  }
+}
+
+TEST(TuneKCommand, ChoosesKInsideTheBracketAndWritesTheCurve) {
+  const fs::path dir = MakeTempDir("tune_k");
+  const std::string set = WriteTerrainSet(dir);
+  const std::string csv = (dir / "curve.csv").string();
+  const RunResult r = RunDgmm({"tune-k", set, "--folds", "3", "--repeats", "2", "--grid-points",
+                               "4", "--refine-points", "1", "--curve-csv", csv, "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const double k = j["k"];
+  EXPECT_GE(k, j["bracket"][0].get<double>() * (1 - 1e-9));
+  EXPECT_LE(k, j["bracket"][1].get<double>() * (1 + 1e-9));
+  EXPECT_EQ(j["curve"].size(), 4u + 1u + 1u);
+  std::ifstream in(csv);
+  std::string header;
+  std::getline(in, header);
+  EXPECT_EQ(header, "k,log_likelihood,sd,standard_error,smoothed,role");
+  // An unwritable output fails before the run and leaves nothing behind.
+  const std::string bad = (dir / "no_such_dir" / "curve.csv").string();
+  const RunResult fail = RunDgmm({"tune-k", set, "--curve-csv", bad});
+  EXPECT_NE(fail.exit_code, 0);
+  EXPECT_FALSE(fs::exists(bad));
+}
+
+}  // namespace
+}  // namespace dgmm::test

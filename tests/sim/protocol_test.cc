@@ -1,0 +1,118 @@
+#include "sim/protocol.h"
+
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+// A short paper protocol: 6 placements (2 commands x 3 headings), 2 executions each.
+ProtocolOptions Short(std::uint64_t seed) {
+  ProtocolOptions o;
+  o.seed = seed;
+  o.placements = 6;
+  o.executions_per_placement = 2;
+  return o;
+}
+
+TEST(ProtocolTest, RecordsTheDocumentedLayout) {
+  SimSummary summary;
+  long long last_done = 0, last_total = 0;
+  const SampleSet set = SimulateProtocol(SimConfig{}, Short(3), [&](long long d, long long t) {
+    last_done = d;
+    last_total = t;
+  }, &summary);
+  EXPECT_EQ(set.Validate(), "");
+  EXPECT_EQ(set.size(), 12);
+  EXPECT_EQ(summary.samples, 12);
+  EXPECT_EQ(summary.falls, 0);
+  EXPECT_EQ(last_done, 6);
+  EXPECT_EQ(last_total, 6);
+  EXPECT_EQ(set.num_commands(), 26);
+  EXPECT_EQ(set.command_dim_names, (std::vector<std::string>{"long", "lat", "turn"}));
+  EXPECT_EQ(set.x_names, (std::vector<std::string>{"dx", "dy", "dz", "droll", "dpitch", "dyaw"}));
+  EXPECT_EQ(set.z_names, (std::vector<std::string>{"pitch", "roll"}));
+  EXPECT_EQ(set.source, "sim");
+  EXPECT_TRUE(set.has_sequence());
+  EXPECT_EQ(set.metadata.at("seed"), "3");
+  EXPECT_EQ(set.metadata.at("protocol"), "paper");
+  EXPECT_NE(set.metadata.at("sim_config").find("slope_deg"), std::string::npos);
+  // No no-op command; every level in {-0.5, 0, 0.5}.
+  for (int c = 0; c < set.num_commands(); ++c) {
+    EXPECT_GT(set.commands.row(c).cwiseAbs().sum(), 0);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(std::abs(set.commands(c, k)) * 2, std::round(std::abs(set.commands(c, k)) * 2));
+  }
+  // Three placements per command (headings 0, 90, -90 deg), two steps each.
+  EXPECT_EQ(std::set<int>(set.command.data(), set.command.data() + set.size()).size(), 2u);
+  for (int i = 0; i < set.size(); ++i) {
+    EXPECT_EQ(set.episode[i], i / 2);
+    EXPECT_EQ(set.step[i], i % 2);
+  }
+  // Headings: across (|roll| ~ slope), downhill (pitch ~ +slope), uphill (pitch ~ -slope).
+  const double slope = 18 * M_PI / 180, kTol = 0.1;  // rad: IMU noise plus stance tilt
+  EXPECT_NEAR(std::abs(set.z(0, 1)), slope, kTol);
+  EXPECT_NEAR(set.z(2, 0), slope, kTol);
+  EXPECT_NEAR(set.z(4, 0), -slope, kTol);
+}
+
+TEST(ProtocolTest, SameSeedSameSetOtherSeedOtherSet) {
+  const SampleSet a = SimulateProtocol(SimConfig{}, Short(7));
+  const SampleSet b = SimulateProtocol(SimConfig{}, Short(7));
+  const SampleSet c = SimulateProtocol(SimConfig{}, Short(8));
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.z, b.z);
+  EXPECT_EQ(a.command, b.command);
+  EXPECT_NE(a.x, c.x);
+}
+
+TEST(ProtocolTest, FullPaperPlanDrawsEveryCommandThreeTimes) {
+  // Plan check without physics cost: one execution of a very short gait per placement.
+  SimConfig fast;
+  fast.command_duration_s = fast.gait.period_s;
+  fast.settle_duration_s = 0.05;
+  ProtocolOptions o;
+  o.executions_per_placement = 1;
+  const SampleSet set = SimulateProtocol(fast, o);
+  ASSERT_EQ(set.size(), 78);
+  std::vector<int> count(26, 0);
+  for (int i = 0; i < set.size(); ++i) ++count[set.command[i]];
+  for (int c = 0; c < 26; ++c) EXPECT_EQ(count[c], 3) << c;
+  // Drawn without replacement: consecutive triples share a command.
+  for (int i = 0; i < set.size(); i += 3) {
+    EXPECT_EQ(set.command[i], set.command[i + 1]);
+    EXPECT_EQ(set.command[i], set.command[i + 2]);
+  }
+}
+
+TEST(ProtocolTest, FallsAreCountedNotRecorded) {
+  SimConfig c;
+  c.slope_deg = 30;
+  c.payload.mass_kg = 60;
+  c.payload.position_body_m = Eigen::Vector3d(0, 0.8, 0.8);
+  ProtocolOptions o = Short(1);
+  o.max_retries_per_placement = 0;
+  SimSummary summary;
+  const SampleSet set = SimulateProtocol(c, o, {}, &summary);
+  EXPECT_GT(summary.falls, 0);
+  EXPECT_EQ(set.size(), 2 * (6 - summary.abandoned_placements));
+  EXPECT_EQ(summary.abandoned_placements, summary.falls);
+  EXPECT_EQ(set.metadata.at("falls"), std::to_string(summary.falls));
+}
+
+TEST(ProtocolTest, ParsesNamesAndRejectsBadOptions) {
+  EXPECT_EQ(ParseProtocol("paper"), Protocol::kPaper);
+  EXPECT_EQ(ParseProtocol("paper-830"), Protocol::kPaper830);
+  EXPECT_THROW(ParseProtocol("paper830"), InputError);
+  ProtocolOptions o;
+  o.executions_per_placement = 0;
+  EXPECT_THROW(SimulateProtocol(SimConfig{}, o), InputError);
+  SimConfig bad;
+  bad.timestep_s = -1;
+  EXPECT_THROW(SimulateProtocol(bad, ProtocolOptions{}), InputError);
+}
+
+}  // namespace
+}  // namespace dgmm::sim

@@ -1,0 +1,197 @@
+#include "sim/simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mujoco_fixture.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+using SimulatorTest = test::MujocoTest;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+
+constexpr double kUphill = 0, kAcross = M_PI / 2, kDownhill = M_PI;
+
+// Displacement of one execution of `command` from a fresh placement.
+Vec6 RunOnce(Simulator& sim, const Eigen::Vector3d& command, double heading = 0) {
+  EXPECT_EQ(sim.Place(0, 0, heading), RunOutcome::kCompleted);
+  const Pose start = sim.TorsoPose();
+  EXPECT_EQ(sim.RunCommand(command), RunOutcome::kCompleted);
+  return DeltaPoseBody(start, sim.TorsoPose());
+}
+
+SimConfig Flat() {
+  SimConfig c;
+  c.slope_deg = 0;
+  return c;
+}
+
+// Nominal speed: stride_m per half period at |command| = 1; commands of 0.5 over 1.5 s should
+// cover 0.36 m if nothing slipped. The thresholds below ask for well over half of that.
+constexpr double kMinTravelM = 0.2;
+constexpr double kMaxCrossTravelM = 0.05;  // sideways leak of a straight command on flat ground
+constexpr double kMinTurnRad = 0.25;       // nominal 0.45 rad
+
+TEST_F(SimulatorTest, BuiltInRobotHasDocumentedMass) {
+  Simulator sim(Flat());
+  const MassConfig m;
+  EXPECT_NEAR(sim.total_mass_kg(), m.torso_kg + 8 * (m.coxa_kg + m.femur_kg + m.tibia_kg), 1e-3);
+  SimConfig heavy = Flat();
+  heavy.payload.mass_kg = 2;
+  EXPECT_NEAR(Simulator(heavy).total_mass_kg(), sim.total_mass_kg() + 2, 1e-3);
+}
+
+TEST_F(SimulatorTest, WalksForwardSidewaysAndTurnsOnFlatGround) {
+  Simulator sim(Flat());
+  const Vec6 fwd = RunOnce(sim, {0.5, 0, 0});
+  EXPECT_GT(fwd[0], kMinTravelM);
+  EXPECT_LT(std::abs(fwd[1]), kMaxCrossTravelM);
+  const Vec6 back = RunOnce(sim, {-0.5, 0, 0});
+  EXPECT_LT(back[0], -kMinTravelM);
+  const Vec6 left = RunOnce(sim, {0, 0.5, 0});
+  EXPECT_GT(left[1], kMinTravelM);
+  EXPECT_LT(std::abs(left[0]), kMaxCrossTravelM);
+  const Vec6 right = RunOnce(sim, {0, -0.5, 0});
+  EXPECT_LT(right[1], -kMinTravelM);
+  const Vec6 ccw = RunOnce(sim, {0, 0, 0.5});
+  EXPECT_GT(ccw[5], kMinTurnRad);
+  EXPECT_LT(ccw.head<2>().norm(), kMaxCrossTravelM);
+  EXPECT_LT(RunOnce(sim, {0, 0, -0.5})[5], -kMinTurnRad);
+  // A full command goes further than a half one.
+  EXPECT_GT(RunOnce(sim, {1, 0, 0})[0], 1.5 * fwd[0]);
+}
+
+TEST_F(SimulatorTest, WalksOnTheSlopeInEveryHeading) {
+  Simulator sim{SimConfig{}};
+  for (double heading : {kUphill, kAcross, kDownhill, -kAcross}) {
+    SCOPED_TRACE(heading);
+    const double kSlopeTravelM = 0.1;  // downhill slip eats up to half the stride uphill
+    EXPECT_GT(RunOnce(sim, {0.5, 0, 0}, heading)[0], kSlopeTravelM);
+    EXPECT_LT(RunOnce(sim, {-0.5, 0, 0}, heading)[0], -kSlopeTravelM);
+    EXPECT_GT(RunOnce(sim, {0, 0.5, 0}, heading)[1], kSlopeTravelM);
+    EXPECT_LT(RunOnce(sim, {0, -0.5, 0}, heading)[1], -kSlopeTravelM);
+    EXPECT_GT(RunOnce(sim, {0, 0, 0.5}, heading)[5], kMinTurnRad);
+  }
+}
+
+TEST_F(SimulatorTest, ImuReadsTheSlope) {
+  Simulator sim{SimConfig{}};
+  const double slope = 18 * M_PI / 180;
+  const double kTolRad = 2.5 * M_PI / 180;  // the standing torso sits within a few degrees of the plane
+  ASSERT_EQ(sim.Place(0, 0, kUphill), RunOutcome::kCompleted);
+  EXPECT_NEAR(sim.TruePitchRoll()[0], -slope, kTolRad);  // nose up
+  ASSERT_EQ(sim.Place(0, 0, kDownhill), RunOutcome::kCompleted);
+  EXPECT_NEAR(sim.TruePitchRoll()[0], slope, kTolRad);
+  ASSERT_EQ(sim.Place(0, 0, kAcross), RunOutcome::kCompleted);  // left side downhill
+  EXPECT_NEAR(sim.TruePitchRoll()[1], -slope, kTolRad);
+  EXPECT_NEAR(sim.TruePitchRoll()[0], 0, kTolRad);
+}
+
+TEST_F(SimulatorTest, LowerFrictionSlipsFurtherDownhill) {
+  SimConfig slippery;
+  slippery.friction.sliding = 0.5;
+  Simulator grippy{SimConfig{}}, slips(slippery);
+  // Stepping on the spot facing across the slope: the body's left (+y) is downhill.
+  const double grip_slip = RunOnce(grippy, Eigen::Vector3d::Zero(), kAcross)[1];
+  const double low_slip = RunOnce(slips, Eigen::Vector3d::Zero(), kAcross)[1];
+  EXPECT_GT(grip_slip, 0);
+  EXPECT_GT(low_slip, grip_slip);
+}
+
+TEST_F(SimulatorTest, SameConfigSameTrajectory) {
+  Simulator a{SimConfig{}}, b{SimConfig{}};
+  EXPECT_EQ(RunOnce(a, {0.5, 0.5, 0.5}, 1.0), RunOnce(b, {0.5, 0.5, 0.5}, 1.0));
+}
+
+TEST_F(SimulatorTest, TippingOverIsReportedAsAFall) {
+  SimConfig c;
+  c.slope_deg = 30;
+  c.payload.mass_kg = 60;  // a heavy block hung far out on the downhill side
+  c.payload.position_body_m = Eigen::Vector3d(0, 0.8, 0.8);
+  Simulator sim(c);
+  RunOutcome outcome = sim.Place(0, 0, kAcross);
+  if (outcome == RunOutcome::kCompleted) outcome = sim.RunCommand({0, 0.5, 0});
+  EXPECT_EQ(outcome, RunOutcome::kFell);
+}
+
+std::string BuiltInXml() {
+  std::ifstream in(std::string(DGMM_SOURCE_DIR) + "/datasets/robots/scorpion.xml");
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string Replace(std::string s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) {
+    s.replace(at, from.size(), to);
+  }
+  return s;
+}
+
+TEST_F(SimulatorTest, UserRobotWithOtherNamesWalks) {
+  const auto dir = std::filesystem::temp_directory_path() / "dgmm_sim_user_robot";
+  std::filesystem::create_directories(dir);
+  std::string xml = Replace(BuiltInXml(), "\"leg", "\"foot");
+  xml = Replace(xml, "name=\"torso\"", "name=\"chassis\"");
+  xml = Replace(xml, "name=\"floor\"", "name=\"ground\"");
+  std::ofstream(dir / "robot.xml") << xml;
+  SimConfig c = Flat();
+  c.mjcf_path = (dir / "robot.xml").string();
+  c.names = {"chassis", "ground", "foot"};
+  Simulator sim(c);
+  EXPECT_GT(RunOnce(sim, {0.5, 0, 0})[0], kMinTravelM);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(SimulatorTest, BrokenUserRobotsAreInputErrors) {
+  const auto dir = std::filesystem::temp_directory_path() / "dgmm_sim_bad_robot";
+  std::filesystem::create_directories(dir);
+  const std::pair<std::string, std::string> cases[] = {
+      {Replace(BuiltInXml(), "name=\"leg5_knee\" joint", "name=\"leg5_elbow\" joint"), "leg5_knee"},
+      {Replace(BuiltInXml(), "<freejoint name=\"root\"/>", ""), "free joint"},
+      {Replace(BuiltInXml(), "<joint name=\"leg2_hip_pitch\" class=\"hip_pitch\"/>",
+               "<joint name=\"leg2_hip_pitch\" class=\"hip_pitch\" axis=\"0 1 0\"/>"),
+       "axes"},
+      {"<mujoco><worldbody><body", "MJCF"},
+  };
+  for (const auto& [xml, expected] : cases) {
+    std::ofstream(dir / "robot.xml") << xml;
+    SimConfig c;
+    c.mjcf_path = (dir / "robot.xml").string();
+    try {
+      Simulator sim(c);
+      ADD_FAILURE() << "accepted a robot without " << expected;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+  SimConfig payload_without_body;
+  payload_without_body.mjcf_path = (dir / "robot.xml").string();
+  std::ofstream(dir / "robot.xml") << Replace(BuiltInXml(), "name=\"payload\"", "name=\"cargo\"");
+  payload_without_body.payload.mass_kg = 1;
+  EXPECT_THROW(Simulator{payload_without_body}, InputError);
+  std::filesystem::remove_all(dir);
+}
+
+TEST_F(SimulatorTest, GeometrySnapshotHasThePlaneAndTheRobot) {
+  Simulator sim{SimConfig{}};
+  sim.Place(0, 0, 0);
+  const auto geoms = sim.Geometry();
+  int planes = 0, spheres = 0, boxes = 0;
+  for (const auto& g : geoms) {
+    planes += g.type == GeomSnapshot::Type::kPlane;
+    spheres += g.type == GeomSnapshot::Type::kSphere;
+    boxes += g.type == GeomSnapshot::Type::kBox;
+  }
+  EXPECT_EQ(planes, 1);
+  EXPECT_EQ(spheres, 8);  // feet
+  EXPECT_EQ(boxes, 1);    // torso (the payload is hidden when it has no mass)
+}
+
+}  // namespace
+}  // namespace dgmm::sim

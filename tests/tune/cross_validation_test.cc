@@ -1,0 +1,185 @@
+#include "tune/cross_validation.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+
+#include "tests/tune/synthetic.h"
+#include "util/error.h"
+
+namespace dgmm {
+namespace {
+
+CvOptions SmallOptions() {
+  CvOptions options;
+  options.folds = 5;
+  options.repeats = 3;
+  options.seed = 7;
+  options.dgmm.k = 0.5;
+  options.em_max_components = 2;
+  options.em.n_init = 1;
+  return options;
+}
+
+TEST(StratifiedFolds, PartitionAndStratifyEveryCommand) {
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    std::mt19937_64 make(seed);
+    const int n = 50 + static_cast<int>(make() % 200);
+    const int folds = 2 + static_cast<int>(make() % 9);
+    Eigen::VectorXi command(n);
+    for (int i = 0; i < n; ++i) command(i) = static_cast<int>(make() % 7);
+    std::mt19937_64 rng(seed);
+    const std::vector<int> fold_of = StratifiedFolds(command, folds, rng);
+    ASSERT_EQ(static_cast<int>(fold_of.size()), n);
+    std::vector<int> fold_size(folds, 0);
+    std::map<int, std::vector<int>> per_command;  // command -> count per fold
+    for (int i = 0; i < n; ++i) {
+      ASSERT_GE(fold_of[i], 0);
+      ASSERT_LT(fold_of[i], folds);  // every sample in exactly one fold: a partition
+      ++fold_size[fold_of[i]];
+      per_command.try_emplace(command(i), folds, 0).first->second[fold_of[i]]++;
+    }
+    const auto [min_size, max_size] = std::minmax_element(fold_size.begin(), fold_size.end());
+    EXPECT_LE(*max_size - *min_size, 1) << "seed " << seed;
+    for (const auto& [c, counts] : per_command) {
+      const auto [lo, hi] = std::minmax_element(counts.begin(), counts.end());
+      EXPECT_LE(*hi - *lo, 1) << "command " << c << " seed " << seed;
+    }
+    std::mt19937_64 again(seed);
+    EXPECT_EQ(StratifiedFolds(command, folds, again), fold_of);
+  }
+}
+
+TEST(DeriveSeed, DistinctStreamsAndDeterministic) {
+  std::set<std::uint64_t> seen;
+  for (int r = 0; r < 10; ++r)
+    for (int f = 0; f < 10; ++f) seen.insert(DeriveSeed(1, r, f, 1));
+  EXPECT_EQ(seen.size(), 100u);
+  EXPECT_EQ(DeriveSeed(3, 4, 5, 6), DeriveSeed(3, 4, 5, 6));
+  EXPECT_NE(DeriveSeed(3, 4, 5, 6), DeriveSeed(4, 4, 5, 6));
+}
+
+TEST(CrossValidate, IdenticalForOneAndTwoThreads) {
+  const SampleSet set = test::MakeTerrainSet(3, 20, 1.0, 11);
+  CvOptions options = SmallOptions();
+  options.threads = 1;
+  const CvSummary one = CrossValidate(set, options);
+  options.threads = 2;
+  const CvSummary two = CrossValidate(set, options);
+  for (auto member : {&CvSummary::dgmm_without_terrain, &CvSummary::dgmm_with_terrain,
+                      &CvSummary::em_without_terrain, &CvSummary::em_with_terrain}) {
+    ASSERT_TRUE((one.*member).evaluated);
+    EXPECT_EQ((one.*member).per_fold, (two.*member).per_fold);
+    EXPECT_EQ((one.*member).per_repeat, (two.*member).per_repeat);
+    EXPECT_EQ((one.*member).standard_error, (two.*member).standard_error);
+  }
+  EXPECT_EQ(one.scored_per_repeat, set.size());
+  EXPECT_EQ(one.unscored_per_repeat, 0);
+  // The per-repeat totals are the sums of the fold totals, and the repeats differ (new folds).
+  const CvScore& s = one.dgmm_with_terrain;
+  ASSERT_EQ(static_cast<int>(s.per_repeat.size()), options.repeats);
+  for (int r = 0; r < options.repeats; ++r)
+    EXPECT_DOUBLE_EQ(s.per_fold.row(r).sum(), s.per_repeat[r]);
+  EXPECT_NE(s.per_repeat[0], s.per_repeat[1]);
+  EXPECT_GT(s.sd, 0);
+  EXPECT_GT(s.standard_error, 0);
+}
+
+TEST(CrossValidate, TerrainHelpsWhenXDependsOnTerrain) {
+  const SampleSet set = test::MakeTerrainSet(3, 40, 1.0, 3);
+  const CvSummary cv = CrossValidate(set, SmallOptions());
+  // x = mu + B z + 0.3 e with |B| ~ 1: knowing z shrinks the spread of x about threefold, a gain
+  // of tens of nats per sample-dimension set; demand at least three standard errors.
+  EXPECT_GT(cv.dgmm_with_terrain.mean,
+            cv.dgmm_without_terrain.mean + 3 * cv.dgmm_without_terrain.standard_error);
+  EXPECT_GT(cv.em_with_terrain.mean,
+            cv.em_without_terrain.mean + 3 * cv.em_without_terrain.standard_error);
+}
+
+TEST(CrossValidate, TerrainDoesNotHelpWhenXIgnoresTerrain) {
+  const SampleSet set = test::MakeTerrainSet(3, 40, 0.0, 3);
+  const CvSummary cv = CrossValidate(set, SmallOptions());
+  // No information in z: conditioning can only add estimation noise. Allow one standard error
+  // of the total (the spread another sample of the same size would show).
+  EXPECT_LT(cv.dgmm_with_terrain.mean,
+            cv.dgmm_without_terrain.mean + cv.dgmm_without_terrain.standard_error);
+  EXPECT_LT(cv.em_with_terrain.mean,
+            cv.em_without_terrain.mean + cv.em_without_terrain.standard_error);
+}
+
+TEST(CrossValidate, FewerSamplesThanFoldsAndSingletonCommands) {
+  SampleSet set = test::MakeTerrainSet(3, 4, 1.0, 5);  // 4 samples per command, 10 folds
+  // Make command 2 a singleton: relabel three of its samples as command 0.
+  int relabelled = 0;
+  for (int i = 0; i < set.size() && relabelled < 3; ++i) {
+    if (set.command(i) == 2) {
+      set.command(i) = 0;
+      ++relabelled;
+    }
+  }
+  CvOptions options = SmallOptions();
+  options.folds = 10;
+  const CvSummary cv = CrossValidate(set, options);
+  EXPECT_EQ(cv.unscored_per_repeat, 1);  // the singleton has no training sample when held out
+  EXPECT_EQ(cv.scored_per_repeat, set.size() - 1);
+  EXPECT_TRUE(std::isfinite(cv.dgmm_with_terrain.mean));
+  EXPECT_TRUE(std::isfinite(cv.em_without_terrain.mean));
+}
+
+TEST(CrossValidate, WithoutTerrainInTheSetSkipsTheTerrainRows) {
+  SampleSet set = test::MakeTerrainSet(2, 15, 1.0, 5);
+  set.z.resize(set.size(), 0);
+  set.z_names.clear();
+  set.z_units.clear();
+  const CvSummary cv = CrossValidate(set, SmallOptions());
+  EXPECT_FALSE(cv.has_terrain);
+  EXPECT_TRUE(cv.dgmm_without_terrain.evaluated);
+  EXPECT_FALSE(cv.dgmm_with_terrain.evaluated);
+  EXPECT_FALSE(cv.em_with_terrain.evaluated);
+}
+
+TEST(CrossValidate, RejectsBadOptionsAndEmptySets) {
+  const SampleSet set = test::MakeTerrainSet(2, 10, 1.0, 5);
+  CvOptions options = SmallOptions();
+  std::string error;
+  options.dgmm.k = 0;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_THROW(CrossValidate(set, options), InputError);
+  options.dgmm.k = -1;
+  EXPECT_THROW(CrossValidate(set, options), InputError);
+  options = SmallOptions();
+  options.folds = 1;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("folds"), std::string::npos);
+  EXPECT_THROW(CrossValidate(set, options), InputError);
+  options = SmallOptions();
+  options.repeats = 0;
+  EXPECT_THROW(CrossValidate(set, options), InputError);
+  EXPECT_THROW(CrossValidate(set.Subset({}), SmallOptions()), InputError);
+}
+
+TEST(FitEmByBic, PrefersTwoComponentsForTwoClusters) {
+  std::mt19937_64 rng(2);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  Eigen::MatrixXd Y(200, 2);
+  for (int i = 0; i < 200; ++i) {
+    const double shift = i < 100 ? -6.0 : 6.0;
+    Y(i, 0) = shift + normal(rng);
+    Y(i, 1) = normal(rng);
+  }
+  EmOptions em{.components = 1, .n_init = 2};
+  int k = 0;
+  const Mixture two = FitEmByBic(Y, em, 4, &k);
+  EXPECT_EQ(k, 2);
+  EXPECT_EQ(two.size(), 2);
+  const Mixture one = FitEmByBic(Y.topRows(100), em, 4, &k);
+  EXPECT_EQ(k, 1);
+  // Never more free parameters than samples: K = 2 in 2-D has 11, so 10 points give K = 1.
+  FitEmByBic(Y.middleRows(95, 10), em, 4, &k);
+  EXPECT_EQ(k, 1);
+}
+
+}  // namespace
+}  // namespace dgmm

@@ -1,0 +1,100 @@
+#include "tune/tune_k.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "tests/tune/synthetic.h"
+#include "util/error.h"
+
+namespace dgmm {
+namespace {
+
+// Relative slack for comparing k values produced by a sigmoid-bounded line search.
+constexpr double kBoundSlack = 1e-9;
+
+TEST(FitAndMaximise, RecoversTheVertexOfAQuadratic) {
+  // L(u) = -3 (u - log 0.2)^2 + 10 sampled on a log grid: the maximiser is k = 0.2 exactly.
+  std::vector<TuneKPoint> points;
+  for (double u = std::log(0.05); u <= std::log(0.8) + 1e-9; u += 0.25) {
+    const double d = u - std::log(0.2);
+    points.push_back({std::exp(u), 10 - 3 * d * d, 0, 1, "grid"});
+  }
+  TuneKSummary summary;
+  FitAndMaximise(points, 0.1, 0.4, 1.0, &summary);
+  EXPECT_NEAR(std::log(summary.k), std::log(0.2), 1e-4);
+  EXPECT_NEAR(summary.c, -3.0, 1e-4);
+  EXPECT_NEAR(summary.Smoothed(0.2), 10.0, 1e-4);
+}
+
+TEST(FitAndMaximise, StaysInTheBracketWhenTheVertexIsOutside) {
+  std::vector<TuneKPoint> points;
+  for (double u = -3; u <= 0; u += 0.5) points.push_back({std::exp(u), u - 0.1 * u * u, 0, 1, ""});
+  TuneKSummary summary;
+  FitAndMaximise(points, std::exp(-1.0), std::exp(0.0), 1.0, &summary);  // vertex at u = 5
+  EXPECT_LE(summary.k, 1.0 * (1 + kBoundSlack));
+  EXPECT_GT(summary.k, std::exp(-0.05));  // pushed against the upper end
+}
+
+TEST(FitAndMaximise, RobustToOneStep) {
+  // A piecewise-constant curve with one outlying step: the Cauchy loss keeps the fit's maximum
+  // near the bulk's vertex (k = 1).
+  std::vector<TuneKPoint> points;
+  for (double u = -2; u <= 2 + 1e-9; u += 0.25) {
+    double value = -std::round(4 * u * u) / 4;  // steps of 0.25
+    if (std::abs(u - 0.5) < 1e-9) value -= 30;  // one bad evaluation
+    points.push_back({std::exp(u), value, 0, 0.25, ""});
+  }
+  TuneKSummary summary;
+  FitAndMaximise(points, std::exp(-0.5), std::exp(0.5), 0.25, &summary);
+  EXPECT_NEAR(std::log(summary.k), 0.0, 0.15);
+}
+
+TEST(TuneK, ChosenKInBracketAndSmoothedMaximumBeatsGridNeighbours) {
+  const SampleSet set = test::MakeTerrainSet(3, 30, 1.0, 9);
+  TuneKOptions options;
+  options.cv.folds = 5;
+  options.cv.repeats = 2;
+  options.k_min = 1e-2;
+  options.k_max = 10;
+  options.grid_points = 6;
+  options.refine_points = 2;
+  const TuneKSummary summary = TuneK(set, options);
+  EXPECT_GE(summary.k, summary.bracket_lo * (1 - kBoundSlack));
+  EXPECT_LE(summary.k, summary.bracket_hi * (1 + kBoundSlack));
+  EXPECT_LT(summary.c, 0);
+  EXPECT_EQ(static_cast<int>(summary.curve.size()), 6 + 2 + 1);
+  // The smoothed objective at k is at least its value at the grid points of the bracket.
+  for (const auto& p : summary.curve) {
+    if (p.role == "grid" && p.k >= summary.bracket_lo * (1 - kBoundSlack) &&
+        p.k <= summary.bracket_hi * (1 + kBoundSlack)) {
+      EXPECT_GE(summary.Smoothed(summary.k), summary.Smoothed(p.k) - 1e-9) << "k " << p.k;
+    }
+  }
+  EXPECT_TRUE(std::isfinite(summary.log_likelihood));
+  EXPECT_GT(summary.standard_error, 0);
+  // Common random numbers: the chosen k's score is reproducible.
+  const TuneKSummary again = TuneK(set, options);
+  EXPECT_EQ(again.k, summary.k);
+  EXPECT_EQ(again.log_likelihood, summary.log_likelihood);
+}
+
+TEST(TuneK, RejectsBadOptions) {
+  const SampleSet set = test::MakeTerrainSet(2, 10, 1.0, 5);
+  TuneKOptions options;
+  options.k_min = 0;
+  EXPECT_THROW(TuneK(set, options), InputError);
+  options = TuneKOptions();
+  options.k_max = options.k_min / 2;
+  EXPECT_THROW(TuneK(set, options), InputError);
+  options = TuneKOptions();
+  options.cv.folds = 1;
+  EXPECT_THROW(TuneK(set, options), InputError);
+  options = TuneKOptions();
+  options.grid_points = 2;
+  EXPECT_THROW(TuneK(set, options), InputError);
+  EXPECT_THROW(TuneK(set.Subset({}), TuneKOptions()), InputError);
+}
+
+}  // namespace
+}  // namespace dgmm
