@@ -34,16 +34,16 @@ echo "EM score:   $("$dgmm" score "$out/old_faithful_em.h5" "$out/old_faithful.h
 
 step "Simulated robot: paper protocol on the 18 degree slope (390 samples)"
 "$dgmm" simulate --protocol paper --seed 1 -o "$out/robot_390.h5"
-"$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_terrain.h5" --k 0.7 --seed 1
-"$dgmm" cv "$out/robot_390.h5" --k 0.7 --folds 10 --repeats 3 --seed 1
-"$dgmm" tune-k "$out/robot_390.h5" --folds 5 --repeats 2 --seed 1 \
-  --curve-csv "$out/tune_k_curve.csv"
-"${render[@]}" "$dgmm" plot --csv "$out/tune_k_curve.csv" --x k --y log_likelihood \
-  --kind line -o "$out/tune_k_curve.png" 2>/dev/null \
-  || echo "(tune-k curve chart skipped: see $out/tune_k_curve.csv)"
+"${render[@]}" "$dgmm" tune-k "$out/robot_390.h5" --folds 5 --repeats 2 --seed 1 \
+  --curve-csv "$out/tune_k_curve.csv" --plot "$out/tune_k_curve.png" --json > "$out/tune_k.json"
+k=$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["k"])' "$out/tune_k.json")
+echo "tune-k chose k = $k (curve: $out/tune_k_curve.png)"
+"$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_terrain.h5" --k "$k" --seed 1
+"$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_no_terrain.h5" --k "$k" --seed 1 --without-terrain
+"$dgmm" cv "$out/robot_390.h5" --k "$k" --folds 10 --repeats 3 --seed 1
 for pitch in -0.3 0.3; do
   "${render[@]}" "$dgmm" render "$out/robot_dgmm_terrain.h5" --command +0.5,0,0 \
-    --x-dim dx --y-dim dy --condition pitch=$pitch --condition roll=0 \
+    --x-dim dx --y-dim dy --condition pitch=$pitch --condition roll=0 --marginalise \
     -o "$out/robot_density_forward_pitch_${pitch}.png"
 done
 "${render[@]}" "$dgmm" sim-pictures -o "$out"

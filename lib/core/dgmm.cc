@@ -112,8 +112,8 @@ AddSampleResult Dgmm::AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std:
   return AddSampleFaithful(x, rng);
 }
 
-AddSampleResult Dgmm::AddSampleFaithful(const Eigen::Ref<const Eigen::VectorXd>& x,
-                                        std::mt19937_64& rng) {
+AddSampleResult Dgmm::DecideMerge(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                  std::mt19937_64& rng) {
   AddSampleResult result;
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double r = uniform(rng);
@@ -151,6 +151,12 @@ AddSampleResult Dgmm::AddSampleFaithful(const Eigen::Ref<const Eigen::VectorXd>&
     }
     result.merged = r < result.threshold;
   }
+  return result;
+}
+
+AddSampleResult Dgmm::AddSampleFaithful(const Eigen::Ref<const Eigen::VectorXd>& x,
+                                        std::mt19937_64& rng) {
+  AddSampleResult result = DecideMerge(x, rng);
   if (result.merged) {
     result.component = ChooseComponent(x, rng);
     MergeInto(result.component, x);

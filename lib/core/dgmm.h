@@ -76,6 +76,9 @@ class Dgmm {
   // Algorithm 2 as written (options_.variant == kFaithful).
   AddSampleResult AddSampleFaithful(const Eigen::Ref<const Eigen::VectorXd>& x,
                                     std::mt19937_64& rng);
+  // Algorithm 2's decision, shared by both variants: draws r ~ U(0,1) and sets threshold t,
+  // merged = r < t and density_evaluated (component is left at -1).
+  AddSampleResult DecideMerge(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng);
   // The improved variant (lib/core/dgmm_improved.cc).
   AddSampleResult AddSampleImproved(const Eigen::Ref<const Eigen::VectorXd>& x,
                                     std::mt19937_64& rng);

@@ -33,23 +33,8 @@ constexpr double kPriorSamples = 1.0;
 
 AddSampleResult Dgmm::AddSampleImproved(const Eigen::Ref<const Eigen::VectorXd>& x,
                                         std::mt19937_64& rng) {
-  AddSampleResult result;
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const double r = uniform(rng);
-  const double decay = std::exp(-options_.k * static_cast<double>(num_samples_));
-  if (mixture_.empty()) {
-    result.threshold = 0.0;
-    result.density_evaluated = true;
-  } else {
-    // As in Algorithm 2 (and AddSampleFaithful): d is only needed when r >= 1 - exp(-k n).
-    result.threshold = 1.0 - decay;
-    if (!(r < result.threshold)) {
-      const double d = std::clamp(std::exp(mixture_.LogDensity(x) - MaxLogDensity()), 0.0, 1.0);
-      result.threshold = 1.0 - (1.0 - d) * decay;
-      result.density_evaluated = true;
-    }
-    result.merged = r < result.threshold;
-  }
+  // The decision to merge or start a Gaussian is Algorithm 2's (unchanged).
+  AddSampleResult result = DecideMerge(x, rng);
   if (!result.merged) {
     result.component = StartComponent(x);
     ++num_samples_;

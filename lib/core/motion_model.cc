@@ -124,9 +124,8 @@ MotionModel MotionModelLearner::Finish() const {
   return model;
 }
 
-MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options) {
-  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
-  const bool terrain = options.with_terrain && set.terrain_dim() > 0;
+MotionModel ModelHeaderFor(const SampleSet& set, bool with_terrain) {
+  const bool terrain = with_terrain && set.terrain_dim() > 0;
   MotionModel header;
   header.pose_dim = set.pose_dim();
   header.terrain_dim = terrain ? set.terrain_dim() : 0;
@@ -142,7 +141,13 @@ MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& opt
   }
   header.transform = set.transform;
   if (!set.source.empty()) header.metadata["training_source"] = set.source;
-  MotionModelLearner learner(std::move(header), options);
+  return header;
+}
+
+MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options) {
+  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
+  const bool terrain = options.with_terrain && set.terrain_dim() > 0;
+  MotionModelLearner learner(ModelHeaderFor(set, options.with_terrain), options);
   Eigen::VectorXd y(learner.Finish().dim());
   for (int i = 0; i < set.size(); ++i) {
     y.head(set.pose_dim()) = set.x.row(i).transpose();

@@ -66,6 +66,10 @@ class MotionModelLearner {
   std::map<int, Dgmm> learners_;
 };
 
+// A model with no mixtures yet, carrying the set's dims, names, command table, transform and
+// source: y = x || z when with_terrain and the set has terrain, else x alone.
+MotionModel ModelHeaderFor(const SampleSet& set, bool with_terrain);
+
 // Streams the samples in set order through one Dgmm per command (a command with no samples has
 // no model). The rng is seeded once from options.seed, so same seed, same model.
 MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options);

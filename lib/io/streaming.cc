@@ -5,26 +5,6 @@
 
 namespace dgmm {
 
-MotionModel ModelHeaderFor(const SampleSet& set, bool with_terrain) {
-  const bool terrain = with_terrain && set.terrain_dim() > 0;
-  MotionModel header;
-  header.pose_dim = set.pose_dim();
-  header.terrain_dim = terrain ? set.terrain_dim() : 0;
-  header.pose_names = set.x_names;
-  header.pose_units = set.x_units;
-  if (terrain) header.terrain_names = set.z_names;
-  header.command_dim_names = set.command_dim_names;
-  for (int c = 0; c < set.num_commands(); ++c) {
-    header.command_values[c] = set.commands.row(c).transpose();
-    if (c < static_cast<int>(set.command_labels.size())) {
-      header.command_labels[c] = set.command_labels[c];
-    }
-  }
-  header.transform = set.transform;
-  if (!set.source.empty()) header.metadata["training_source"] = set.source;
-  return header;
-}
-
 MotionModel LearnMotionModelFromFile(const std::string& path, const MotionModelOptions& options,
                                      int chunk_rows, const StreamProgress& progress) {
   SampleSetReader reader(path, chunk_rows);

@@ -12,10 +12,6 @@ namespace dgmm {
 // Called after each chunk with samples done and the total.
 using StreamProgress = std::function<void(long long done, long long total)>;
 
-// The model header (dims, names, command table, transform, source) that LearnMotionModel
-// builds for a set with these tables; terrain is used when with_terrain and the set has it.
-MotionModel ModelHeaderFor(const SampleSet& header, bool with_terrain);
-
 // Same model as LearnMotionModel(ReadSampleSet(path), options), streaming the samples through
 // a MotionModelLearner. Throws InputError naming the file.
 MotionModel LearnMotionModelFromFile(const std::string& path, const MotionModelOptions& options,

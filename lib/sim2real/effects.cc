@@ -1,5 +1,6 @@
 #include "sim2real/effects.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -31,22 +32,37 @@ std::vector<EffectSpec> EffectLibrary(const PoseLayout& layout, int pose_dim, bo
        {{"gain", "fraction of displacement gained per unit of downhill alignment"}}, true, false,
        false},
       {EffectId::kPayloadOffset, "payload_offset", "Centre-of-mass / payload offset",
-       "an off-centre mass: load shifts between the legs, so the robot drifts and turns in a way "
-       "that depends on the direction of gravity",
+       "an off-centre mass: load shifts between the legs, so the robot drifts (and turns) in a way "
+       "that depends on the direction of gravity, and the extra load shortens its strides",
        {{"drift_x", "m per execution"}, {"drift_y", "m per execution (positive: to the left)"},
-        {"drift_x_per_gx", "m per unit gravity along body x"},
+        {"load_shift_xx", "m per unit gravity: +along x for g_x, -along y for g_y (traceless)"},
         {"drift_x_per_gy", "m per unit gravity along body y"},
         {"drift_y_per_gx", "m per unit gravity along body x"},
-        {"drift_y_per_gy", "m per unit gravity along body y"},
         {"yaw_per_gx", "rad per unit gravity along body x"},
-        {"yaw_per_gy", "rad per unit gravity along body y"}},
+        {"yaw_per_gy", "rad per unit gravity along body y"},
+        {"load_loss_x", "fraction of the simulated forward displacement lost under the load"},
+        {"load_loss_y", "fraction of the simulated lateral displacement lost under the load"},
+        {"load_loss_yaw", "fraction of the simulated turn lost under the load"}},
        true, false, false},
       {EffectId::kActuatorAsymmetry, "actuator_asymmetry", "Actuator asymmetry",
-       "one side or leg weaker than simulated: the robot turns as it walks (the other way when it "
-       "walks backwards), more so when the weak side carries more load",
+       "one side or leg weaker than simulated: the robot turns and drifts as it walks, differently "
+       "for each direction of each commanded motion (a weak leg pushes less in one direction than "
+       "in the other), more so when the weak side carries more load",
        {{"yaw_per_execution", "rad per execution (positive: to the left)"},
-        {"yaw_per_metre_forward", "rad per metre of forward displacement"},
-        {"yaw_per_metre_left", "rad per metre of leftward displacement"},
+        {"drift_x", "m per execution"},
+        {"drift_y", "m per execution (positive: to the left)"},
+        {"dy_per_m_forward", "m per metre of simulated forward displacement"},
+        {"dy_per_m_backward", "m per metre of simulated backward displacement"},
+        {"dy_per_m_left", "m per metre of simulated leftward displacement"},
+        {"dy_per_m_right", "m per metre of simulated rightward displacement"},
+        {"dy_per_rad_left_turn", "m per rad of simulated left turn"},
+        {"dy_per_rad_right_turn", "m per rad of simulated right turn"},
+        {"yaw_per_m_forward", "rad per metre of simulated forward displacement"},
+        {"yaw_per_m_backward", "rad per metre of simulated backward displacement"},
+        {"yaw_per_m_left", "rad per metre of simulated leftward displacement"},
+        {"yaw_per_m_right", "rad per metre of simulated rightward displacement"},
+        {"yaw_per_rad_left_turn", "rad per rad of simulated left turn"},
+        {"yaw_per_rad_right_turn", "rad per rad of simulated right turn"},
         {"yaw_per_gx", "rad per unit gravity along body x"},
         {"yaw_per_gy", "rad per unit gravity along body y"}},
        false, false, false},
@@ -67,7 +83,7 @@ std::vector<EffectSpec> EffectLibrary(const PoseLayout& layout, int pose_dim, bo
        {{"log_spread_ratio", "log of real / simulated standard deviation"}}, false, false, true},
   };
   for (auto& e : all) {
-    if (e.id == EffectId::kActuatorAsymmetry && !has_terrain) e.parameters.resize(3);
+    if (e.id == EffectId::kActuatorAsymmetry && !has_terrain) e.parameters.resize(15);
     if (e.id == EffectId::kBias) {
       for (int j = 0; j < pose_dim; ++j) e.parameters.push_back({"offset_" + std::to_string(j), "x units"});
     }
@@ -122,22 +138,39 @@ Eigen::MatrixXd EffectDesign(const EffectSpec& effect, const PoseLayout& layout,
     case EffectId::kPayloadOffset:
       d(layout.dx, 0) = 1.0;
       d(layout.dy, 1) = 1.0;
+      // Coulomb friction: the downhill pull and the friction limit both scale with the total
+      // mass, so an added mass creates no isotropic downhill creep (that is slope_slip); the
+      // load shift moves the drift anisotropically: a traceless 2x2 map of (g_x, g_y).
       d(layout.dx, 2) = g(0);
+      d(layout.dy, 2) = -g(1);
       d(layout.dx, 3) = g(1);
       d(layout.dy, 4) = g(0);
-      d(layout.dy, 5) = g(1);
-      d(layout.dyaw, 6) = g(0);
-      d(layout.dyaw, 7) = g(1);
+      d(layout.dyaw, 5) = g(0);
+      d(layout.dyaw, 6) = g(1);
+      d(layout.dx, 7) = -u(layout.dx);
+      d(layout.dy, 8) = -u(layout.dy);
+      d(layout.dyaw, 9) = -u(layout.dyaw);
       break;
-    case EffectId::kActuatorAsymmetry:
+    case EffectId::kActuatorAsymmetry: {
       d(layout.dyaw, 0) = 1.0;
-      d(layout.dyaw, 1) = u(layout.dx);
-      d(layout.dyaw, 2) = u(layout.dy);
-      if (effect.num_params() > 3) {
-        d(layout.dyaw, 3) = g(0);
-        d(layout.dyaw, 4) = g(1);
+      d(layout.dx, 1) = 1.0;
+      d(layout.dy, 2) = 1.0;
+      // Per output (dy, dyaw) and per commanded component (forward, lateral, turn as simulated),
+      // one coefficient for each direction: (u)+ and (u)-.
+      const int out[2] = {layout.dy, layout.dyaw};
+      const double in[3] = {u(layout.dx), u(layout.dy), u(layout.dyaw)};
+      for (int o = 0; o < 2; ++o) {
+        for (int k = 0; k < 3; ++k) {
+          d(out[o], 3 + 6 * o + 2 * k) = std::max(in[k], 0.0);
+          d(out[o], 4 + 6 * o + 2 * k) = std::max(-in[k], 0.0);
+        }
+      }
+      if (effect.num_params() > 15) {
+        d(layout.dyaw, 15) = g(0);
+        d(layout.dyaw, 16) = g(1);
       }
       break;
+    }
     case EffectId::kLatency:
       if (first) add_motion(0, -1.0);
       break;
@@ -173,18 +206,30 @@ std::string DescribeEffect(const EffectSpec& e, const Eigen::VectorXd& t, double
              (t(0) >= 0 ? "more" : "less") +
              " ground than simulated and walking uphill correspondingly less (more).";
     case EffectId::kPayloadOffset: {
-      const double gravity_drift = s * std::max(std::hypot(t(2), t(4)), std::hypot(t(3), t(5)));
+      const double gravity_drift = s * std::max(std::hypot(t(2), t(4)), std::hypot(t(3), t(2)));
       return Format("The centre of mass is off-centre: the robot drifts %.1f mm forward and %.1f mm "
                     "to the left per execution", 1000 * t(0), 1000 * t(1)) +
              Format(", plus up to %.1f mm and %.1f mrad of yaw depending on the direction of gravity "
-                    "on the observed slope.", 1000 * gravity_drift, 1000 * s * std::hypot(t(6), t(7)));
+                    "on the observed slope", 1000 * gravity_drift, 1000 * s * std::hypot(t(5), t(6))) +
+             Format("; the load changes forward, lateral and turning motion by %.0f%%, %.0f%% and "
+                    "%.0f%%.", -100 * t(7), -100 * t(8), -100 * t(9));
     }
     case EffectId::kActuatorAsymmetry: {
-      const double load = e.num_params() > 3 ? s * std::hypot(t(3), t(4)) : 0.0;
+      const double load = e.num_params() > 15 ? s * std::hypot(t(15), t(16)) : 0.0;
+      // The largest direction-dependent term, as a sentence.
+      static const char* kDir[6] = {"forward", "backward", "to the left", "to the right",
+                                    "turning left", "turning right"};
+      static const char* kOut[2] = {"mm to the left", "mrad of turn"};
+      int best = 3;
+      for (int q = 3; q < 15; ++q) if (std::abs(t(q)) > std::abs(t(best))) best = q;
+      const int o = (best - 3) / 6, k = (best - 3) % 6;
+      const double typical = k < 4 ? 0.1 : 0.15;  // a typical commanded motion: 10 cm or 0.15 rad
       return Format("One side is weaker than simulated: the robot turns %.1f mrad per execution "
-                    "(positive: to the left), %.1f mrad per metre walked forward", 1000 * t(0), 1000 * t(1)) +
-             Format(" and %.1f mrad per metre walked to the left, up to %.1f mrad more depending on "
-                    "which side is loaded on the observed slope.", 1000 * t(2), 1000 * load);
+                    "(positive: to the left), up to %.1f mrad more depending on which side is loaded "
+                    "on the observed slope, and drifts %.1f mm forward", 1000 * t(0), 1000 * load, 1000 * t(1)) +
+             Format(" and %.1f mm to the left per execution", 1000 * t(2)) +
+             Format("; the largest direction-dependent term: %+.1f ", 1000 * t(best) * typical) +
+             kOut[o] + " per " + (k < 4 ? "10 cm walked " : "0.15 rad ") + kDir[k] + ".";
     }
     case EffectId::kLatency:
       return Format("The first execution after a change of command loses %.0f%% of its motion "

@@ -17,8 +17,8 @@ enum class EffectId {
   kSlopeSlip,         // downhill creep along gravity's horizontal component in the body frame
   kStrideLoss,        // planar displacement and turn scaled down uniformly
   kSlopeTraction,     // scaling that differs uphill and downhill
-  kPayloadOffset,     // yaw from the torque of an off-centre mass under gravity
-  kActuatorAsymmetry, // one side weaker: yaw and lateral drift per metre travelled
+  kPayloadOffset,     // off-centre mass: drift/yaw linear in gravity, load-shortened strides
+  kActuatorAsymmetry, // weak side: drift/yaw per direction of each commanded component
   kLatency,           // motion lost at the first execution after a command change (backlash)
   kCompliance,        // sinking (dz) and damped attitude changes on soft ground
   kBias,              // constant offset of every pose dimension (tracker, calibration)

@@ -87,9 +87,24 @@ TEST(Sim2RealApp, WeakLegPairIsFoundAndReportedUnexplained) {
   EXPECT_FALSE(j["unexplained"].empty());
 }
 
-// UNMET requirements of issue 5, kept visible: the planted effect ranked first with its
-// parameter within 30% and >= 70% of the gap closed on the payload and weak-leg pairs.
-TEST(Sim2RealApp, DISABLED_PayloadPairRanksPayloadFirst) {
+// The payload pair: the payload effect (drift, a traceless load shift under gravity, strides
+// shortened by the load) is ranked first, its lateral drift within 30% of the planted value (the
+// same analysis on the oracle recording).
+TEST(Sim2RealApp, PayloadPairRanksPayloadFirstWithPlantedDrift) {
+  json j = RunSim2Real("datasets/sim2real/payload/real.h5", "payload-first");
+  json oracle = RunSim2Real("datasets/sim2real/payload/oracle.h5", "payload-oracle");
+  ASSERT_FALSE(j["effects"].empty());
+  ASSERT_FALSE(oracle["effects"].empty());
+  EXPECT_EQ(j["effects"][0]["effect"], "payload_offset");
+  ASSERT_EQ(oracle["effects"][0]["effect"], "payload_offset");
+  const double planted = Parameter(oracle["effects"][0], "drift_y");
+  EXPECT_NEAR(Parameter(j["effects"][0], "drift_y"), planted, kParameterTolerance * std::abs(planted));
+  EXPECT_GT(j["gap_closed"].get<double>(), 0.0);
+}
+
+// UNMET requirements of issue 5, kept visible: >= 70% of the gap closed on the payload pair
+// (about 56% today); the weak leg ranked first with >= 70% closed.
+TEST(Sim2RealApp, DISABLED_PayloadPairClosesSeventyPercentOfTheGap) {
   json j = RunSim2Real("datasets/sim2real/payload/real.h5", "payload-strict");
   ASSERT_FALSE(j["effects"].empty());
   EXPECT_EQ(j["effects"][0]["effect"], "payload_offset");
