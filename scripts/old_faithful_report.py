@@ -174,13 +174,9 @@ def section(work, seconds):
       f"{g(f['mean'])} ± {g(f['sd'])} for the paper's algorithm and 0.0358 reported; impurity "
       f"{100 * im['mean_impurity']:.1f} %. Mixture weights are still sample counts (eq. 3).")
     w("")
-    w("Ablation measured while designing the variant (same protocol, 100 runs with 2 Gaussians, "
-      "standardised; development switches that are not in the code, so these numbers are not "
-      "regenerated): most-likely component alone (with weight, plain counts) 0.100 ± 0.079; "
-      "most-likely without weight + recency weighting, paper's prior 0.074 ± 0.074; + S0 as one "
-      "pseudo-sample but plain counts 0.0096 ± 0.0146; all three but choosing by w_i N_i(x) "
-      "0.0325 ± 0.066; all three (the variant) 0.0034 ± 0.0038. Each change matters; the prior "
-      "matters most.")
+    w("While designing the variant we tried each of the three changes alone with temporary "
+      "switches that are not in the code; each helped and the prior helped most, but those "
+      "ablation figures are not reproduced here because no script can rerun them.")
     print("\n".join(out))
 
 
