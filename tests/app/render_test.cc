@@ -41,7 +41,8 @@ std::string WithoutXvfbRunLines(const std::string& err) {
 RunResult RunUnderXvfb(const std::vector<std::string>& args, const fs::path& dir) {
   const char* exe = std::getenv("DGMM_EXE");
   std::string binary = exe ? exe : std::string(DGMM_BINARY_DIR) + "/app/dgmm";
-  std::string command = "xvfb-run -a -s '-screen 0 1280x1024x24' " + binary;
+  // scripts/with-display.sh: $DISPLAY when set (scripts/test.sh starts one), else xvfb-run -a.
+  std::string command = std::string(DGMM_SOURCE_DIR) + "/scripts/with-display.sh " + binary;
   for (const auto& a : args) command += " '" + a + "'";
   command += " >" + (dir / "out").string() + " 2>" + (dir / "err").string();
   RunResult r;

@@ -106,7 +106,9 @@ TEST(SimulateAppTest, PicturesUnderXvfb) {
   const char* exe = std::getenv("DGMM_EXE");
   ASSERT_NE(exe, nullptr);
   const fs::path dir = MakeTempDir("sim_pictures_xvfb");
-  const std::string command = std::string("xvfb-run -a ") + exe + " sim-pictures --executions 1 -o " +
+  // scripts/with-display.sh: $DISPLAY when set (scripts/test.sh starts one), else xvfb-run -a.
+  const std::string command = std::string(DGMM_SOURCE_DIR) + "/scripts/with-display.sh " + exe +
+                              " sim-pictures --executions 1 -o " +
                               dir.string() + " > /dev/null 2>&1";
   int status = std::system(command.c_str());
   if (status != 0) status = std::system(command.c_str());  // Xvfb start-up is occasionally flaky
