@@ -2,32 +2,176 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
+#include <random>
+#include <vector>
+
+#include "sim2real/locate.h"
+#include "util/error.h"
 
 namespace dgmm::sim2real {
 namespace {
 
-// Corrected mean at terrain z for command c, first executions weighted by `first` in [0, 1].
-Eigen::VectorXd CorrectedMean(const Sim2RealResult& r, int c, const Eigen::VectorXd& z,
-                              int pitch_col, int roll_col, bool with_effects, double first) {
-  Prediction p = r.sim_model.Predict(c, z, first);
-  if (!with_effects) return p.mean;
-  const double pitch = pitch_col >= 0 ? z(pitch_col) : 0.0, roll = roll_col >= 0 ? z(roll_col) : 0.0;
-  Eigen::Vector3d g(std::sin(pitch), -std::sin(roll) * std::cos(pitch), -std::cos(roll) * std::cos(pitch));
-  Eigen::VectorXd mean = p.mean;
-  for (size_t k = 0; k < r.fit.effects.size(); ++k) {
-    const EffectSpec& e = r.library[r.fit.effects[k]];
-    if (e.is_noise) continue;
-    const Eigen::VectorXd u_first = r.sim_model.Predict(c, z, 1.0).mean;
-    const Eigen::VectorXd u_repeat = r.sim_model.Predict(c, z, 0.0).mean;
-    Eigen::VectorXd shift_first = EffectDesign(e, r.layout, u_first, g, true) * r.fit.theta[k];
-    Eigen::VectorXd shift_repeat = EffectDesign(e, r.layout, u_repeat, g, false) * r.fit.theta[k];
-    mean += first * shift_first + (1 - first) * shift_repeat;
+// The analysis' prediction of x for command c at terrain z with a known first-execution flag.
+class Predictor {
+ public:
+  Predictor(const Sim2RealResult& r, const SampleSet& sim, bool corrected)
+      : r_(r), corrected_(corrected) {
+    DetectTerrainColumns(sim, &pitch_col_, &roll_col_);
+    tau2_ = corrected ? std::exp(2 * r.fit.log_tau) : 1.0;
   }
-  return mean;
+
+  // E[x | c, z, f] = u + sum_e D_e(u, g(z), f) theta_e (effects only when corrected).
+  Eigen::VectorXd Mean(int c, const Eigen::VectorXd& z, bool first) const {
+    const Prediction p = r_.sim_model.Predict(c, z, first ? 1.0 : 0.0);
+    if (!corrected_) return p.mean;
+    const double pitch = pitch_col_ >= 0 ? z(pitch_col_) : 0.0;
+    const double roll = roll_col_ >= 0 ? z(roll_col_) : 0.0;
+    const Eigen::Vector3d g(std::sin(pitch), -std::sin(roll) * std::cos(pitch),
+                            -std::cos(roll) * std::cos(pitch));
+    Eigen::VectorXd mean = p.mean;
+    for (size_t k = 0; k < r_.fit.effects.size(); ++k) {
+      const EffectSpec& e = r_.library[r_.fit.effects[k]];
+      if (!e.is_noise) mean += EffectDesign(e, r_.layout, p.mean, g, first) * r_.fit.theta[k];
+    }
+    return mean;
+  }
+
+  // tau^2 Sigma_c(z, f): the predictive covariance (with its inflation at z).
+  Eigen::MatrixXd Covariance(int c, const Eigen::VectorXd& z, bool first) const {
+    const Prediction p = r_.sim_model.Predict(c, z, first ? 1.0 : 0.0);
+    return tau2_ * p.chol * p.chol.transpose();
+  }
+
+  // Whether the prediction depends on the first-execution flag at all.
+  bool UsesSequence() const {
+    if (r_.sim_model.uses_sequence()) return true;
+    if (!corrected_) return false;
+    for (int e : r_.fit.effects) {
+      if (r_.library[e].needs_sequence) return true;
+    }
+    return false;
+  }
+
+ private:
+  const Sim2RealResult& r_;
+  bool corrected_;
+  int pitch_col_ = -1, roll_col_ = -1;
+  double tau2_ = 1.0;
+};
+
+// One piece of the sim terrain: its samples (rows of z), mean and covariance.
+struct Piece {
+  std::vector<int> members;
+  Eigen::VectorXd mean;
+  Eigen::MatrixXd cov;
+};
+
+// k-means pieces of the rows of z (n x dz), clustered on z scaled to unit variance per column.
+// Each piece's covariance gets one pseudo-observation of the pooled covariance / k, so that a
+// piece whose samples are (nearly) collinear keeps a proper density.
+std::vector<Piece> TerrainPieces(const Eigen::MatrixXd& z, const CorrectedModelOptions& options) {
+  const int n = static_cast<int>(z.rows()), dz = static_cast<int>(z.cols());
+  if (dz == 0 || n == 0) return {Piece{{}, Eigen::VectorXd::Zero(dz), Eigen::MatrixXd::Zero(dz, dz)}};
+  const Eigen::RowVectorXd mean = z.colwise().mean();
+  const Eigen::MatrixXd centred = z.rowwise() - mean;
+  const Eigen::MatrixXd pooled = centred.transpose() * centred / std::max(1, n - 1);
+  const Eigen::VectorXd sd = pooled.diagonal().cwiseMax(1e-12).cwiseSqrt();
+  const Eigen::MatrixXd scaled = centred * sd.cwiseInverse().asDiagonal();
+  const int k = std::clamp(n / std::max(1, options.samples_per_piece), 1, std::max(1, options.max_pieces));
+  std::mt19937_64 rng(options.seed);
+  const Eigen::MatrixXd centres = TerrainClusters(scaled, k, rng);
+  const std::vector<int> label = NearestCentre(scaled, centres);
+  std::vector<Piece> pieces(centres.rows());
+  for (int i = 0; i < n; ++i) pieces[label[i]].members.push_back(i);
+  const Eigen::MatrixXd prior = pooled / centres.rows() +
+                                1e-12 * Eigen::MatrixXd::Identity(dz, dz);
+  std::vector<Piece> out;
+  for (Piece& p : pieces) {
+    if (p.members.empty()) continue;
+    Eigen::MatrixXd zp(p.members.size(), dz);
+    for (size_t j = 0; j < p.members.size(); ++j) zp.row(j) = z.row(p.members[j]);
+    p.mean = zp.colwise().mean().transpose();
+    const Eigen::MatrixXd zc = zp.rowwise() - p.mean.transpose();
+    p.cov = (zc.transpose() * zc + prior) / static_cast<double>(p.members.size());
+    out.push_back(std::move(p));
+  }
+  return out;
 }
 
-MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected) {
+// The joint Gaussian over y = x || z with z ~ N(m, S) and x | z ~ N(a + B (z - m), Sigma).
+std::optional<Gaussian> JointGaussian(const Eigen::VectorXd& a, const Eigen::MatrixXd& b,
+                                      const Eigen::MatrixXd& sigma, const Eigen::VectorXd& m,
+                                      const Eigen::MatrixXd& s) {
+  const int dx = static_cast<int>(a.size()), dz = static_cast<int>(m.size());
+  Eigen::VectorXd mean(dx + dz);
+  mean << a, m;
+  Eigen::MatrixXd cov(dx + dz, dx + dz);
+  cov.topLeftCorner(dx, dx) = sigma + b * s * b.transpose();
+  if (dz > 0) {
+    cov.topRightCorner(dx, dz) = b * s;
+    cov.bottomLeftCorner(dz, dx) = s * b.transpose();
+    cov.bottomRightCorner(dz, dz) = s;
+  }
+  cov = 0.5 * (cov + cov.transpose());
+  auto g = Gaussian::Create(mean, cov);
+  for (int attempt = 0; !g && attempt < 6; ++attempt) {
+    cov.diagonal().array() += std::pow(10.0, attempt - 9) * (1.0 + cov.diagonal().array().abs());
+    g = Gaussian::Create(mean, cov);
+  }
+  return g;
+}
+
+// Local fit of the prediction over one piece for command c and flag `first`: intercept a (at the
+// piece mean), slope B (dx x dz) by ridge-stabilised least squares over the piece's samples, and
+// Sigma = mean predictive covariance + residual scatter of the linear fit.
+struct LocalFit {
+  Eigen::VectorXd a;
+  Eigen::MatrixXd b, sigma;
+};
+LocalFit FitPiece(const Predictor& predictor, int c, const Piece& piece, const Eigen::MatrixXd& z,
+                  bool first, int max_points) {
+  const int dz = static_cast<int>(piece.mean.size());
+  std::vector<Eigen::VectorXd> points;
+  // Large sets: an evenly strided subset of the piece's samples is enough for a linear fit.
+  const size_t stride = std::max<size_t>(1, (piece.members.size() + max_points - 1) / max_points);
+  for (size_t j = 0; j < piece.members.size(); j += stride) points.push_back(z.row(piece.members[j]).transpose());
+  if (points.empty()) points.push_back(piece.mean);
+  const int n = static_cast<int>(points.size());
+  std::vector<Eigen::VectorXd> ys;
+  Eigen::MatrixXd sigma;
+  for (const auto& p : points) {
+    ys.push_back(predictor.Mean(c, p, first));
+    const Eigen::MatrixXd s = predictor.Covariance(c, p, first);
+    sigma = sigma.size() ? Eigen::MatrixXd(sigma + s) : s;
+  }
+  sigma /= n;
+  const int dx = static_cast<int>(ys[0].size());
+  Eigen::MatrixXd y(n, dx), zc(n, dz);
+  for (int i = 0; i < n; ++i) {
+    y.row(i) = ys[i].transpose();
+    zc.row(i) = (points[i] - piece.mean).transpose();
+  }
+  LocalFit fit;
+  fit.a = y.colwise().mean().transpose();
+  const Eigen::MatrixXd yc = y.rowwise() - fit.a.transpose();
+  fit.b = Eigen::MatrixXd::Zero(dx, dz);
+  if (dz > 0 && n > 1) {
+    Eigen::MatrixXd gram = zc.transpose() * zc;
+    gram.diagonal().array() += 1e-8 * gram.trace() / dz + 1e-15;
+    fit.b = gram.ldlt().solve(zc.transpose() * yc).transpose();
+  }
+  const Eigen::MatrixXd resid = yc - zc * fit.b.transpose();
+  fit.sigma = sigma + resid.transpose() * resid / n;
+  return fit;
+}
+
+MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected,
+                  const CorrectedModelOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "corrected model options", error);
   MotionModel m;
   m.kind = corrected ? "corrected" : "sim2real-sim";
   m.pose_dim = sim.pose_dim();
@@ -37,88 +181,75 @@ MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected)
   m.terrain_names = sim.z_names;
   m.command_dim_names = sim.command_dim_names;
   m.transform = sim.transform;
-  int pitch_col, roll_col;
-  DetectTerrainColumns(sim, &pitch_col, &roll_col);
-  const int dx = m.pose_dim, dz = m.terrain_dim;
-  const double tau2 = corrected ? std::exp(2 * r.fit.log_tau) : 1.0;
-  const double share = r.sim_model.uses_sequence() || corrected ? r.first_execution_share : 0.0;
+  m.seed = options.seed;
+  const Predictor predictor(r, sim, corrected);
+  const bool sequence = predictor.UsesSequence();
+  const double share = std::clamp(r.first_execution_share, 0.0, 1.0);
+  // (flag, weight) of the execution kinds mixed in each piece.
+  std::vector<std::pair<bool, double>> kinds;
+  if (!sequence) {
+    kinds = {{false, 1.0}};
+  } else {
+    if (share > 0) kinds.push_back({true, share});
+    if (share < 1) kinds.push_back({false, 1 - share});
+  }
+  const Eigen::MatrixXd& z = sim.z;
+  const std::vector<Piece> pieces = TerrainPieces(z, options);
   nlohmann::json effects = nlohmann::json::array();
   if (corrected) {
     for (size_t k = 0; k < r.fit.effects.size(); ++k) {
       const EffectSpec& e = r.library[r.fit.effects[k]];
-      nlohmann::json j = {{"effect", e.key}, {"theta", std::vector<double>(r.fit.theta[k].data(),
-                                                 r.fit.theta[k].data() + r.fit.theta[k].size())}};
-      effects.push_back(j);
+      effects.push_back({{"effect", e.key},
+                         {"theta", std::vector<double>(r.fit.theta[k].data(),
+                                                       r.fit.theta[k].data() + r.fit.theta[k].size())}});
     }
   }
   m.metadata["sim2real_effects"] = effects.dump();
   m.metadata["sim2real_note"] =
-      "one joint Gaussian per command; effects projected linearly in z; sequence effects averaged "
-      "(first-execution share " + std::to_string(r.first_execution_share) + ")";
+      "per command " + std::to_string(pieces.size()) +
+      " terrain pieces (k-means of the sim terrain), each a local linear fit of the prediction in "
+      "z" + (sequence ? ", split into first executions and repeats mixed with the real "
+                        "first-execution share " + std::to_string(share)
+                      : std::string()) +
+      "; p(x | c, z) is piecewise linear in z, weighted by the terrain density of the pieces";
   for (int c : r.sim_model.Commands()) {
     if (c < sim.num_commands()) {
       m.command_values[c] = sim.commands.row(c).transpose();
       if (c < static_cast<int>(sim.command_labels.size())) m.command_labels[c] = sim.command_labels[c];
     }
-    const Eigen::VectorXd mz = r.sim_model.TerrainMean(c);
-    const Eigen::MatrixXd sz = r.sim_model.TerrainCovariance(c);
-    Prediction at_mean = r.sim_model.Predict(c, mz, r.first_execution_share);
-    Eigen::MatrixXd sigma = tau2 * at_mean.chol * at_mean.chol.transpose();
-    // Mixing first and repeated executions adds share (1 - share) d d^T, d = their mean difference.
-    const Eigen::VectorXd d = CorrectedMean(r, c, mz, pitch_col, roll_col, corrected, 1.0) -
-                              CorrectedMean(r, c, mz, pitch_col, roll_col, corrected, 0.0);
-    sigma += share * (1 - share) * d * d.transpose();
-    // Least-squares linear map z -> mean over points spread across the command's terrain.
-    Eigen::MatrixXd b = Eigen::MatrixXd::Zero(dx, dz);
-    Eigen::VectorXd mean_x = CorrectedMean(r, c, mz, pitch_col, roll_col, corrected, share);
-    if (dz > 0) {
-      Eigen::LLT<Eigen::MatrixXd> llt(sz);
-      Eigen::MatrixXd lz = llt.matrixL();
-      std::vector<Eigen::VectorXd> pts = {mz};
-      for (int j = 0; j < dz; ++j) {
-        for (double s : {-2.0, -1.0, 1.0, 2.0}) pts.push_back(mz + s * lz.col(j));
+    Mixture mix(m.dim());
+    for (const Piece& piece : pieces) {
+      double count = options.piece_pseudo_count;
+      for (int i : piece.members) count += sim.command(i) == c ? 1.0 : 0.0;
+      for (const auto& [first, kind_weight] : kinds) {
+        const LocalFit fit = FitPiece(predictor, c, piece, z, first, options.max_fit_points);
+        auto g = JointGaussian(fit.a, fit.b, fit.sigma, piece.mean, piece.cov);
+        if (g && count * kind_weight > 0) mix.Add(count * kind_weight, *g);
       }
-      Eigen::MatrixXd phi(pts.size(), dz + 1), y(pts.size(), dx);
-      for (size_t k = 0; k < pts.size(); ++k) {
-        phi(k, 0) = 1.0;
-        phi.row(k).tail(dz) = (pts[k] - mz).transpose();
-        y.row(k) = CorrectedMean(r, c, pts[k], pitch_col, roll_col, corrected, share).transpose();
-      }
-      Eigen::MatrixXd w = phi.colPivHouseholderQr().solve(y);  // (dz+1) x dx
-      mean_x = w.row(0).transpose();
-      b = w.bottomRows(dz).transpose();
     }
-    Eigen::VectorXd mean(dx + dz);
-    Eigen::MatrixXd cov(dx + dz, dx + dz);
-    mean << mean_x, mz;
-    cov.topLeftCorner(dx, dx) = sigma + b * sz * b.transpose();
-    if (dz > 0) {
-      cov.topRightCorner(dx, dz) = b * sz;
-      cov.bottomLeftCorner(dz, dx) = sz * b.transpose();
-      cov.bottomRightCorner(dz, dz) = sz;
-    }
-    cov = 0.5 * (cov + cov.transpose());
-    auto g = Gaussian::Create(mean, cov);
-    if (!g) {
-      cov.diagonal().array() += 1e-9 * (1.0 + cov.diagonal().array().abs());
-      g = Gaussian::Create(mean, cov);
-    }
-    if (!g) continue;
-    Mixture mix(dx + dz);
-    mix.Add(1.0, *g);
-    m.mixtures[c] = mix;
+    if (!mix.empty()) m.mixtures[c] = std::move(mix);
   }
   return m;
 }
 
 }  // namespace
 
-MotionModel BuildSimModel(const Sim2RealResult& result, const SampleSet& sim) {
-  return Build(result, sim, false);
+bool CorrectedModelOptions::IsValid(std::string* error) const {
+  if (max_pieces < 1 || samples_per_piece < 1 || max_fit_points < 1 || !(piece_pseudo_count > 0)) {
+    if (error) *error = "max_pieces, samples_per_piece and max_fit_points must be >= 1, piece_pseudo_count > 0";
+    return false;
+  }
+  return true;
 }
 
-MotionModel BuildCorrectedModel(const Sim2RealResult& result, const SampleSet& sim) {
-  return Build(result, sim, true);
+MotionModel BuildSimModel(const Sim2RealResult& result, const SampleSet& sim,
+                          const CorrectedModelOptions& options) {
+  return Build(result, sim, false, options);
+}
+
+MotionModel BuildCorrectedModel(const Sim2RealResult& result, const SampleSet& sim,
+                                const CorrectedModelOptions& options) {
+  return Build(result, sim, true, options);
 }
 
 }  // namespace dgmm::sim2real

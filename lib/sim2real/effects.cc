@@ -64,7 +64,10 @@ std::vector<EffectSpec> EffectLibrary(const PoseLayout& layout, int pose_dim, bo
         {"yaw_per_rad_left_turn", "rad per rad of simulated left turn"},
         {"yaw_per_rad_right_turn", "rad per rad of simulated right turn"},
         {"yaw_per_gx", "rad per unit gravity along body x"},
-        {"yaw_per_gy", "rad per unit gravity along body y"}},
+        {"yaw_per_gy", "rad per unit gravity along body y"},
+        {"load_shift_xx", "m per unit gravity: +along x for g_x, -along y for g_y (traceless)"},
+        {"dx_per_gy", "m per unit gravity along body y"},
+        {"dy_per_gx", "m per unit gravity along body x"}},
        false, false, false},
       {EffectId::kLatency, "latency", "Backlash / latency",
        "motion lost when the command changes (backlash, actuator latency)",
@@ -84,6 +87,13 @@ std::vector<EffectSpec> EffectLibrary(const PoseLayout& layout, int pose_dim, bo
   };
   for (auto& e : all) {
     if (e.id == EffectId::kActuatorAsymmetry && !has_terrain) e.parameters.resize(15);
+    // Strides and turns are separate motions of the gait (stride length, turn angle), each can
+    // lose its own share: one fraction per planar axis when the layout names them.
+    if (e.id == EffectId::kStrideLoss && layout.has_planar()) {
+      e.parameters = {{"loss_forward", "fraction of the simulated forward displacement"},
+                      {"loss_lateral", "fraction of the simulated lateral displacement"}};
+      if (layout.dyaw >= 0) e.parameters.push_back({"loss_turn", "fraction of the simulated turn"});
+    }
     if (e.id == EffectId::kBias) {
       for (int j = 0; j < pose_dim; ++j) e.parameters.push_back({"offset_" + std::to_string(j), "x units"});
     }
@@ -126,7 +136,13 @@ Eigen::MatrixXd EffectDesign(const EffectSpec& effect, const PoseLayout& layout,
       d(layout.dy, 0) = g(1);
       break;
     case EffectId::kStrideLoss:
-      add_motion(0, -1.0);
+      if (effect.num_params() == 1) {
+        add_motion(0, -1.0);
+      } else {
+        d(layout.dx, 0) = -u(layout.dx);
+        d(layout.dy, 1) = -u(layout.dy);
+        if (effect.num_params() > 2) d(layout.dyaw, 2) = -u(layout.dyaw);
+      }
       break;
     case EffectId::kSlopeTraction: {
       if (planar > kMinPlanar) {
@@ -166,8 +182,15 @@ Eigen::MatrixXd EffectDesign(const EffectSpec& effect, const PoseLayout& layout,
         }
       }
       if (effect.num_params() > 15) {
+        // The weak leg's load (and so its sag and lost thrust) changes with the direction of
+        // gravity: a turn linear in (g_x, g_y) and a drift through a traceless 2x2 map (as for
+        // a payload: a load shift creates no isotropic downhill creep, which is slope_slip).
         d(layout.dyaw, 15) = g(0);
         d(layout.dyaw, 16) = g(1);
+        d(layout.dx, 17) = g(0);
+        d(layout.dy, 17) = -g(1);
+        d(layout.dx, 18) = g(1);
+        d(layout.dy, 19) = g(0);
       }
       break;
     }
@@ -197,6 +220,12 @@ std::string DescribeEffect(const EffectSpec& e, const Eigen::VectorXd& t, double
                  : Format("The real robot moves %.1f mm less downhill per execution than simulated "
                           "(friction higher than simulated).", -1000 * t(0) * s);
     case EffectId::kStrideLoss:
+      if (t.size() > 1) {
+        return Format("Executions cover %.0f%% less forward and %.0f%% less sideways ground than "
+                      "simulated", 100 * t(0), 100 * t(1)) +
+               (t.size() > 2 ? Format(" and turn %.0f%% less", 100 * t(2)) : std::string()) +
+               " (less traction or shorter strides; negative: more).";
+      }
       return t(0) >= 0 ? Format("Every execution covers %.0f%% less ground and turn than simulated "
                                 "(less traction).", 100 * t(0))
                        : Format("Every execution covers %.0f%% more ground and turn than simulated.",
@@ -216,6 +245,9 @@ std::string DescribeEffect(const EffectSpec& e, const Eigen::VectorXd& t, double
     }
     case EffectId::kActuatorAsymmetry: {
       const double load = e.num_params() > 15 ? s * std::hypot(t(15), t(16)) : 0.0;
+      // Largest drift change over the directions of gravity: the operator norm of the 2x2 map.
+      const double load_drift =
+          e.num_params() > 19 ? s * Eigen::Matrix2d{{t(17), t(18)}, {t(19), -t(17)}}.operatorNorm() : 0.0;
       // The largest direction-dependent term, as a sentence.
       static const char* kDir[6] = {"forward", "backward", "to the left", "to the right",
                                     "turning left", "turning right"};
@@ -227,7 +259,8 @@ std::string DescribeEffect(const EffectSpec& e, const Eigen::VectorXd& t, double
       return Format("One side is weaker than simulated: the robot turns %.1f mrad per execution "
                     "(positive: to the left), up to %.1f mrad more depending on which side is loaded "
                     "on the observed slope, and drifts %.1f mm forward", 1000 * t(0), 1000 * load, 1000 * t(1)) +
-             Format(" and %.1f mm to the left per execution", 1000 * t(2)) +
+             Format(" and %.1f mm to the left per execution (up to %.1f mm more with the load)",
+                    1000 * t(2), 1000 * load_drift) +
              Format("; the largest direction-dependent term: %+.1f ", 1000 * t(best) * typical) +
              kOut[o] + " per " + (k < 4 ? "10 cm walked " : "0.15 rad ") + kDir[k] + ".";
     }

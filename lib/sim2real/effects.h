@@ -15,7 +15,7 @@ namespace dgmm::sim2real {
 
 enum class EffectId {
   kSlopeSlip,         // downhill creep along gravity's horizontal component in the body frame
-  kStrideLoss,        // planar displacement and turn scaled down uniformly
+  kStrideLoss,        // forward, lateral displacement and turn each scaled down
   kSlopeTraction,     // scaling that differs uphill and downhill
   kPayloadOffset,     // off-centre mass: drift/yaw linear in gravity, load-shortened strides
   kActuatorAsymmetry, // weak side: drift/yaw per direction of each commanded component

@@ -34,6 +34,18 @@ double Percentile(std::vector<double> v, double q) {
   return i + 1 < v.size() ? (1 - f) * v[i] + f * v[i + 1] : v[i];
 }
 
+// Whether effect a's mean shifts are a special case of effect b's on these samples: every
+// whitened design column of a lies in the column space of b's (relative residual < 1e-6).
+bool NestedIn(const FitProblem& fp, int a, int b) {
+  if (a == b || fp.library[a].is_noise || fp.library[b].is_noise) return false;
+  const Eigen::MatrixXd& ga = fp.g[a];
+  const Eigen::MatrixXd& gb = fp.g[b];
+  if (ga.cols() == 0 || gb.cols() <= ga.cols() || ga.norm() < 1e-300) return false;
+  Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(gb);
+  const Eigen::MatrixXd residual = ga - gb * qr.solve(ga);
+  return residual.norm() < 1e-6 * ga.norm();
+}
+
 }  // namespace
 
 bool SelectionOptions::IsValid(std::string* error) const {
@@ -131,11 +143,32 @@ SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows
     }
     std::sort(step.candidates.begin(), step.candidates.end(),
               [](const auto& a, const auto& b) { return a.gain > b.gain; });
-    const CandidateScore& best = step.candidates.front();
-    if (!(best.z > step.threshold_z && best.gain > options.min_gain_nats)) {
+    // The best-gaining candidate among those whose gain is significant (a larger but noisier
+    // gain does not stop a clearly significant one from being added).
+    auto eligible = std::find_if(step.candidates.begin(), step.candidates.end(), [&](const auto& c) {
+      return c.z > step.threshold_z && c.gain > options.min_gain_nats;
+    });
+    if (eligible == step.candidates.end()) {
       result.steps.push_back(step);
       break;
     }
+    // Parsimony: a significant candidate nested in the best one (its shifts a special case of
+    // the best one's) whose gain is within one clustered SE of the paired difference is the
+    // simpler explanation the data cannot beat, and is chosen instead.
+    for (auto it = step.candidates.begin(); it != step.candidates.end(); ++it) {
+      if (it == eligible || !(it->z > step.threshold_z && it->gain > options.min_gain_nats)) continue;
+      if (!NestedIn(fp, it->effect, eligible->effect)) continue;
+      double diff, diff_se;
+      ClusteredMean(heldout[eligible->effect] - heldout[it->effect], cluster, &diff, &diff_se);
+      if (diff <= diff_se &&
+          fp.library[it->effect].num_params() < fp.library[eligible->effect].num_params()) {
+        eligible = it;
+      }
+    }
+    std::iter_swap(step.candidates.begin(), eligible);  // keep the chosen one first
+    std::stable_sort(step.candidates.begin() + 1, step.candidates.end(),
+                     [](const auto& a, const auto& b) { return a.gain > b.gain; });
+    const CandidateScore& best = step.candidates.front();
     step.chosen = best.effect;
     // Which runners-up the data cannot separate from the best: near-equal held-out gain (within
     // one clustered SE of the paired difference) and strongly correlated fitted shifts.

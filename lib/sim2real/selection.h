@@ -1,6 +1,6 @@
 #pragma once
-// Sparse selection of effects by cross-validated real likelihood: forward selection that adds
-// the effect with the largest held-out gain while that gain is significant, bootstrap inclusion
+// Sparse selection of effects by cross-validated real likelihood: forward selection that adds,
+// of the effects whose held-out gain is significant, the one with the largest gain, bootstrap inclusion
 // probabilities and confidence intervals, and the pairs of effects the data cannot tell apart.
 #include <Eigen/Dense>
 #include <cstdint>
@@ -46,7 +46,7 @@ struct CandidateScore {
 
 struct SelectionStep {
   int chosen = -1;                      // library index, -1: stopped here
-  std::vector<CandidateScore> candidates;  // sorted by gain, best first
+  std::vector<CandidateScore> candidates;  // the chosen one first, then by gain
   // Other candidates whose gain is within one SE of the chosen one and whose fitted predictions
   // correlate strongly with it: the data cannot tell them apart.
   std::vector<int> confusable;

@@ -71,6 +71,18 @@ TEST(Sim2RealPipeline, WeakSideIsFoundFirst) {
   ExpectFirst(RunPair(w, 31), "actuator_asymmetry", 0, w.asymmetry_yaw_per_execution);
 }
 
+// A shorter stride is a special case of a payload (whose load losses are the same three
+// fractions): when the payload gains only insignificantly more (here by fitting a 1 mm drift,
+// within one SE), the nested, simpler effect is named.
+TEST(Sim2RealPipeline, StrideLossIsPreferredToThePayloadItIsNestedIn) {
+  SyntheticWorld w;
+  w.stride_loss = 0.1;
+  w.payload_drift_y = 0.001;  // a drift far below the noise: the payload gains a hair more
+  Sim2RealResult r = RunPair(w, 61);
+  ExpectFirst(r, "stride_loss", 0, w.stride_loss);
+  for (const auto& e : r.effects) EXPECT_NE(e.spec.key, "payload_offset");
+}
+
 TEST(Sim2RealPipeline, LatencyIsFoundFirst) {
   SyntheticWorld w;
   w.latency_first_loss = 0.3;
