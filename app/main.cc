@@ -11,11 +11,12 @@
 int main(int argc, char** argv) {
   CLI::App root{"dgmm: Dynamic Gaussian Mixture motion models for legged robots"};
   root.require_subcommand(1);
-  root.set_help_all_flag("--help-all", "Help for every subcommand");
   auto& registry = dgmm::app::CommandRegistry();
   std::sort(registry.begin(), registry.end(),
             [](const auto& a, const auto& b) { return a.name < b.name; });
   for (const auto& command : registry) command.setup(root);
+  // After the subcommands: CLI11 copies the flag into subcommands created later.
+  root.set_help_all_flag("--help-all", "Help for every subcommand");
   try {
     root.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

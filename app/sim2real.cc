@@ -71,6 +71,12 @@ void Run(const Sim2RealArgs& args) {
     recal.sim_config_path = args.sim_config;
     recal.seed = args.seed;
     ctx.recalibration_json = sim2real::Recalibrate(result, real, recal);
+    // The recalibrated config on its own, ready for `dgmm simulate --config`.
+    const auto recal_json = nlohmann::json::parse(ctx.recalibration_json, nullptr, false);
+    if (!recal_json.is_discarded() && recal_json.contains("recalibrated_config")) {
+      WriteText(fs::path(args.out) / "recalibrated_config.json",
+                recal_json["recalibrated_config"].dump(2) + "\n");
+    }
   }
   if (args.no_figures) {
     ctx.notes.push_back("figures skipped: --no-figures");

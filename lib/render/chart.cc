@@ -12,8 +12,13 @@
 #include <vtkTable.h>
 #include <vtkTextProperty.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "render/vtk_image.h"
 #include "util/error.h"
@@ -69,10 +74,34 @@ void AddErrorBars(vtkChartXY* chart, const std::vector<double>& x, const std::ve
   line->SetLegendVisibility(false);
 }
 
+// Title text and font size that fit `width` pixels: bold glyphs are about 0.6 x the font size
+// wide; a long title first gets a smaller font (down to 11 pt), then a line break at the space
+// nearest its middle.
+std::pair<std::string, int> FitTitle(const std::string& title, int width) {
+  const double room = std::max(100, width - 40);
+  auto fits = [&](size_t chars, int size) { return 0.6 * size * chars <= room; };
+  for (int size = 15; size >= 11; --size) {
+    if (fits(title.size(), size)) return {title, size};
+  }
+  size_t cut = std::string::npos;
+  for (size_t i = 0; i < title.size(); ++i) {
+    if (title[i] == ' ' && (cut == std::string::npos ||
+                            std::abs(2.0 * i - title.size()) < std::abs(2.0 * cut - title.size()))) {
+      cut = i;
+    }
+  }
+  if (cut == std::string::npos) return {title, 11};
+  const size_t longest = std::max(cut, title.size() - cut - 1);
+  int size = 15;
+  while (size > 9 && !fits(longest, size)) --size;
+  return {title.substr(0, cut) + "\n" + title.substr(cut + 1), size};
+}
+
 void StyleChart(vtkChartXY* chart, const std::string& title, const std::string& x_label,
-                const std::string& y_label, bool legend) {
-  chart->SetTitle(title);
-  chart->GetTitleProperties()->SetFontSize(15);
+                const std::string& y_label, bool legend, int width) {
+  const auto [text, size] = FitTitle(title, width);
+  chart->SetTitle(text);
+  chart->GetTitleProperties()->SetFontSize(size);
   chart->GetTitleProperties()->SetBold(true);
   chart->GetAxis(vtkAxis::BOTTOM)->SetTitle(x_label);
   chart->GetAxis(vtkAxis::LEFT)->SetTitle(y_label);
@@ -81,6 +110,34 @@ void StyleChart(vtkChartXY* chart, const std::string& title, const std::string& 
     chart->GetLegend()->SetHorizontalAlignment(vtkChartLegend::RIGHT);
     chart->GetLegend()->SetVerticalAlignment(vtkChartLegend::TOP);
   }
+}
+
+// The legend goes to the corner (of four) that covers the fewest data points: a corner box is
+// 45% of the width and 30% of the height of the data range (in axis units, log where log).
+void PlaceLegendInEmptiestCorner(vtkChartXY* chart, const LineChartSpec& spec) {
+  std::vector<std::pair<double, double>> pts;
+  double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
+  for (const auto& s : spec.series) {
+    for (size_t j = 0; j < s.x.size(); ++j) {
+      const double x = spec.log_x ? std::log10(s.x[j]) : s.x[j];
+      const double y = spec.log_y ? std::log10(s.y[j]) : s.y[j];
+      pts.emplace_back(x, y);
+      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+    }
+  }
+  const double w = std::max(x1 - x0, 1e-300), h = std::max(y1 - y0, 1e-300);
+  int best = 0, best_count = INT32_MAX;
+  for (int corner = 0; corner < 4; ++corner) {  // top-right, top-left, bottom-right, bottom-left
+    const bool right = corner % 2 == 0, top = corner < 2;
+    int count = 0;
+    for (const auto& [x, y] : pts) {
+      const double u = (x - x0) / w, v = (y - y0) / h;
+      count += (right ? u > 0.55 : u < 0.45) && (top ? v > 0.7 : v < 0.3);
+    }
+    if (count < best_count) best = corner, best_count = count;
+  }
+  chart->GetLegend()->SetHorizontalAlignment(best % 2 == 0 ? vtkChartLegend::RIGHT : vtkChartLegend::LEFT);
+  chart->GetLegend()->SetVerticalAlignment(best < 2 ? vtkChartLegend::TOP : vtkChartLegend::BOTTOM);
 }
 
 // Ticks at the decades 10^e covering [lo, hi] on an axis that shows log10 of the values.
@@ -151,7 +208,7 @@ void RenderLineChart(const LineChartSpec& spec, const std::string& png_path) {
   auto view = render_internal::MakeOffscreenView(spec.width, spec.height);
   auto chart = vtkSmartPointer<vtkChartXY>::New();
   view->GetScene()->AddItem(chart);
-  StyleChart(chart, spec.title, spec.x_label, spec.y_label, spec.series.size() > 1);
+  StyleChart(chart, spec.title, spec.x_label, spec.y_label, spec.series.size() > 1, spec.width);
   double x_min = INFINITY, x_max = -INFINITY;
   for (const auto& s : spec.series) {
     for (double v : s.x) x_min = std::min(x_min, v), x_max = std::max(x_max, v);
@@ -181,6 +238,7 @@ void RenderLineChart(const LineChartSpec& spec, const std::string& png_path) {
                                        1e-12);
     AddErrorBars(chart, s.x, s.y, s.y_error, cap, rgb);
   }
+  if (spec.series.size() > 1) PlaceLegendInEmptiestCorner(chart, spec);
   if (spec.log_x) SetDecadeTicks(chart->GetAxis(vtkAxis::BOTTOM), x_min, x_max);
   if (spec.log_y) {
     double y_min = INFINITY, y_max = -INFINITY;
@@ -200,7 +258,7 @@ void RenderBarChart(const BarChartSpec& spec, const std::string& png_path) {
   auto view = render_internal::MakeOffscreenView(spec.width, spec.height);
   auto chart = vtkSmartPointer<vtkChartXY>::New();
   view->GetScene()->AddItem(chart);
-  StyleChart(chart, spec.title, spec.x_label, spec.y_label, spec.series.size() > 1);
+  StyleChart(chart, spec.title, spec.x_label, spec.y_label, spec.series.size() > 1, spec.width);
   const float fraction = chart->GetBarWidthFraction();
   const size_t n = spec.series.size();
   std::vector<double> index(spec.categories.size());

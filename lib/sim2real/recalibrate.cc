@@ -1,17 +1,24 @@
 #include "sim2real/recalibrate.h"
 
+#include <chrono>
+#include <exception>
 #include <nlohmann/json.hpp>
 
 #ifdef DGMM_SIM2REAL_HAVE_SIM
-#include "sim/protocol.h"
 #include "sim/sim_config.h"
+#include "sim2real/recalibrate_scans.h"
+#include "sim2real/recalibrate_scorer.h"
 #endif
 
 namespace dgmm::sim2real {
 
 bool RecalibrationOptions::IsValid(std::string* error) const {
-  if (sim_config_path.empty() || placements < 5) {
-    if (error) *error = "a sim config path and >= 5 placements are needed";
+  if (sim_config_path.empty() || placements < 5 || threads < 1 ||
+      (verify_placements != 0 && verify_placements < 5)) {
+    if (error) {
+      *error = "a sim config path, >= 5 placements per re-simulation (and per check, or 0) and "
+               ">= 1 thread are needed";
+    }
     return false;
   }
   return true;
@@ -19,14 +26,22 @@ bool RecalibrationOptions::IsValid(std::string* error) const {
 
 std::string Recalibrate(const Sim2RealResult& result, const SampleSet& real,
                         const RecalibrationOptions& options) {
-  nlohmann::json out;
-  bool friction_effect = false;
-  for (const auto& e : result.effects) {
-    friction_effect |= e.spec.key == "slope_slip" || e.spec.key == "stride_loss" ||
-                       e.spec.key == "slope_traction";
-  }
-  if (!friction_effect) {
-    out["skipped"] = "no effect with a simulator mapping (slip, stride loss, traction -> friction) was found";
+  using json = nlohmann::json;
+  json out;
+  auto selected = [&](std::initializer_list<const char*> keys) {
+    for (const auto& e : result.effects) {
+      for (const char* k : keys) {
+        if (e.spec.key == k) return true;
+      }
+    }
+    return false;
+  };
+  const bool friction = selected({"slope_slip", "stride_loss", "slope_traction"});
+  const bool payload = selected({"payload_offset"});
+  const bool legs = selected({"actuator_asymmetry"});
+  if (!friction && !payload && !legs) {
+    out["skipped"] = "no selected effect has a simulator mapping (slip, stride loss, traction -> "
+                     "friction; payload offset -> payload; actuator asymmetry -> leg gains)";
     return out.dump(2);
   }
 #ifndef DGMM_SIM2REAL_HAVE_SIM
@@ -38,39 +53,53 @@ std::string Recalibrate(const Sim2RealResult& result, const SampleSet& real,
     out["skipped"] = error;
     return out.dump(2);
   }
-  const sim::SimConfig base = sim::LoadSimConfig(options.sim_config_path);
-  const double nominal = base.friction.sliding;
-  out["parameter"] = "friction.sliding";
-  out["nominal"] = nominal;
-  out["placements_per_simulation"] = options.placements;
-  nlohmann::json candidates = nlohmann::json::array();
-  std::vector<int> identity;
-  double best_ll = -INFINITY, best_value = nominal, nominal_ll = NAN;
-  for (double factor : {1.0, 0.85, 0.7, 0.55}) {
-    sim::SimConfig config = base;
-    config.friction.sliding = nominal * factor;
-    sim::ProtocolOptions protocol;
-    protocol.protocol = sim::Protocol::kPaper830;
-    protocol.seed = options.seed;
-    protocol.placements = options.placements;
-    SampleSet resim = sim::SimulateProtocol(config, protocol);
-    std::vector<int> id(resim.num_commands());
-    for (int c = 0; c < resim.num_commands(); ++c) id[c] = c;
-    Samples s = MakeSamples(resim, id);
-    Samples r = MakeSamples(real, AlignCommands(resim, real));
-    LinearGaussianModel model = LinearGaussianModel::Fit(s, LinearGaussianOptions{});
-    const double ll = model.LogLikelihood(r).mean();
-    candidates.push_back({{"value", config.friction.sliding}, {"mean_log_likelihood", ll},
-                          {"samples", resim.size()}});
-    if (factor == 1.0) nominal_ll = ll;
-    if (ll > best_ll) {
-      best_ll = ll;
-      best_value = config.friction.sliding;
+  const auto start = std::chrono::steady_clock::now();
+  try {
+    const sim::SimConfig base = sim::LoadSimConfig(options.sim_config_path);
+    std::vector<EffectSpec> effects;
+    json projected = json::array();
+    for (const auto& e : result.effects) {
+      effects.push_back(e.spec);
+      if (!e.spec.is_noise && e.spec.num_params() > 0) projected.push_back(e.spec.key);
     }
+    ResimOptions resim;
+    resim.seed = options.seed;
+    resim.placements = options.placements;
+    resim.threads = options.threads;
+    ResimScorer scorer(result, real, base, effects, resim);
+    out["placements_per_simulation"] = options.placements;
+    out["projected_on"] = projected;
+    out["nominal_mean_log_likelihood"] = scorer.NominalLogLikelihood();
+    // The scans are separate (each from the nominal config); their winners are combined.
+    sim::SimConfig recalibrated = base;
+    json scans = json::array();
+    if (friction) {
+      json f = ScanFriction(scorer, &recalibrated);
+      for (const char* k : {"parameter", "nominal", "candidates", "best", "improvement_nats_per_sample"}) {
+        out[k] = f[k];
+      }
+      scans.push_back(f);
+    }
+    if (payload) scans.push_back(ScanPayload(scorer, &recalibrated));
+    if (legs) scans.push_back(ScanLegGain(scorer, &recalibrated));
+    out["scans"] = scans;
+    out["recalibrated_config"] = json::parse(sim::SimConfigToJson(recalibrated));
+    out["recalibrated_mean_log_likelihood"] = scorer.Evaluate({recalibrated})[0].mean_log_likelihood;
+    if (options.verify_placements > 0) {
+      // The literal check: models trained on new re-simulations (another seed) of the nominal
+      // and the recalibrated config, each scored on the real set.
+      const std::vector<double> direct =
+          scorer.DirectLogLikelihoods({base, recalibrated}, options.verify_placements);
+      out["verification"] = {{"placements", options.verify_placements},
+                             {"nominal_mean_log_likelihood", direct[0]},
+                             {"recalibrated_mean_log_likelihood", direct[1]},
+                             {"improvement_nats_per_sample", direct[1] - direct[0]}};
+    }
+    out["simulations"] = scorer.simulations();
+  } catch (const std::exception& e) {
+    out = json{{"skipped", std::string("re-simulation failed: ") + e.what()}};
   }
-  out["candidates"] = candidates;
-  out["best"] = best_value;
-  out["improvement_nats_per_sample"] = best_ll - nominal_ll;
+  out["seconds"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out.dump(2);
 #endif
 }
