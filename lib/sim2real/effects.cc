@@ -268,8 +268,10 @@ std::string DescribeEffect(const EffectSpec& e, const Eigen::VectorXd& t, double
       return Format("The first execution after a change of command loses %.0f%% of its motion "
                     "(backlash or latency).", 100 * t(0));
     case EffectId::kCompliance:
-      return Format("The ground gives way: the robot sinks %.1f mm per execution and its roll and "
-                    "pitch changes are %.0f%% damped.", 1000 * t(0), 100 * t(1));
+      return (t(0) >= 0 ? Format("The ground gives way: the robot sinks %.1f mm per execution", 1000 * t(0))
+                        : Format("The robot ends %.1f mm higher per execution than simulated", -1000 * t(0))) +
+             (t(1) >= 0 ? Format(" and its roll and pitch changes are %.0f%% damped.", 100 * t(1))
+                        : Format(" and its roll and pitch changes are %.0f%% larger.", -100 * t(1)));
     case EffectId::kBias:
       return "The measured pose change carries a constant offset (tracker or calibration): " +
              Format("|offset| = %.3g in x units.", t.norm());

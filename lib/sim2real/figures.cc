@@ -1,5 +1,6 @@
 #include "sim2real/figures.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 
@@ -71,19 +72,39 @@ std::vector<ReportFigure> RenderFigures(const Sim2RealResult& r, const SampleSet
     RenderBarChart(bars, (dir / "loglik.png").string());
     figures.push_back({"loglik.png", "Held-out real log-likelihood per sample: (a) sim-trained, "
                                      "(b) corrected, (c) real-trained ceiling."});
-    // 2. Heat map: rows = commands (as in the table), columns = terrain regions.
+    // 2. Heat map: rows = commands (as in the table), columns = terrain regions; cell (c, t) is
+    // the block [t, t + 1] x [c, c + 1] (nearest-neighbour upsampling, so cells are equal blocks),
+    // before and after the correction side by side.
     if (r.heat_before.rows() >= 2 && r.heat_before.cols() >= 2) {
-      HeatMapSpec heat;
-      heat.palette = HeatMapSpec::Palette::kDiverging;
-      heat.background.range = {0, double(r.heat_before.cols() - 1), 0, double(r.heat_before.rows() - 1)};
-      heat.background.values = r.heat_before.unaryExpr([](double v) { return std::isfinite(v) ? v : 0.0; });
-      heat.title = "Deficit (nats per real sample) by command (row) and terrain region (column)";
-      heat.x_label = "terrain region (see table)";
-      heat.y_label = "command (table order)";
-      heat.value_label = "deficit";
-      RenderHeatMap(heat, (dir / "heat_map.png").string());
-      figures.push_back({"heat_map.png", "Command x terrain deficit before the correction (rows and "
-                                         "columns in the order of the report's table)."});
+      auto blocks = [](const Eigen::MatrixXd& h, const std::string& title) {
+        constexpr int kPerCell = 16;
+        HeatMapSpec heat;
+        heat.palette = HeatMapSpec::Palette::kDiverging;
+        heat.background.range = {0, double(h.cols()), 0, double(h.rows())};
+        const int nx = static_cast<int>(h.cols()) * kPerCell, ny = static_cast<int>(h.rows()) * kPerCell;
+        heat.background.values.resize(ny, nx);
+        for (int j = 0; j < ny; ++j) {
+          for (int i = 0; i < nx; ++i) {
+            const int c = std::min<int>(h.rows() - 1, j * h.rows() / (ny - 1));
+            const int t = std::min<int>(h.cols() - 1, i * h.cols() / (nx - 1));
+            heat.background.values(j, i) = std::isfinite(h(c, t)) ? h(c, t) : 0.0;
+          }
+        }
+        heat.title = title;
+        heat.x_label = "terrain region k in [k, k+1] (see table)";
+        heat.y_label = "command row r in [r, r+1] (table order)";
+        heat.value_label = "nats/sample";
+        heat.width = 560;
+        heat.height = 640;
+        return heat;
+      };
+      RenderHeatMapRow({blocks(r.heat_before, "Deficit before the correction"),
+                        blocks(r.heat_after, "Deficit after the correction")},
+                       (dir / "heat_map.png").string());
+      figures.push_back({"heat_map.png", "Held-out deficit (nats per real sample, real-trained "
+                                         "ceiling minus model) per command x terrain region, "
+                                         "before and after the correction (rows and columns in "
+                                         "the order of the report's table; white: no samples)."});
     }
     // 3. Density maps for the two worst cells: sim, corrected, corrected - sim; real points overlaid.
     if (r.layout.has_planar()) {
