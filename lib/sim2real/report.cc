@@ -85,6 +85,43 @@ std::string HeatColour(double v, double scale) {
   return buf;
 }
 
+// The re-simulation summary: one row per scan, the direct check, the raw JSON folded away.
+std::string RecalibrationHtml(const std::string& text) {
+  const json j = json::parse(text, nullptr, /*allow_exceptions=*/false);
+  std::ostringstream o;
+  if (j.is_discarded() || !j.is_object()) return "<pre>" + Escape(text) + "</pre>";
+  if (j.contains("skipped")) {
+    return "<p>Skipped: " + Escape(j["skipped"].is_string() ? j["skipped"].get<std::string>() : j["skipped"].dump()) + "</p>";
+  }
+  if (j.contains("scans") && j["scans"].is_array()) {
+    o << "<table><tr><th>effect</th><th>simulator parameter</th><th>nominal</th><th>best</th>"
+         "<th>gain over nominal (nats per real sample)</th></tr>";
+    for (const auto& s : j["scans"]) {
+      const auto field = [&](const char* k) {
+        if (!s.contains(k)) return std::string("-");
+        return Escape(s[k].is_string() ? s[k].get<std::string>() : s[k].dump());
+      };
+      o << "<tr><td>" << field("effect") << "</td><td>" << field("parameter") << "</td><td>"
+        << field("nominal") << "</td><td>" << field("best") << "</td><td>"
+        << (s.contains("improvement_nats_per_sample") && s["improvement_nats_per_sample"].is_number()
+                ? F("%+.3f", s["improvement_nats_per_sample"].get<double>()) : std::string("-"))
+        << "</td></tr>";
+    }
+    o << "</table>";
+  }
+  if (j.contains("verification") && j["verification"].contains("nominal_mean_log_likelihood")) {
+    const auto& v = j["verification"];
+    o << "<p>Check: sets re-simulated with " << Escape(v.value("placements", json(0)).dump())
+      << " new placements; a model trained on each scores the real set "
+      << F("%.3f", v["nominal_mean_log_likelihood"].get<double>()) << " (nominal config) and "
+      << F("%.3f", v["recalibrated_mean_log_likelihood"].get<double>())
+      << " (recalibrated config) nats per sample. The recalibrated config is written as "
+         "<code>recalibrated_config.json</code>.</p>";
+  }
+  o << "<details><summary>All candidates (JSON)</summary><pre>" << Escape(j.dump(2)) << "</pre></details>";
+  return o.str();
+}
+
 std::string HeatTable(const Sim2RealResult& r, const Eigen::MatrixXd& h) {
   double scale = 0.5;
   for (int i = 0; i < h.rows(); ++i)
@@ -240,7 +277,7 @@ std::string ReportHtml(const Sim2RealResult& r, const ReportContext& ctx, const 
     << "</code> (kind \"corrected\", readable by <code>dgmm score</code> and <code>dgmm render</code>); "
        "the sim-trained model of the analysis as <code>" << Escape(ctx.sim_model_file) << "</code>.</p>\n";
   if (!ctx.recalibration_json.empty()) {
-    o << "<h3>Re-simulation with the fitted physical parameter</h3><pre>" << Escape(ctx.recalibration_json) << "</pre>";
+    o << "<h3>Re-simulation with the fitted physical parameters</h3>" << RecalibrationHtml(ctx.recalibration_json);
   }
   o << "<h2>4. The fit</h2><table><tr><th>model</th><th>held-out real log-likelihood per sample</th></tr>"
     << "<tr><td>(a) sim-trained</td><td>" << F("%.3f", r.ll_sim) << "</td></tr>"

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iterator>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -132,6 +133,11 @@ json RunRecalibration(const std::string& real, const std::string& name) {
     const auto config = dir / "recalibrated_config.json";
     EXPECT_TRUE(std::filesystem::exists(config));
     EXPECT_EQ(RunDgmm({"simulate", "--config", config.string(), "--print-config"}).exit_code, 0);
+    // The report summarises the scans in a table, with the check.
+    std::ifstream html(dir / "report.html");
+    const std::string text((std::istreambuf_iterator<char>(html)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("Re-simulation with the fitted physical parameters</h3><table>"), std::string::npos);
+    EXPECT_NE(text.find("recalibrated config"), std::string::npos);
   }
   return j["recalibration"];
 }
