@@ -2,7 +2,6 @@
 // log-likelihood, found with Ceres on a smooth fit of the curve (lib/tune/tune_k.h).
 #include "tune/tune_k.h"
 
-#include <algorithm>
 #include <fmt/format.h>
 
 #include <cmath>
@@ -66,13 +65,8 @@ void PlotCurve(const TuneKSummary& s, const std::string& path) {
     cv.y_error.push_back(p.standard_error);
   }
   ChartSeries fit{"Ceres quadratic fit in log k (over the bracket)", {}, {}, {}, {}};
-  // Only over the bracket it was fitted and maximised on, never beyond the evaluated grid.
-  double k_min = s.bracket_lo, k_max = s.bracket_hi;
-  for (const auto& p : s.curve) {
-    k_min = std::min(k_min, p.k);
-    k_max = std::max(k_max, p.k);
-  }
-  const double lo = std::log(std::max(s.bracket_lo, k_min)), hi = std::log(std::min(s.bracket_hi, k_max));
+  // Only over the bracket it was fitted and maximised on (grid points around the best one).
+  const double lo = std::log(s.bracket_lo), hi = std::log(s.bracket_hi);
   for (int i = 0; i <= 40; ++i) {
     const double k = std::exp(lo + (hi - lo) * i / 40.0);
     fit.x.push_back(k);

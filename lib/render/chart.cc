@@ -112,18 +112,12 @@ void StyleChart(vtkChartXY* chart, const std::string& title, const std::string& 
   }
 }
 
-// The legend goes to the corner (of four) that covers the fewest data points: a corner box is
-// 45% of the width and 30% of the height of the data range (in axis units, log where log).
-void PlaceLegendInEmptiestCorner(vtkChartXY* chart, const LineChartSpec& spec) {
-  std::vector<std::pair<double, double>> pts;
+// The legend goes to the corner (of four) that covers the fewest data points (x, y in axis
+// units): a corner box is 45% of the width and 30% of the height of the data range.
+void PlaceLegendInEmptiestCorner(vtkChartXY* chart, const std::vector<std::pair<double, double>>& pts) {
   double x0 = INFINITY, x1 = -INFINITY, y0 = INFINITY, y1 = -INFINITY;
-  for (const auto& s : spec.series) {
-    for (size_t j = 0; j < s.x.size(); ++j) {
-      const double x = spec.log_x ? std::log10(s.x[j]) : s.x[j];
-      const double y = spec.log_y ? std::log10(s.y[j]) : s.y[j];
-      pts.emplace_back(x, y);
-      x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-    }
+  for (const auto& [x, y] : pts) {
+    x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
   }
   const double w = std::max(x1 - x0, 1e-300), h = std::max(y1 - y0, 1e-300);
   int best = 0, best_count = INT32_MAX;
@@ -216,6 +210,7 @@ void RenderLineChart(const LineChartSpec& spec, const std::string& png_path) {
   // Log axes are drawn as log10 of the values with decade tick labels (VTK 9.1's own log axis
   // crashes on some ranges).
   auto axis_value = [](double v, bool log) { return log ? std::log10(v) : v; };
+  std::vector<std::pair<double, double>> plotted;  // every point, in axis units
   for (size_t i = 0; i < spec.series.size(); ++i) {
     ChartSeries s = spec.series[i];
     if (spec.log_y && !s.y_error.empty()) {
@@ -226,6 +221,7 @@ void RenderLineChart(const LineChartSpec& spec, const std::string& png_path) {
     }
     for (double& v : s.x) v = axis_value(v, spec.log_x);
     for (double& v : s.y) v = axis_value(v, spec.log_y);
+    for (size_t j = 0; j < s.x.size(); ++j) plotted.emplace_back(s.x[j], s.y[j]);
     const Rgb rgb = SeriesColour(spec.series[i], i);
     auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
     line->SetInputData(XyTable(s.x, s.y, s.name), 0, 1);
@@ -238,7 +234,7 @@ void RenderLineChart(const LineChartSpec& spec, const std::string& png_path) {
                                        1e-12);
     AddErrorBars(chart, s.x, s.y, s.y_error, cap, rgb);
   }
-  if (spec.series.size() > 1) PlaceLegendInEmptiestCorner(chart, spec);
+  if (spec.series.size() > 1) PlaceLegendInEmptiestCorner(chart, plotted);
   if (spec.log_x) SetDecadeTicks(chart->GetAxis(vtkAxis::BOTTOM), x_min, x_max);
   if (spec.log_y) {
     double y_min = INFINITY, y_max = -INFINITY;

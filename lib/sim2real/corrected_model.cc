@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim2real/locate.h"
+#include "sim2real/samples.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -29,8 +30,7 @@ class Predictor {
     if (!corrected_) return p.mean;
     const double pitch = pitch_col_ >= 0 ? z(pitch_col_) : 0.0;
     const double roll = roll_col_ >= 0 ? z(roll_col_) : 0.0;
-    const Eigen::Vector3d g(std::sin(pitch), -std::sin(roll) * std::cos(pitch),
-                            -std::cos(roll) * std::cos(pitch));
+    const Eigen::Vector3d g = BodyGravity(pitch, roll);
     Eigen::VectorXd mean = p.mean;
     for (size_t k = 0; k < r_.fit.effects.size(); ++k) {
       const EffectSpec& e = r_.library[r_.fit.effects[k]];

@@ -15,6 +15,15 @@ std::string Format(const char* fmt, double a, double b = 0, double c = 0) {
 
 constexpr double kMinPlanar = 1e-3;  // m: below this the commanded direction is undefined
 
+// A load shift under gravity: (dx, dy) += T (g_x, g_y) with T = [[a, b], [c, -a]] traceless, so
+// it holds no isotropic downhill creep (slope_slip's form); (a, b, c) in columns col .. col + 2.
+void AddLoadShift(const PoseLayout& layout, const Eigen::Vector3d& g, int col, Eigen::MatrixXd* d) {
+  (*d)(layout.dx, col) = g(0);
+  (*d)(layout.dy, col) = -g(1);
+  (*d)(layout.dx, col + 1) = g(1);
+  (*d)(layout.dy, col + 2) = g(0);
+}
+
 }  // namespace
 
 std::vector<EffectSpec> EffectLibrary(const PoseLayout& layout, int pose_dim, bool has_terrain,
@@ -156,11 +165,8 @@ Eigen::MatrixXd EffectDesign(const EffectSpec& effect, const PoseLayout& layout,
       d(layout.dy, 1) = 1.0;
       // Coulomb friction: the downhill pull and the friction limit both scale with the total
       // mass, so an added mass creates no isotropic downhill creep (that is slope_slip); the
-      // load shift moves the drift anisotropically: a traceless 2x2 map of (g_x, g_y).
-      d(layout.dx, 2) = g(0);
-      d(layout.dy, 2) = -g(1);
-      d(layout.dx, 3) = g(1);
-      d(layout.dy, 4) = g(0);
+      // load shift moves the drift anisotropically.
+      AddLoadShift(layout, g, 2, &d);
       d(layout.dyaw, 5) = g(0);
       d(layout.dyaw, 6) = g(1);
       d(layout.dx, 7) = -u(layout.dx);
@@ -183,14 +189,10 @@ Eigen::MatrixXd EffectDesign(const EffectSpec& effect, const PoseLayout& layout,
       }
       if (effect.num_params() > 15) {
         // The weak leg's load (and so its sag and lost thrust) changes with the direction of
-        // gravity: a turn linear in (g_x, g_y) and a drift through a traceless 2x2 map (as for
-        // a payload: a load shift creates no isotropic downhill creep, which is slope_slip).
+        // gravity: a turn linear in (g_x, g_y) and a drift through the payload's load-shift map.
         d(layout.dyaw, 15) = g(0);
         d(layout.dyaw, 16) = g(1);
-        d(layout.dx, 17) = g(0);
-        d(layout.dy, 17) = -g(1);
-        d(layout.dx, 18) = g(1);
-        d(layout.dy, 19) = g(0);
+        AddLoadShift(layout, g, 17, &d);
       }
       break;
     }

@@ -9,6 +9,7 @@
 #include "render/density_grid.h"
 #include "render/display.h"
 #include "render/heat_map.h"
+#include "sim2real/samples.h"
 #endif
 
 namespace dgmm::sim2real {
@@ -31,7 +32,7 @@ void PlanarPrediction(const Sim2RealResult& r, int c, const Eigen::VectorXd& z, 
   if (corrected) {
     int pitch_col = r.terrain_dim >= 1 ? 0 : -1, roll_col = r.terrain_dim >= 2 ? 1 : -1;
     const double pitch = pitch_col >= 0 ? z(pitch_col) : 0, roll = roll_col >= 0 ? z(roll_col) : 0;
-    Eigen::Vector3d g(std::sin(pitch), -std::sin(roll) * std::cos(pitch), -std::cos(roll) * std::cos(pitch));
+    const Eigen::Vector3d g = BodyGravity(pitch, roll);
     for (size_t k = 0; k < r.fit.effects.size(); ++k) {
       const EffectSpec& e = r.library[r.fit.effects[k]];
       if (e.is_noise) continue;

@@ -7,7 +7,7 @@
 #include <thread>
 
 #include "sim/protocol.h"
-#include "sim2real/effects.h"
+#include "sim2real/effect_fit.h"
 #include "sim2real/linear_gaussian.h"
 #include "sim2real/samples.h"
 #include "util/error.h"
@@ -39,32 +39,7 @@ ResimScorer::ResimScorer(const Sim2RealResult& result, const SampleSet& real,
     throw MakeInputError("--sim-config", "commands",
                          "the simulator's commands match none of the real set's");
   }
-  real_a_ = Eigen::MatrixXd::Zero(num_params_, num_params_);
-  real_b_ = Eigen::VectorXd::Zero(num_params_);
-  constexpr double kLog2Pi = 1.8378770664093453;
-  for (int k = 0; k < r.size(); ++k) {
-    const Prediction p = result_.sim_model.Predict(r.command[k], r.z.row(k).transpose(),
-                                                   r.first_execution[k]);
-    const auto l = p.chol.triangularView<Eigen::Lower>();
-    const Eigen::MatrixXd w = l.solve(Design(p.mean, r.gravity.row(k).transpose(), r.first_execution[k]));
-    const Eigen::VectorXd y = l.solve(Eigen::VectorXd(r.x.row(k).transpose() - p.mean));
-    real_a_ += w.transpose() * w;
-    real_b_ += w.transpose() * y;
-    real_yy_ += y.squaredNorm();
-    real_const_ += -0.5 * p.log_det - 0.5 * r.pose_dim() * kLog2Pi;
-  }
-  real_n_ = r.size();
-}
-
-Eigen::MatrixXd ResimScorer::Design(const Eigen::VectorXd& u, const Eigen::Vector3d& g,
-                                    bool first) const {
-  Eigen::MatrixXd d(u.size(), num_params_);
-  int col = 0;
-  for (const auto& e : effects_) {
-    d.middleCols(col, e.num_params()) = EffectDesign(e, result_.layout, u, g, first);
-    col += e.num_params();
-  }
-  return d;
+  real_projection_ = Project(r);
 }
 
 std::vector<int> ResimScorer::CommandMap(const SampleSet& set) const {
@@ -91,18 +66,18 @@ std::vector<int> ResimScorer::CommandMap(const SampleSet& set) const {
   return to_sim;
 }
 
-ResimScorer::Projection ResimScorer::Project(const SampleSet& set) const {
-  const Samples s = MakeSamples(set, CommandMap(set));
-  Projection p{Eigen::MatrixXd::Zero(num_params_, num_params_), Eigen::VectorXd::Zero(num_params_)};
-  for (int k = 0; k < s.size(); ++k) {
-    const Prediction pr = result_.sim_model.Predict(s.command[k], s.z.row(k).transpose(),
-                                                    s.first_execution[k]);
-    const auto l = pr.chol.triangularView<Eigen::Lower>();
-    const Eigen::MatrixXd w = l.solve(Design(pr.mean, s.gravity.row(k).transpose(), s.first_execution[k]));
-    p.a += w.transpose() * w;
-    p.b += w.transpose() * l.solve(Eigen::VectorXd(s.x.row(k).transpose() - pr.mean));
+ResimScorer::Projection ResimScorer::Project(const Samples& samples) const {
+  const FitProblem fp = MakeFitProblem(samples, result_.sim_model, effects_, result_.layout);
+  // Stacked whitened designs ((n dx) x P, rows sample-major as in FitProblem) and residuals.
+  Eigen::MatrixXd g(fp.n * fp.dx, num_params_);
+  int col = 0;
+  for (const Eigen::MatrixXd& ge : fp.g) {
+    g.middleCols(col, ge.cols()) = ge;
+    col += static_cast<int>(ge.cols());
   }
-  return p;
+  const Eigen::MatrixXd r0t = fp.r0.transpose();
+  const Eigen::Map<const Eigen::VectorXd> y(r0t.data(), r0t.size());
+  return {g.transpose() * g, g.transpose() * y, y.squaredNorm(), fp.log_norm.sum(), fp.n};
 }
 
 Eigen::VectorXd ResimScorer::Solve(const Projection& p) const {
@@ -113,14 +88,15 @@ Eigen::VectorXd ResimScorer::Solve(const Projection& p) const {
 
 double ResimScorer::LogLikelihood(const Eigen::VectorXd& theta) const {
   // sum_r -||y_r - W_r theta||^2 / 2 expanded in the precomputed sums.
-  const double ss = real_yy_ - 2 * theta.dot(real_b_) + theta.dot(real_a_ * theta);
-  return (real_const_ - 0.5 * ss) / real_n_;
+  const Projection& p = real_projection_;
+  const double ss = p.yy - 2 * theta.dot(p.b) + theta.dot(p.a * theta);
+  return (p.log_norm - 0.5 * ss) / p.n;
 }
 
 Eigen::VectorXd ResimScorer::FitCoefficients(const Eigen::MatrixXd& basis, double ridge) const {
-  Eigen::MatrixXd a = basis.transpose() * real_a_ * basis;
+  Eigen::MatrixXd a = basis.transpose() * real_projection_.a * basis;
   a.diagonal().array() += 1e-12 + ridge * std::abs(a.diagonal().mean());
-  return a.ldlt().solve(basis.transpose() * real_b_);
+  return a.ldlt().solve(basis.transpose() * real_projection_.b);
 }
 
 std::vector<SampleSet> ResimScorer::Simulate(const std::vector<sim::SimConfig>& configs,
@@ -177,7 +153,7 @@ std::vector<ResimScore> ResimScorer::Evaluate(const std::vector<sim::SimConfig>&
         }
         s.error.clear();
         s.samples = sets[i].size();
-        s.shift = Solve(Project(sets[i]));  // theta(set); shifted below
+        s.shift = Solve(Project(MakeSamples(sets[i], CommandMap(sets[i]))));  // theta(set); shifted below
       }
       cache_[todo_keys[i]] = s;
     }
@@ -192,7 +168,7 @@ std::vector<ResimScore> ResimScorer::Evaluate(const std::vector<sim::SimConfig>&
   std::vector<ResimScore> out;
   for (const auto& k : keys) {
     ResimScore s = cache_[k];
-    if (s.ok && real_n_ > 0) s.mean_log_likelihood = LogLikelihood(s.shift);
+    if (s.ok && real_projection_.n > 0) s.mean_log_likelihood = LogLikelihood(s.shift);
     out.push_back(s);
   }
   return out;
@@ -202,6 +178,7 @@ std::vector<double> ResimScorer::DirectLogLikelihoods(const std::vector<sim::Sim
                                                       int placements) {
   std::vector<std::string> errors;
   std::vector<SampleSet> sets = Simulate(configs, placements, options_.seed + 1, &errors);
+  const Samples r = MakeSamples(real_, CommandMap(real_));
   std::vector<double> out;
   for (size_t i = 0; i < configs.size(); ++i) {
     if (!errors[i].empty() || sets[i].size() == 0) {
@@ -209,7 +186,6 @@ std::vector<double> ResimScorer::DirectLogLikelihoods(const std::vector<sim::Sim
       continue;
     }
     const Samples s = MakeSamples(sets[i], CommandMap(sets[i]));
-    const Samples r = MakeSamples(real_, CommandMap(real_));
     const LinearGaussianModel model = LinearGaussianModel::Fit(s, LinearGaussianOptions{});
     out.push_back(model.LogLikelihood(r).mean());
   }

@@ -19,6 +19,7 @@
 #include "core/sample_set.h"
 #include "sim/sim_config.h"
 #include "sim2real/pipeline.h"
+#include "sim2real/samples.h"
 
 namespace dgmm::sim2real {
 
@@ -62,15 +63,19 @@ class ResimScorer {
   const sim::SimConfig& nominal() const { return nominal_; }
 
  private:
+  // Normal equations of the whitened problem over a set of samples, y_k = L_k^-1 (x_k - u_k),
+  // W_k = L_k^-1 D_k under the sim model (the analysis' own FitProblem, effect_fit.h).
   struct Projection {
-    Eigen::MatrixXd a;  // sum W^T W (P x P)
-    Eigen::VectorXd b;  // sum W^T y (P)
+    Eigen::MatrixXd a;     // sum W^T W (P x P)
+    Eigen::VectorXd b;     // sum W^T y (P)
+    double yy = 0;         // sum y^T y
+    double log_norm = 0;   // sum (-log det Sigma_k / 2 - dx log(2 pi) / 2)
+    int n = 0;
   };
   // Simulates each config (same seed) in parallel; failed ones come back empty with an error.
   std::vector<SampleSet> Simulate(const std::vector<sim::SimConfig>& configs, int placements,
                                   std::uint64_t seed, std::vector<std::string>* errors);
-  Eigen::MatrixXd Design(const Eigen::VectorXd& u, const Eigen::Vector3d& g, bool first) const;
-  Projection Project(const SampleSet& set) const;
+  Projection Project(const Samples& samples) const;
   // Set command row -> sim model command (by label, else via the values of the real set).
   std::vector<int> CommandMap(const SampleSet& set) const;
   Eigen::VectorXd Solve(const Projection& p) const;
@@ -82,12 +87,7 @@ class ResimScorer {
   ResimOptions options_;
   int num_params_ = 0;
   int simulations_ = 0;
-  // Real samples, whitened by the sim model: y_r = L_r^-1 (x_r - u_r), W_r = L_r^-1 D_r.
-  Eigen::MatrixXd real_a_;  // sum W^T W
-  Eigen::VectorXd real_b_;  // sum W^T y
-  double real_yy_ = 0;      // sum y^T y
-  double real_const_ = 0;   // sum (-log det Sigma_r / 2 - dx log(2 pi) / 2)
-  int real_n_ = 0;
+  Projection real_projection_;  // of the real samples
   SampleSet nominal_set_;         // the nominal re-simulation (command table anchor)
   Eigen::VectorXd nominal_theta_;  // theta(nominal)
   std::map<std::string, ResimScore> cache_;  // by SimConfigToJson

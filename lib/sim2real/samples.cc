@@ -46,6 +46,10 @@ PoseLayout DetectPoseLayout(const SampleSet& set) {
   return layout;
 }
 
+Eigen::Vector3d BodyGravity(double pitch, double roll) {
+  return {std::sin(pitch), -std::sin(roll) * std::cos(pitch), -std::cos(roll) * std::cos(pitch)};
+}
+
 void DetectTerrainColumns(const SampleSet& set, int* pitch, int* roll) {
   *pitch = -1;
   *roll = -1;
@@ -81,7 +85,7 @@ Samples MakeSamples(const SampleSet& set, const std::vector<int>& command_map) {
     if (set.terrain_dim() > 0) s.z.row(k) = set.z.row(i);
     const double p = pitch_col >= 0 ? set.z(i, pitch_col) : 0.0;
     const double r = roll_col >= 0 ? set.z(i, roll_col) : 0.0;
-    s.gravity.row(k) << std::sin(p), -std::sin(r) * std::cos(p), -std::cos(r) * std::cos(p);
+    s.gravity.row(k) = BodyGravity(p, r).transpose();
     if (s.has_sequence) {
       s.episode.push_back(set.episode(i));
       s.first_execution.push_back(set.step(i) == 0 ? 1 : 0);

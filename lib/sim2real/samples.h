@@ -35,6 +35,10 @@ struct Samples {
   int terrain_dim() const { return static_cast<int>(z.cols()); }
 };
 
+// Unit gravity in the body frame at pitch p and roll r (ZYX Euler, x forward, y left, z up):
+// g_b = (sin p, -sin r cos p, -cos r cos p).
+Eigen::Vector3d BodyGravity(double pitch, double roll);
+
 // Index of the pitch and roll columns of z (by name, else columns 0 and 1), -1 when absent.
 void DetectTerrainColumns(const SampleSet& set, int* pitch, int* roll);
 

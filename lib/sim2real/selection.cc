@@ -145,9 +145,10 @@ SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows
               [](const auto& a, const auto& b) { return a.gain > b.gain; });
     // The best-gaining candidate among those whose gain is significant (a larger but noisier
     // gain does not stop a clearly significant one from being added).
-    auto eligible = std::find_if(step.candidates.begin(), step.candidates.end(), [&](const auto& c) {
+    const auto significant = [&](const CandidateScore& c) {
       return c.z > step.threshold_z && c.gain > options.min_gain_nats;
-    });
+    };
+    auto eligible = std::find_if(step.candidates.begin(), step.candidates.end(), significant);
     if (eligible == step.candidates.end()) {
       result.steps.push_back(step);
       break;
@@ -156,7 +157,7 @@ SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows
     // the best one's) whose gain is within one clustered SE of the paired difference is the
     // simpler explanation the data cannot beat, and is chosen instead.
     for (auto it = step.candidates.begin(); it != step.candidates.end(); ++it) {
-      if (it == eligible || !(it->z > step.threshold_z && it->gain > options.min_gain_nats)) continue;
+      if (it == eligible || !significant(*it)) continue;
       if (!NestedIn(fp, it->effect, eligible->effect)) continue;
       double diff, diff_se;
       ClusteredMean(heldout[eligible->effect] - heldout[it->effect], cluster, &diff, &diff_se);

@@ -5,6 +5,7 @@
 #include <numbers>
 #include <random>
 
+#include "sim2real/samples.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -77,8 +78,7 @@ SampleSet GenerateSynthetic(const SyntheticWorld& w, const std::string& protocol
         double pitch = std::asin(std::sin(alpha) * std::sin(psi)) + w.placement_jitter_rad * normal(rng);
         double roll = std::asin(std::sin(alpha) * std::cos(psi) / std::cos(pitch)) +
                       w.placement_jitter_rad * normal(rng);
-        Eigen::Vector3d g(std::sin(pitch), -std::sin(roll) * std::cos(pitch),
-                          -std::cos(roll) * std::cos(pitch));
+        const Eigen::Vector3d g = BodyGravity(pitch, roll);
         for (int step = 0; step < 5 && n < total; ++step, ++n) {
           Eigen::VectorXd u = Nominal(table[c], g);
           Eigen::VectorXd x = u + bias;
