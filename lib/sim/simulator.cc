@@ -74,7 +74,7 @@ namespace {
 void QuietWarning(const char*) {}
 }  // namespace
 
-Simulator::Simulator(const SimConfig& config) : impl_(std::make_unique<Impl>()) {
+Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std::make_unique<Impl>()) {
   if (mju_user_warning == nullptr) mju_user_warning = QuietWarning;
   std::string error;
   if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
@@ -83,6 +83,7 @@ Simulator::Simulator(const SimConfig& config) : impl_(std::make_unique<Impl>()) 
   impl_->model = LoadRobotModel(config);
   impl_->parts = FindRobotParts(impl_->model.get(), config, source);
   ApplyConfig(config, impl_->parts, impl_->model.get(), source);
+  if (edit) edit(impl_->model.get());
   impl_->data.reset(mj_makeData(impl_->model.get()));
   mj_setConst(impl_->model.get(), impl_->data.get());
   const double a = config.slope_deg * M_PI / 180;
