@@ -188,6 +188,26 @@ TEST_F(SimulatorTest, UserRobotWithOtherNamesWalks) {
   std::filesystem::remove_all(dir);
 }
 
+// The battery's second robot (datasets/robots/harvestman.json: longer splayed legs, lighter
+// torso) walks on the 18 degree slope in every heading without falling.
+TEST_F(SimulatorTest, SecondRobotWalksOnTheSlope) {
+  const SimConfig c = LoadSimConfig(std::string(DGMM_SOURCE_DIR) + "/datasets/robots/harvestman.json");
+  Simulator sim(c);
+  const double kDocumentedMassKg = 5.5 + 8 * (0.10 + 0.20 + 0.12);  // datasets/robots/harvestman.xml
+  EXPECT_NEAR(sim.total_mass_kg(), kDocumentedMassKg, 1e-3);
+  EXPECT_NEAR(sim.legs()[0].tibia_m, 0.19, 1e-3);
+  const double kSlopeTravelM = 0.08;  // nominal 0.3 m at command 0.5 (stride 0.10 m)
+  for (double heading : {kUphill, kAcross, kDownhill, -kAcross}) {
+    SCOPED_TRACE(heading);
+    EXPECT_GT(RunOnce(sim, {0.5, 0, 0}, heading)[0], kSlopeTravelM);
+    EXPECT_LT(RunOnce(sim, {0, -0.5, 0}, heading)[1], -kSlopeTravelM);
+    EXPECT_GT(RunOnce(sim, {0, 0, 0.5}, heading)[5], kMinTurnRad);
+    // Five executions in a row, as the paper protocol does, without a fall.
+    ASSERT_EQ(sim.Place(0, 0, heading), RunOutcome::kCompleted);
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(sim.RunCommand({1, 0.5, -0.5}), RunOutcome::kCompleted);
+  }
+}
+
 TEST_F(SimulatorTest, BrokenUserRobotsAreInputErrors) {
   const auto dir = std::filesystem::temp_directory_path() / "dgmm_sim_bad_robot";
   std::filesystem::create_directories(dir);
