@@ -17,11 +17,12 @@ OLD_EFFECT_FAMILY = {
 }
 
 # Words a reported knob name must contain to be the planted knob (knob names are the method's
-# own, found from the model; only the physical quantity is compared).
+# own, found from the model; only the physical quantity is compared). A weak leg must be named by
+# its index ("leg3"), a weak side by "left"/"right".
 KNOB_WORDS = {
     "friction.sliding": ["slid"], "floor.solref.timeconst": ["time"],
-    "floor.solref.dampratio": ["damp"], "masses.scale": ["mass"], "payload.mass_kg": ["payload"],
-    "actuators.kp_nm_per_rad": ["kp", "gain"], "actuators.joint_damping_nms_per_rad": ["damp"],
+    "floor.solref.dampratio": ["damp"], "masses.scale": ["mass"], "payload.mass_kg": ["mass"],
+    "actuators.kp_nm_per_rad": ["kp"], "actuators.joint_damping_nms_per_rad": ["damp"],
     "actuators.latency_s": ["laten", "delay"],
 }
 
@@ -62,26 +63,31 @@ def found_families(verdict):
 def knob_matches(truth_knob, named_knob):
     if truth_knob is None or named_knob is None:
         return False
-    words = KNOB_WORDS.get(truth_knob)
-    if truth_knob.startswith("actuators.leg_gain") or truth_knob.startswith("imu") or \
-            truth_knob.startswith("tracker"):
-        return True  # per-leg/per-side gain, measurement effects: the family's value is compared
-    return any(w in named_knob.lower() for w in words or [])
+    named = named_knob.lower().replace(" ", "").replace("_", "")
+    if truth_knob.startswith("actuators.leg_gain["):
+        which = truth_knob[len("actuators.leg_gain["):-1]
+        return (f"leg{which}" in named) if which.isdigit() else which in named
+    if truth_knob.startswith("imu") or truth_knob.startswith("tracker"):
+        return True  # measurement effects: one knob per family
+    return any(w in named for w in KNOB_WORDS.get(truth_knob, []))
 
 
 def value_error(effect, verdict):
-    """Relative error of the named value of the planted effect's family, or None if unnamed."""
-    for n in verdict.get("named") or []:
-        if n.get("family") != effect["family"] or n.get("value") is None:
-            continue
+    """Relative error of the named value of the planted knob, or None when the family is not
+    named with a value; error None when only other knobs of the family are named."""
+    entries = [n for n in verdict.get("named") or []
+               if n.get("family") == effect["family"] and n.get("value") is not None]
+    if not entries:
+        return None
+    for n in entries:
         if not knob_matches(effect["knob"], n.get("knob")):
-            return {"error": None, "reported": n.get("value"), "knob": n.get("knob"),
-                    "why": "another knob of the family"}
+            continue
         planted, got = effect["value"], float(n["value"])
         if effect["family"] in ("imu_bias", "tracker_bias"):  # "largest offset": magnitude
             planted, got = abs(planted), abs(got)
         return {"error": (got - planted) / abs(planted), "reported": got, "knob": n.get("knob")}
-    return None
+    return {"error": None, "reported": entries[0].get("value"), "knob": entries[0].get("knob"),
+            "why": "another knob of the family"}
 
 
 def column_of(verdict, truth_families):

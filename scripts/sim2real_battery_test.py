@@ -130,6 +130,17 @@ class ScoreTest(unittest.TestCase):
         other = verdict("explained", [name("friction", "floor.friction.torsional", 0.6)])
         v = score.score_pair(pair("single", FRICTION), other)["values"]["friction"]
         self.assertIsNone(v["error"])
+        leg3 = {"family": "actuator_gain", "knob": "actuators.leg_gain[3]", "value": 0.5}
+        for knob, ok in [("actuators.leg3.gain", True), ("actuators.leg5.gain", False),
+                         ("actuators.left_side.gain", False)]:
+            got = verdict("explained", [name("actuator_gain", knob, 0.55)])
+            v = score.score_pair(pair("single", leg3), got)["values"]["actuator_gain"]
+            self.assertEqual(v["error"] is not None, ok, knob)
+        # The payload's mass is compared even when its position is named first.
+        both = verdict("explained", [name("payload", "payload.position_x_m", 0.1),
+                                     name("payload", "payload.mass_kg", 2.2)])
+        v = score.score_pair(pair("single", PAYLOAD), both)["values"]["payload"]
+        self.assertAlmostEqual(v["error"], 0.1)
 
     def test_two_effects_and_out_of_library(self):
         both = verdict("explained", [name("payload"), name("friction")])
