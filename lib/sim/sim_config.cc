@@ -106,7 +106,9 @@ bool SimConfig::IsValid(std::string* error) const {
       !Check(Finite(a.kp_nm_per_rad) && a.kp_nm_per_rad > 0 && Finite(a.torque_limit_nm) &&
                  a.torque_limit_nm > 0 && Finite(a.joint_damping_nms_per_rad) &&
                  a.joint_damping_nms_per_rad >= 0,
-             "actuators: expected positive kp and torque limit, non-negative damping", error))
+             "actuators: expected positive kp and torque limit, non-negative damping", error) ||
+      !Check(Finite(a.latency_s) && a.latency_s >= 0 && a.latency_s <= 0.2,
+             "actuators.latency_s: expected a value in [0, 0.2] s", error))
     return false;
   for (int i = 0; i < kNumLegs; ++i) {
     if (!Check(Finite(a.leg_gain[i]) && a.leg_gain[i] > 0 && a.leg_gain[i] <= 10,
@@ -181,6 +183,7 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
     a.Numbers<kNumLegs>("leg_gain", &c.actuators.leg_gain);
     a.Number("joint_damping_nms_per_rad", &c.actuators.joint_damping_nms_per_rad);
     a.Number("torque_limit_nm", &c.actuators.torque_limit_nm);
+    a.Number("latency_s", &c.actuators.latency_s);
     a.CheckNoUnknownKeys();
   }
   {
@@ -247,7 +250,8 @@ std::string SimConfigToJson(const SimConfig& c) {
   j["actuators"] = {{"kp_nm_per_rad", c.actuators.kp_nm_per_rad},
                     {"leg_gain", c.actuators.leg_gain},
                     {"joint_damping_nms_per_rad", c.actuators.joint_damping_nms_per_rad},
-                    {"torque_limit_nm", c.actuators.torque_limit_nm}};
+                    {"torque_limit_nm", c.actuators.torque_limit_nm},
+                    {"latency_s", c.actuators.latency_s}};
   j["gait"] = {{"period_s", c.gait.period_s},
                {"stride_m", c.gait.stride_m},
                {"turn_rad", c.gait.turn_rad},

@@ -1,6 +1,7 @@
 #include "sim/simulator.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 
 #include "sim/mujoco_model.h"
@@ -16,12 +17,41 @@ struct Simulator::Impl {
   Eigen::Vector3d up;
   double time_s = 0;
 
-  // Sets the leg actuator targets to the joint angles reaching the given foot targets.
-  void SetFootTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) {
+  // Joint targets of all legs (leg-major: leg * 3 + joint).
+  using Targets = std::array<double, 3 * kNumLegs>;
+  // Actuation latency: targets in flight, a ring of latency_steps entries; `pending[head]` is
+  // the oldest (computed latency_steps steps ago) and is the one the servos see now.
+  std::vector<Targets> pending;
+  int head = 0;
+
+  Targets JointTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) const {
+    Targets q;
     for (int leg = 0; leg < kNumLegs; ++leg) {
-      const LegAngles q = LegInverse(parts.legs[leg], feet[leg]);
-      for (int j = 0; j < 3; ++j) data->ctrl[parts.actuator[leg][j]] = q[j];
+      const LegAngles angles = LegInverse(parts.legs[leg], feet[leg]);
+      for (int j = 0; j < 3; ++j) q[3 * leg + j] = angles[j];
     }
+    return q;
+  }
+  void WriteCtrl(const Targets& q) {
+    for (int leg = 0; leg < kNumLegs; ++leg) {
+      for (int j = 0; j < 3; ++j) data->ctrl[parts.actuator[leg][j]] = q[3 * leg + j];
+    }
+  }
+  // Sets the servo targets at once and fills the latency line with them (no targets in flight).
+  void ResetFootTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) {
+    const Targets q = JointTargets(feet);
+    std::fill(pending.begin(), pending.end(), q);
+    head = 0;
+    WriteCtrl(q);
+  }
+  // Sends the joint angles reaching the given foot targets; the servos see them after the
+  // configured latency (at once when it is zero).
+  void SetFootTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) {
+    const Targets q = JointTargets(feet);
+    if (pending.empty()) return WriteCtrl(q);
+    WriteCtrl(pending[head]);
+    pending[head] = q;
+    head = (head + 1) % static_cast<int>(pending.size());
   }
   std::array<Eigen::Vector3d, kNumLegs> NominalFeet() const {
     std::array<Eigen::Vector3d, kNumLegs> feet;
@@ -85,6 +115,9 @@ Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std
   ApplyConfig(config, impl_->parts, impl_->model.get(), source);
   if (edit) edit(impl_->model.get());
   impl_->data.reset(mj_makeData(impl_->model.get()));
+  const int latency_steps =
+      static_cast<int>(std::lround(config.actuators.latency_s / config.timestep_s));
+  impl_->pending.resize(latency_steps);
   mj_setConst(impl_->model.get(), impl_->data.get());
   const double a = config.slope_deg * M_PI / 180;
   impl_->up = Eigen::Vector3d(std::sin(a), 0, std::cos(a));
@@ -111,7 +144,7 @@ RunOutcome Simulator::Place(double x_m, double y_m, double heading_rad) {
   d->qpos[q0 + 4] = 0;
   d->qpos[q0 + 5] = 0;
   d->qpos[q0 + 6] = std::sin(heading_rad / 2);
-  s.SetFootTargets(feet);
+  s.ResetFootTargets(feet);
   mj_forward(m, d);
   return Stand(s.config.settle_duration_s);
 }

@@ -23,6 +23,7 @@ TEST(SimConfigTest, JsonRoundTripKeepsEveryField) {
   c.payload.mass_kg = 1.5;
   c.payload.position_body_m = Eigen::Vector3d(0.05, -0.1, 0.06);
   c.actuators.leg_gain[3] = 0.4;
+  c.actuators.latency_s = 0.03;
   c.noise.imu_roll_sd_rad = 0.02;
   c.mjcf_path = "/tmp/robot.xml";
   c.names.torso_body = "body";
@@ -30,6 +31,7 @@ TEST(SimConfigTest, JsonRoundTripKeepsEveryField) {
   EXPECT_EQ(SimConfigToJson(back), SimConfigToJson(c));
   EXPECT_DOUBLE_EQ(back.payload.position_body_m.y(), -0.1);
   EXPECT_DOUBLE_EQ(back.actuators.leg_gain[3], 0.4);
+  EXPECT_DOUBLE_EQ(back.actuators.latency_s, 0.03);
   EXPECT_EQ(back.names.torso_body, "body");
 }
 
@@ -52,6 +54,8 @@ TEST(SimConfigTest, RejectsBadInputNamingTheField) {
       {R"({"actuators": {"leg_gain": [1, 1]}})", "actuators.leg_gain"},
       {R"({"actuators": {"leg_gain": [1, 1, 1, 1, 1, 1, 1, 0]}})", "leg_gain"},
       {R"({"masses": {"torso_kg": -1}})", "masses"},
+      {R"({"actuators": {"latency_s": 0.3}})", "actuators.latency_s"},
+      {R"({"actuators": {"latency_s": -0.01}})", "actuators.latency_s"},
       {R"({"command_duration_s": 1.2})", "command_duration_s"},
       {R"({"timestep_s": 0})", "timestep_s"},
       {R"([1, 2])", "object"},

@@ -108,6 +108,46 @@ TEST_F(SimulatorTest, SameConfigSameTrajectory) {
   EXPECT_EQ(RunOnce(a, {0.5, 0.5, 0.5}, 1.0), RunOnce(b, {0.5, 0.5, 0.5}, 1.0));
 }
 
+// Torso poses after every step of one command from a fresh placement (optionally standing
+// `stand_s` first, which the latency test uses as the reference delay).
+std::vector<Pose> StepPoses(Simulator& sim, const Eigen::Vector3d& command, double stand_s = 0) {
+  EXPECT_EQ(sim.Place(0, 0, 0), RunOutcome::kCompleted);
+  std::vector<Pose> poses;
+  const auto record = [&](const Simulator& s) { poses.push_back(s.TorsoPose()); };
+  if (stand_s > 0) {
+    const int steps = static_cast<int>(std::lround(stand_s / sim.config().timestep_s));
+    for (int i = 0; i < steps; ++i) {
+      EXPECT_EQ(sim.Stand(sim.config().timestep_s), RunOutcome::kCompleted);
+      record(sim);
+    }
+  }
+  EXPECT_EQ(sim.RunCommand(command, record, 1), RunOutcome::kCompleted);
+  return poses;
+}
+
+// With latency L the servos see each target L later: after a placement (constant targets, so no
+// targets in flight) running a command equals standing for L and then running it without
+// latency, step for step, and differs from running it at once.
+TEST_F(SimulatorTest, LatencyDelaysServoTargets) {
+  SimConfig delayed = Flat();
+  delayed.actuators.latency_s = 0.05;
+  Simulator lagging(delayed), prompt(Flat());
+  const Eigen::Vector3d command(0.5, 0, 0.3);
+  const std::vector<Pose> lag = StepPoses(lagging, command);
+  const std::vector<Pose> reference = StepPoses(prompt, command, delayed.actuators.latency_s);
+  const std::vector<Pose> at_once = StepPoses(prompt, command);
+  ASSERT_EQ(lag.size(), at_once.size());
+  const double kSameM = 1e-9;  // same state, same controls: identical up to rounding
+  double max_diff = 0, max_diff_at_once = 0;
+  for (size_t i = 0; i < lag.size(); ++i) {
+    max_diff = std::max(max_diff, (lag[i].position_m - reference[i].position_m).norm());
+    max_diff_at_once = std::max(max_diff_at_once, (lag[i].position_m - at_once[i].position_m).norm());
+  }
+  EXPECT_LT(max_diff, kSameM);
+  const double kVisibleM = 0.01;  // 50 ms of a walking gait moves the torso by centimetres
+  EXPECT_GT(max_diff_at_once, kVisibleM);
+}
+
 TEST_F(SimulatorTest, TippingOverIsReportedAsAFall) {
   SimConfig c;
   c.slope_deg = 30;
@@ -146,6 +186,26 @@ TEST_F(SimulatorTest, UserRobotWithOtherNamesWalks) {
   Simulator sim(c);
   EXPECT_GT(RunOnce(sim, {0.5, 0, 0})[0], kMinTravelM);
   std::filesystem::remove_all(dir);
+}
+
+// The battery's second robot (datasets/robots/harvestman.json: longer splayed legs, lighter
+// torso) walks on the 18 degree slope in every heading without falling.
+TEST_F(SimulatorTest, SecondRobotWalksOnTheSlope) {
+  const SimConfig c = LoadSimConfig(std::string(DGMM_SOURCE_DIR) + "/datasets/robots/harvestman.json");
+  Simulator sim(c);
+  const double kDocumentedMassKg = 5.5 + 8 * (0.10 + 0.20 + 0.12);  // datasets/robots/harvestman.xml
+  EXPECT_NEAR(sim.total_mass_kg(), kDocumentedMassKg, 1e-3);
+  EXPECT_NEAR(sim.legs()[0].tibia_m, 0.19, 1e-3);
+  const double kSlopeTravelM = 0.08;  // nominal 0.3 m at command 0.5 (stride 0.10 m)
+  for (double heading : {kUphill, kAcross, kDownhill, -kAcross}) {
+    SCOPED_TRACE(heading);
+    EXPECT_GT(RunOnce(sim, {0.5, 0, 0}, heading)[0], kSlopeTravelM);
+    EXPECT_LT(RunOnce(sim, {0, -0.5, 0}, heading)[1], -kSlopeTravelM);
+    EXPECT_GT(RunOnce(sim, {0, 0, 0.5}, heading)[5], kMinTurnRad);
+    // Five executions in a row, as the paper protocol does, without a fall.
+    ASSERT_EQ(sim.Place(0, 0, heading), RunOutcome::kCompleted);
+    for (int i = 0; i < 5; ++i) EXPECT_EQ(sim.RunCommand({1, 0.5, -0.5}), RunOutcome::kCompleted);
+  }
 }
 
 TEST_F(SimulatorTest, BrokenUserRobotsAreInputErrors) {

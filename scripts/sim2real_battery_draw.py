@@ -1,0 +1,211 @@
+"""Concealed-effect pairs for scripts/sim2real_battery.py: what is drawn from a seed and how it is
+planted (issue #9, "Proof, blinded"). Ranges are physical and fixed before any result was seen;
+docs/sim2real.md ("Blinded battery") lists them. Nothing here looks at an analysis.
+
+A pair is drawn from numpy's default_rng(seed) alone: same seed, same pair. Each planted effect is
+a dict {family, knob, value, unit, nominal, what, config, mjcf, data}: `config` edits the sim
+config JSON of the "real" robot, `mjcf` edits a copy of its MJCF, `data` edits the recorded set.
+"""
+import re
+
+import numpy as np
+
+# Families of the report.json verdict contract (docs/sim2real.md, "report.json verdict").
+PHYSICS = ["friction", "contact", "mass", "payload", "actuator_gain", "joint_damping", "latency"]
+MEASUREMENT = ["imu_bias", "tracker_bias", "tracker_noise", "heading_drift"]
+FAMILIES = PHYSICS + MEASUREMENT
+OUT_OF_LIBRARY = ["periodic_pitch", "fatigue"]
+
+# Shares of the pair kinds (issue #9: ~20% nulls, ~20% two effects, ~10% outside every library);
+# the rest are single in-library effects. A share of pairs runs on the second robot.
+P_NULL, P_TWO, P_OOL = 0.2, 0.2, 0.1
+P_SECOND_ROBOT = 0.15
+
+
+# Physical ranges, fixed before any analysis result was seen (docs/sim2real.md lists them):
+# (lo, hi) of a uniform draw; pairs of ranges are chosen with the probability next to them.
+RANGES = {
+    "friction.sliding": [(0.75, (0.45, 0.85)), (0.25, (1.3, 2.0))],
+    "floor.solref.timeconst": (0.04, 0.1),      # s, log-uniform; nominal 0.02 (MuJoCo default)
+    "floor.solref.dampratio": [(0.5, (0.2, 0.5)), (0.5, (2.0, 4.0))],  # nominal 1
+    "masses.scale": [(0.6, (1.15, 1.5)), (0.4, (0.7, 0.87))],
+    "payload.mass_kg": (1.0, 4.0),
+    "leg_gain.one_leg": (0.3, 0.7),
+    "leg_gain.one_side": (0.5, 0.8),
+    "kp.scale": [(0.6, (0.5, 0.8)), (0.4, (1.3, 2.0))],
+    "joint_damping.scale": [(0.75, (2.5, 8.0)), (0.25, (0.2, 0.4))],
+    "latency_s": (0.01, 0.06),
+    "imu_bias_rad": (0.02, 0.07),               # per biased axis, random sign
+    "tracker_bias_m": (0.004, 0.015),           # per biased axis, random sign
+    "tracker_noise.scale": (1.6, 3.0),
+    "heading_drift_rad": (0.01, 0.04),          # per execution, random sign
+    "ool.periodic_pitch_rad": (0.015, 0.03),
+    "ool.fatigue_rate": (0.15, 0.3),
+}
+
+
+def _range(rng, key):
+    r = RANGES[key]
+    if isinstance(r, list):
+        r = r[0][1] if rng.random() < r[0][0] else r[1][1]
+    return float(rng.uniform(*r))
+
+
+def _signed(rng, lo, hi):
+    return float(rng.choice([-1.0, 1.0]) * rng.uniform(lo, hi))
+
+
+def _log_uniform(rng, lo, hi):
+    return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
+
+
+def draw_effect(family, rng, nominal, robot):
+    """One planted effect of `family` for a robot whose nominal sim config is `nominal` (dict)."""
+    act = nominal["actuators"]
+    e = {"family": family, "config": {}, "mjcf": None, "data": None}
+    if family == "friction":
+        # Sliding friction only: both robots use condim-3 contacts, for which MuJoCo ignores the
+        # torsional coefficient (a torsional change would be a null in disguise).
+        v = _range(rng, "friction.sliding")
+        e.update(knob="friction.sliding", value=v, unit="", nominal=nominal["friction"]["sliding"],
+                 what=f"ground sliding friction {v:.2f}")
+        e["config"] = {"friction": {"sliding": v}}
+    elif family == "contact":
+        if rng.random() < 0.7:  # softer ground (time constant), damping ratio 1 as MuJoCo's default
+            tc, dr = _log_uniform(rng, *RANGES["floor.solref.timeconst"]), 1.0
+            e.update(knob="floor.solref.timeconst", value=tc, unit="s", nominal=0.02,
+                     what=f"floor solref time constant {tc:.3f} s (nominal 0.02)")
+        else:  # bouncier or more damped ground
+            tc, dr = 0.02, _range(rng, "floor.solref.dampratio")
+            e.update(knob="floor.solref.dampratio", value=dr, unit="", nominal=1.0,
+                     what=f"floor solref damping ratio {dr:.2f} (nominal 1)")
+        e["mjcf"] = {"floor_solref": [tc, dr]}
+    elif family == "mass":
+        s = _range(rng, "masses.scale")
+        e.update(knob="masses.scale", value=s, unit="", nominal=1.0,
+                 what=f"all body masses x{s:.2f}")
+        e["config"] = {"masses": {k: v * s for k, v in nominal["masses"].items()}}
+    elif family == "payload":
+        m = _range(rng, "payload.mass_kg")
+        half = {"scorpion": (0.2, 0.12), "harvestman": (0.15, 0.09)}[robot]
+        pos = [float(rng.uniform(-half[0], half[0])), float(rng.uniform(-half[1], half[1])), 0.05]
+        e.update(knob="payload.mass_kg", value=m, unit="kg", nominal=0.0, position_body_m=pos,
+                 what=f"{m:.1f} kg payload at ({pos[0]:+.2f}, {pos[1]:+.2f}, 0.05) m")
+        e["config"] = {"payload": {"mass_kg": m, "position_body_m": pos}}
+    elif family == "actuator_gain":
+        gains = list(act["leg_gain"])
+        kind = rng.choice(["leg", "side", "all"])
+        if kind == "leg":
+            leg, g = int(rng.integers(0, 8)), _range(rng, "leg_gain.one_leg")
+            gains[leg] = g
+            e.update(knob=f"actuators.leg_gain[{leg}]", value=g, what=f"leg {leg} at {g:.2f} gain")
+            e["config"] = {"actuators": {"leg_gain": gains}}
+        elif kind == "side":
+            side, g = int(rng.integers(0, 2)), _range(rng, "leg_gain.one_side")
+            for leg in range(4 * side, 4 * side + 4):
+                gains[leg] = g
+            e.update(knob=f"actuators.leg_gain[{'left' if side == 0 else 'right'}]", value=g,
+                     what=f"{'left' if side == 0 else 'right'} legs at {g:.2f} gain")
+            e["config"] = {"actuators": {"leg_gain": gains}}
+        else:
+            g = _range(rng, "kp.scale")
+            e.update(knob="actuators.kp_nm_per_rad", value=g,
+                     what=f"servo kp x{g:.2f} on all legs")
+            e["config"] = {"actuators": {"kp_nm_per_rad": act["kp_nm_per_rad"] * g}}
+        e.update(unit="", nominal=1.0)  # contract: the gain factor of the weakest leg
+    elif family == "joint_damping":
+        s = _range(rng, "joint_damping.scale")
+        e.update(knob="actuators.joint_damping_nms_per_rad", value=s, unit="", nominal=1.0,
+                 what=f"joint damping x{s:.2f}")
+        e["config"] = {"actuators": {"joint_damping_nms_per_rad":
+                                     act["joint_damping_nms_per_rad"] * s}}
+    elif family == "latency":
+        lat = round(_range(rng, "latency_s"), 3)
+        e.update(knob="actuators.latency_s", value=lat, unit="s", nominal=0.0,
+                 what=f"actuation latency {1000 * lat:.0f} ms")
+        e["config"] = {"actuators": {"latency_s": lat}}
+    elif family == "imu_bias":
+        b = [0.0, 0.0]
+        axes = [[0], [1], [0, 1]][int(rng.integers(0, 3))]
+        for a in axes:
+            b[a] = _signed(rng, *RANGES["imu_bias_rad"])
+        e.update(knob="imu.bias", value=max(abs(v) for v in b), unit="rad", nominal=0.0,
+                 what=f"IMU bias pitch {np.degrees(b[0]):+.1f} deg, roll {np.degrees(b[1]):+.1f} deg")
+        e["data"] = {"z_add": {"pitch": b[0], "roll": b[1]}}
+    elif family == "tracker_bias":
+        b = {"dx": 0.0, "dy": 0.0}
+        for k in [["dx"], ["dy"], ["dx", "dy"]][int(rng.integers(0, 3))]:
+            b[k] = _signed(rng, *RANGES["tracker_bias_m"])
+        e.update(knob="tracker.bias", value=max(abs(v) for v in b.values()), unit="m",
+                 nominal=0.0, what=f"tracker bias dx {1000 * b['dx']:+.1f} mm, dy {1000 * b['dy']:+.1f} mm")
+        e["data"] = {"x_add": b}
+    elif family == "tracker_noise":
+        s = _range(rng, "tracker_noise.scale")
+        n = nominal["noise"]
+        sd = {"dx": n["tracker_position_sd_m"], "dy": n["tracker_position_sd_m"],
+              "dz": n["tracker_position_sd_m"], "droll": n["tracker_roll_sd_rad"],
+              "dpitch": n["tracker_pitch_sd_rad"], "dyaw": n["tracker_yaw_sd_rad"]}
+        extra = {k: v * float(np.sqrt(s * s - 1)) for k, v in sd.items()}
+        e.update(knob="tracker.noise_scale", value=s, unit="", nominal=1.0,
+                 what=f"tracker noise x{s:.2f}")
+        e["data"] = {"x_noise_sd": extra}
+    elif family == "heading_drift":
+        d = _signed(rng, *RANGES["heading_drift_rad"])
+        e.update(knob="tracker.heading_drift", value=d, unit="rad", nominal=0.0,
+                 what=f"heading drift {d:+.3f} rad per execution")
+        e["data"] = {"x_add": {"dyaw": d}}
+    else:
+        raise ValueError(family)
+    return e
+
+
+def draw_out_of_library(rng):
+    """An effect no library has: a step-periodic pitch oscillation or a fatigue drift."""
+    kind = OUT_OF_LIBRARY[int(rng.integers(0, 2))]
+    if kind == "periodic_pitch":
+        amp, period, phase = _range(rng, "ool.periodic_pitch_rad"), int(rng.choice([2, 3])), float(rng.uniform(0, 2 * np.pi))
+        return {"family": "out_of_library", "kind": kind, "knob": None, "value": amp, "unit": "rad",
+                "what": f"pitch oscillation {np.degrees(amp):.1f} deg, period {period} steps",
+                "config": {}, "mjcf": None,
+                "data": {"periodic": {"column": "dpitch", "amp": amp, "period": period, "phase": phase}}}
+    rate = _range(rng, "ool.fatigue_rate")
+    return {"family": "out_of_library", "kind": kind, "knob": None, "value": rate, "unit": "",
+            "what": f"fatigue: strides and turns shrink linearly to {100 * (1 - rate):.0f}% over the session",
+            "config": {}, "mjcf": None, "data": {"fatigue": {"rate": rate}}}
+
+
+def draw_pair(seed, nominals):
+    """The concealed pair of `seed`: robot, kind and planted effects (list, empty for a null)."""
+    rng = np.random.default_rng(seed)
+    robot = "harvestman" if rng.random() < P_SECOND_ROBOT else "scorpion"
+    u = rng.random()
+    kind = "null" if u < P_NULL else "two" if u < P_NULL + P_TWO else \
+        "out_of_library" if u < P_NULL + P_TWO + P_OOL else "single"
+    if robot == "harvestman" and kind in ("two", "out_of_library"):
+        kind = "single"  # the second robot is tried on single effects and nulls
+    if kind == "null":
+        effects = []
+    elif kind == "out_of_library":
+        effects = [draw_out_of_library(rng)]
+    else:
+        families = list(rng.choice(FAMILIES, size=2 if kind == "two" else 1, replace=False))
+        effects = [draw_effect(str(f), rng, nominals[robot], robot) for f in families]
+    return {"seed": seed, "robot": robot, "kind": kind, "effects": effects,
+            "real_seed": 100000 + seed}
+
+
+def merge(base, edit):
+    """Recursive dict update (config edits)."""
+    out = dict(base)
+    for k, v in edit.items():
+        out[k] = merge(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def edit_mjcf(xml, edit):
+    """Applies an `mjcf` edit to MJCF text; the floor geom must be named "floor"."""
+    tc, dr = edit["floor_solref"]
+    new, n = re.subn(r'<geom name="floor"', f'<geom name="floor" solref="{tc:.5f} {dr:.4f}"', xml)
+    if n != 1:
+        raise ValueError("MJCF: expected one geom named floor")
+    return new

@@ -1,0 +1,175 @@
+"""Scoring of report.json verdicts against the concealed truth for scripts/sim2real_battery.py.
+
+The contract is the `verdict` object of docs/sim2real.md ("report.json verdict"). Reports written
+before it existed (a top-level `effects` list) are mapped onto families by OLD_EFFECT_FAMILY so
+the battery runs end to end on either.
+"""
+import statistics
+
+CONFIDENT = 0.8   # issue #9: "confident wrong" = inclusion >= 80%, no tie reported
+VALUE_TOL = 0.25  # issue #9: knob value within +-25% of the planted one
+
+# Fallback for reports without a verdict: the old hand-written effect library.
+OLD_EFFECT_FAMILY = {
+    "slope_slip": "friction", "slope_traction": "friction", "stride_loss": "actuator_gain",
+    "payload_offset": "payload", "actuator_asymmetry": "actuator_gain", "latency": "latency",
+    "compliance": "contact", "bias": "tracker_bias", "noise": "tracker_noise",
+}
+
+# Words a reported knob name must contain to be the planted knob (knob names are the method's
+# own, found from the model; only the physical quantity is compared). A weak leg must be named by
+# its index ("leg3"), a weak side by "left"/"right".
+KNOB_WORDS = {
+    "friction.sliding": ["slid"], "floor.solref.timeconst": ["time"],
+    "floor.solref.dampratio": ["damp"], "masses.scale": ["mass"], "payload.mass_kg": ["mass"],
+    "actuators.kp_nm_per_rad": ["kp"], "actuators.joint_damping_nms_per_rad": ["damp"],
+    "actuators.latency_s": ["laten", "delay"],
+}
+
+
+def verdict_of(report):
+    """The report's verdict, or one built from an old report's effects list."""
+    if isinstance(report.get("verdict"), dict):
+        return report["verdict"], False
+    named = [{"family": OLD_EFFECT_FAMILY.get(e.get("effect"), e.get("effect")), "knob": None,
+              "value": None, "inclusion": e.get("inclusion_probability"), "tie_group": None}
+             for e in report.get("effects", [])]
+    unexplained = bool(report.get("unexplained"))
+    located = report.get("conditional_flagged_regions", 0) > 0
+    status = ("clean" if not located and not named else "unexplained" if not named
+              else "partly_explained" if unexplained else "explained")
+    return {"status": status, "named": named, "ties": [],
+            "unexplained": {"present": unexplained, "structured_in": []},
+            "gap_closed": report.get("gap_closed")}, True
+
+
+def tie_families(verdict, entry):
+    """Families reported as indistinguishable from `entry` (its own family included)."""
+    fams = {entry.get("family")}
+    g = entry.get("tie_group")
+    ties = verdict.get("ties") or []
+    if isinstance(g, int) and 0 <= g < len(ties):
+        fams |= set(ties[g].get("families", []))
+    return fams
+
+
+def found_families(verdict):
+    fams = set()
+    for n in verdict.get("named") or []:
+        fams |= tie_families(verdict, n)
+    return fams
+
+
+def knob_matches(truth_knob, named_knob):
+    if truth_knob is None or named_knob is None:
+        return False
+    named = named_knob.lower().replace(" ", "").replace("_", "")
+    if truth_knob.startswith("actuators.leg_gain["):
+        which = truth_knob[len("actuators.leg_gain["):-1]
+        return (f"leg{which}" in named) if which.isdigit() else which in named
+    if truth_knob.startswith("imu") or truth_knob.startswith("tracker"):
+        return True  # measurement effects: one knob per family
+    return any(w in named for w in KNOB_WORDS.get(truth_knob, []))
+
+
+def value_error(effect, verdict):
+    """Relative error of the named value of the planted knob, or None when the family is not
+    named with a value; error None when only other knobs of the family are named."""
+    entries = [n for n in verdict.get("named") or []
+               if n.get("family") == effect["family"] and n.get("value") is not None]
+    if not entries:
+        return None
+    for n in entries:
+        if not knob_matches(effect["knob"], n.get("knob")):
+            continue
+        planted, got = effect["value"], float(n["value"])
+        if effect["family"] in ("imu_bias", "tracker_bias"):  # "largest offset": magnitude
+            planted, got = abs(planted), abs(got)
+        return {"error": (got - planted) / abs(planted), "reported": got, "knob": n.get("knob")}
+    return {"error": None, "reported": entries[0].get("value"), "knob": entries[0].get("knob"),
+            "why": "another knob of the family"}
+
+
+def column_of(verdict, truth_families):
+    """Confusion-matrix column: the first named family, tie, unexplained or none."""
+    named = verdict.get("named") or []
+    if not named:
+        return "unexplained" if verdict.get("status") in ("unexplained", "partly_explained") \
+            or (verdict.get("unexplained") or {}).get("present") else "none"
+    first = named[0]
+    if first.get("family") not in truth_families and truth_families & tie_families(verdict, first):
+        return "tie"
+    return first.get("family")
+
+
+def score_pair(pair, report):
+    """Scores of one pair (dict) given its truth `pair` and the parsed report.json."""
+    verdict, fallback = verdict_of(report)
+    truth = {e["family"] for e in pair["effects"] if e["family"] != "out_of_library"}
+    named = verdict.get("named") or []
+    first = named[0] if named else None
+    s = {"status": verdict.get("status"), "fallback_mapping": fallback,
+         "named": [[n.get("family"), n.get("knob"), n.get("value"), n.get("inclusion"),
+                    n.get("tie_group")] for n in named],
+         "ties": [t.get("families") for t in verdict.get("ties") or []],
+         "structured_in": (verdict.get("unexplained") or {}).get("structured_in"),
+         "gap_closed": verdict.get("gap_closed"), "column": column_of(verdict, truth)}
+    kind = pair["kind"]
+    if kind == "null":
+        s["clean"] = verdict.get("status") == "clean" and not named
+    elif kind == "single":
+        s["correct"] = first is not None and bool(truth & tie_families(verdict, first))
+    elif kind == "two":
+        s["both_found"] = truth <= found_families(verdict)
+        s["one_found"] = bool(truth & found_families(verdict))
+    else:
+        s["unexplained_reported"] = verdict.get("status") in ("unexplained", "partly_explained") \
+            or bool((verdict.get("unexplained") or {}).get("present"))
+    inclusion = first.get("inclusion") if first else None
+    s["confident_wrong"] = bool(first is not None and not truth & tie_families(verdict, first)
+                                and inclusion is not None and inclusion >= CONFIDENT
+                                and first.get("tie_group") is None)
+    if kind in ("single", "two"):
+        s["values"] = {}
+        for e in pair["effects"]:
+            if e["family"] in found_families(verdict):
+                s["values"][e["family"]] = value_error(e, verdict)
+    return s
+
+
+def _rate(hits):
+    hits = list(hits)
+    return (sum(hits), len(hits))
+
+
+def summarize(results):
+    """Headline numbers over scored pairs: each a (hits, n) count or a median."""
+    by = lambda k: [r for r in results if r["kind"] == k and "score" in r]
+    nulls, singles, twos, ool = by("null"), by("single"), by("two"), by("out_of_library")
+    scored = [r for r in results if "score" in r]
+    # Knob values of the correctly named effects (a family found only through a tie, with no
+    # value of its own, counts as a miss).
+    values = [v for r in singles if r["score"]["correct"]
+              for v in (r["score"].get("values") or {}).values()] + \
+             [v for r in twos for v in (r["score"].get("values") or {}).values()]
+    gaps = [r["score"]["gap_closed"] for r in scored
+            if r["kind"] != "null" and r["score"].get("gap_closed") is not None]
+    times = [r["analysis_wall_s"] for r in scored if r.get("analysis_wall_s") is not None]
+    first = [r["analysis_wall_s"] for r in scored if r.get("first_of_robot")]
+    cached = [r["analysis_wall_s"] for r in scored if not r.get("first_of_robot")]
+    return {
+        "pairs": len(scored),
+        "null_clean": _rate(r["score"]["clean"] for r in nulls),
+        "in_library_correct": _rate(r["score"]["correct"] for r in singles),
+        "two_effect_both_found": _rate(r["score"]["both_found"] for r in twos),
+        "confident_wrong": _rate(r["score"]["confident_wrong"] for r in scored),
+        "out_of_library_unexplained": _rate(r["score"]["unexplained_reported"] for r in ool),
+        "value_within_25pct": _rate(v is not None and v["error"] is not None
+                                    and abs(v["error"]) <= VALUE_TOL for v in values),
+        "median_gap_closed": statistics.median(gaps) if gaps else None,
+        "gaps_counted": len(gaps),
+        "wall_s_first_uncached": first,
+        "wall_s_cached_median": statistics.median(cached) if cached else None,
+        "wall_s_cached_max": max(cached) if cached else None,
+        "wall_s_all_median": statistics.median(times) if times else None,
+    }
