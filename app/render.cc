@@ -1,13 +1,11 @@
 // `dgmm render`: density heat maps of a model (PNG, VTK offscreen) and, with --diff, the
 // three-panel comparison of two models laid out like Figure 3 of Edgington et al.
-#include <fmt/format.h>
-
-#include <filesystem>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "app/figure_options.h"
 #include "core/mise.h"
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
@@ -15,6 +13,7 @@
 #include "render/display.h"
 #include "render/heat_map.h"
 #include "render/model_slice.h"
+#include "render/slice_figure.h"
 #include "util/error.h"
 
 namespace dgmm::app {
@@ -32,42 +31,9 @@ struct RenderArgs {
   int grid = 200;
   std::string title;
   std::vector<std::string> labels;
+  std::string window;
   bool json = false;
 };
-
-std::pair<int, int> ParseSize(const std::string& text) {
-  int w = 0, h = 0;
-  char x = 0, extra = 0;
-  if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
-    throw MakeInputError("", "--size", "expected WIDTHxHEIGHT, got '" + text + "'");
-  }
-  return {w, h};
-}
-
-std::vector<std::pair<std::string, double>> ParseConditions(const std::vector<std::string>& in) {
-  std::vector<std::pair<std::string, double>> out;
-  for (const std::string& c : in) {
-    auto eq = c.find('=');
-    size_t used = 0;
-    double value = 0;
-    bool ok = eq != std::string::npos && eq > 0;
-    if (ok) {
-      try {
-        value = std::stod(c.substr(eq + 1), &used);
-        ok = used == c.size() - eq - 1;
-      } catch (const std::exception&) {
-        ok = false;
-      }
-    }
-    if (!ok) throw MakeInputError("", "--condition", "expected name=value, got '" + c + "'");
-    out.emplace_back(c.substr(0, eq), value);
-  }
-  return out;
-}
-
-std::string Basename(const std::string& path) {
-  return std::filesystem::path(path).filename().string();
-}
 
 nlohmann::json LayoutJson(const PlotLayout& l) {
   return {{"range", {l.range.x_min, l.range.x_max, l.range.y_min, l.range.y_max}},
@@ -80,23 +46,6 @@ nlohmann::json ModeJson(const Mixture& mixture, const PlotLayout& layout) {
   Eigen::Vector2d px = layout.ToPixel(mode.x(0), mode.x(1));
   return {{"x", mode.x(0)}, {"y", mode.x(1)}, {"density", std::exp(mode.log_density)},
           {"pixel", {px(0), px(1)}}};
-}
-
-// A window that shows every slice and the data (padded by 5% when data widen it).
-PlotRange CombinedRange(const std::vector<const ModelSlice*>& slices,
-                        const Eigen::MatrixX2d& points) {
-  PlotRange range = MixtureRange(slices.front()->mixture);
-  for (const ModelSlice* s : slices) {
-    PlotRange r = MixtureRange(s->mixture);
-    range.Include(r.x_min, r.y_min);
-    range.Include(r.x_max, r.y_max);
-  }
-  if (points.rows() > 0) {
-    for (Eigen::Index i = 0; i < points.rows(); ++i) range.Include(points(i, 0), points(i, 1));
-    const double px = 0.05 * (range.x_max - range.x_min), py = 0.05 * (range.y_max - range.y_min);
-    range = {range.x_min - px, range.x_max + px, range.y_min - py, range.y_max + py};
-  }
-  return range;
 }
 
 void Run(const RenderArgs& args) {
@@ -131,59 +80,32 @@ void Run(const RenderArgs& args) {
     points = SlicePoints(set, slices[0].command, slices[0].x_index, slices[0].y_index);
   }
   std::vector<const ModelSlice*> slice_ptrs;
-  for (const auto& s : slices) slice_ptrs.push_back(&s);
-  const PlotRange range = CombinedRange(slice_ptrs, points);
+  std::vector<const Mixture*> mixtures;
+  std::vector<SliceSource> sources;
+  for (size_t i = 0; i < slices.size(); ++i) {
+    slice_ptrs.push_back(&slices[i]);
+    mixtures.push_back(&slices[i].mixture);
+    sources.push_back({models[i].kind, args.models[i]});
+  }
+  const PlotRange range =
+      args.window.empty() ? SliceWindow(mixtures, points) : ParseWindow(args.window);
   if (!range.IsValid()) throw MakeInputError(args.models[0], "", "cannot find a plot window");
 
+  SliceFigureOptions figure;
+  figure.contours = args.contours;
+  figure.grid = args.grid;
+  figure.width = width;
+  figure.height = height;
+  figure.title = args.title;
+  figure.labels = args.labels;
+  const std::vector<HeatMapSpec> panels = SliceHeatMaps(slice_ptrs, sources, points, range, figure);
   nlohmann::json report = {{"output", args.output}, {"width", width}, {"height", height}};
   if (!args.diff) {
-    const ModelSlice& s = slices[0];
-    HeatMapSpec map;
-    map.background = MixtureDensityGrid(s.mixture, range, args.grid, args.grid);
-    if (args.contours > 0) map.contours.push_back({map.background, args.contours, {200, 200, 200}});
-    map.points = points;
-    map.title = args.title.empty() ? fmt::format("{} model {}: {}", models[0].kind,
-                                                 Basename(args.models[0]), s.description)
-                                   : args.title;
-    map.x_label = s.x_label;
-    map.y_label = s.y_label;
-    map.width = width;
-    map.height = height;
-    PlotLayout layout = RenderHeatMap(map, args.output);
+    PlotLayout layout = RenderHeatMap(panels[0], args.output);
     report["panels"] = {LayoutJson(layout)};
-    report["panels"][0]["mode"] = ModeJson(s.mixture, layout);
-    report["description"] = s.description;
+    report["panels"][0]["mode"] = ModeJson(slices[0].mixture, layout);
+    report["description"] = slices[0].description;
   } else {
-    std::vector<std::string> labels = args.labels;
-    for (size_t i = labels.size(); i < 2; ++i) {
-      labels.push_back(models[i].kind + " " + Basename(args.models[i]));
-    }
-    std::vector<DensityGrid> grids;
-    for (const auto& s : slices) grids.push_back(MixtureDensityGrid(s.mixture, range, args.grid, args.grid));
-    std::vector<HeatMapSpec> panels(3);
-    const std::array<unsigned char, 3> kA{0, 0, 0}, kB{0, 150, 60}, kGrey{200, 200, 200};
-    for (int i = 0; i < 2; ++i) {
-      panels[i].background = grids[i];
-      if (args.contours > 0) panels[i].contours.push_back({grids[i], args.contours, kGrey});
-      panels[i].title = fmt::format("{}: {}", i == 0 ? "A" : "B", labels[i]);
-    }
-    HeatMapSpec& d = panels[2];
-    d.background = grids[0];
-    d.background.values = grids[0].values - grids[1].values;
-    d.palette = HeatMapSpec::Palette::kDiverging;
-    d.value_label = "density difference A - B";
-    if (args.contours > 0) {
-      d.contours.push_back({grids[0], args.contours, kA, 1.5f, labels[0]});
-      d.contours.push_back({grids[1], args.contours, kB, 1.5f, labels[1]});
-    }
-    d.title = args.title.empty() ? "A - B (red: A higher); contours A black, B green" : args.title;
-    for (auto& p : panels) {
-      p.points = points;
-      p.x_label = slices[0].x_label;
-      p.y_label = slices[0].y_label;
-      p.width = width;
-      p.height = height;
-    }
     std::vector<PlotLayout> layouts = RenderHeatMapRow(panels, args.output);
     report["width"] = layouts.front().width;
     for (int i = 0; i < 3; ++i) report["panels"].push_back(LayoutJson(layouts[i]));
@@ -223,6 +145,8 @@ void Setup(CLI::App& root) {
   cmd->add_option("--size", args->size, "WIDTHxHEIGHT of the image (of each panel with --diff)")
       ->capture_default_str();
   cmd->add_option("--grid", args->grid, "grid points per axis")->capture_default_str();
+  cmd->add_option("--window", args->window,
+                  "x_min,x_max,y_min,y_max: the plot window (default: the slices and the data)");
   cmd->add_option("--title", args->title, "title (default: what is shown)");
   cmd->add_option("--labels", args->labels, "names of models A and B for --diff")->expected(0, 2);
   cmd->add_flag("--json", args->json, "print output, plot windows, pixel layout and modes as JSON");

@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "render/heat_map_chart.h"
 #include "render/vtk_image.h"
 #include "util/error.h"
 
@@ -104,6 +105,24 @@ vtkSmartPointer<vtkTable> ContourSegments(const ContourOverlay& overlay) {
   return table;
 }
 
+// Polylines as pairs of rows (x0,y0),(x1,y1) for a non-polyline vtkPlotLine.
+vtkSmartPointer<vtkTable> CurveSegments(const CurveOverlay& curve) {
+  auto table = vtkSmartPointer<vtkTable>::New();
+  auto xs = vtkSmartPointer<vtkFloatArray>::New();
+  auto ys = vtkSmartPointer<vtkFloatArray>::New();
+  xs->SetName("x");
+  ys->SetName("y");
+  for (Eigen::Index r = 0; r + 1 < curve.points.rows(); ++r) {
+    for (Eigen::Index e : {r, r + 1}) {
+      xs->InsertNextValue(static_cast<float>(curve.points(e, 0)));
+      ys->InsertNextValue(static_cast<float>(curve.points(e, 1)));
+    }
+  }
+  table->AddColumn(xs);
+  table->AddColumn(ys);
+  return table;
+}
+
 struct RenderedPanel {
   vtkSmartPointer<vtkImageData> image;
   PlotLayout layout;
@@ -114,9 +133,22 @@ RenderedPanel RenderPanel(const HeatMapSpec& spec) {
     throw MakeInputError("", "heat map", problem);
   }
   auto view = MakeOffscreenView(spec.width, spec.height);
-  auto chart = vtkSmartPointer<vtkChartHistogram2D>::New();
+  vtkSmartPointer<vtkChartHistogram2D> chart = render_internal::MakeHeatMapChart(spec);
   view->GetScene()->AddItem(chart);
+  RenderedPanel out;
+  out.image = CaptureView(view);
+  out.layout = render_internal::ChartLayout(chart, spec);
+  return out;
+}
 
+bool AllFinite(const Eigen::MatrixXd& m) { return m.size() == 0 || m.allFinite(); }
+
+}  // namespace
+
+namespace render_internal {
+
+vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
+  auto chart = vtkSmartPointer<vtkChartHistogram2D>::New();
   const DensityGrid& bg = spec.background;
   chart->SetInputData(ToImage(bg, true));
   if (spec.palette == HeatMapSpec::Palette::kSequential) {
@@ -141,6 +173,13 @@ RenderedPanel RenderPanel(const HeatMapSpec& spec) {
     line->SetColor(overlay.rgb[0], overlay.rgb[1], overlay.rgb[2], 255);
     line->SetWidth(overlay.width);
     line->SetLabel(overlay.label);
+  }
+  for (const CurveOverlay& curve : spec.curves) {
+    auto* line = vtkPlotLine::SafeDownCast(chart->AddPlot(vtkChart::LINE));
+    line->SetInputData(CurveSegments(curve), 0, 1);
+    line->SetPolyLine(false);
+    line->SetColor(curve.rgb[0], curve.rgb[1], curve.rgb[2], 255);
+    line->SetWidth(curve.width);
   }
   if (spec.points.rows() > 0) {
     auto table = vtkSmartPointer<vtkTable>::New();
@@ -168,24 +207,24 @@ RenderedPanel RenderPanel(const HeatMapSpec& spec) {
   for (vtkAxis* axis : {x_axis, y_axis}) axis->SetBehavior(vtkAxis::FIXED);
   x_axis->SetRange(bg.range.x_min, bg.range.x_max);
   y_axis->SetRange(bg.range.y_min, bg.range.y_max);
-
-  RenderedPanel out;
-  out.image = CaptureView(view);
-  const int* p1 = chart->GetPoint1();
-  const int* p2 = chart->GetPoint2();
-  out.layout.range = bg.range;
-  out.layout.left = p1[0];
-  out.layout.bottom = p1[1];
-  out.layout.right = p2[0];
-  out.layout.top = p2[1];
-  out.layout.width = spec.width;
-  out.layout.height = spec.height;
-  return out;
+  return chart;
 }
 
-bool AllFinite(const Eigen::MatrixXd& m) { return m.size() == 0 || m.allFinite(); }
+PlotLayout ChartLayout(vtkChartHistogram2D* chart, const HeatMapSpec& spec) {
+  PlotLayout layout;
+  const int* p1 = chart->GetPoint1();
+  const int* p2 = chart->GetPoint2();
+  layout.range = spec.background.range;
+  layout.left = p1[0];
+  layout.bottom = p1[1];
+  layout.right = p2[0];
+  layout.top = p2[1];
+  layout.width = spec.width;
+  layout.height = spec.height;
+  return layout;
+}
 
-}  // namespace
+}  // namespace render_internal
 
 std::string HeatMapSpec::Validate() const {
   if (width < 200 || height < 150 || width > 8000 || height > 8000) {
@@ -200,6 +239,9 @@ std::string HeatMapSpec::Validate() const {
     }
   }
   if (points.size() > 0 && !points.allFinite()) return "data points have NaN or infinite values";
+  for (const auto& c : curves) {
+    if (c.points.size() > 0 && !c.points.allFinite()) return "a curve has NaN or infinite points";
+  }
   return "";
 }
 

@@ -20,6 +20,13 @@ struct ContourOverlay {
   std::string label;  // shown in the chart legend when non-empty
 };
 
+// A polyline in data units (rows = (x, y)), e.g. a component's ellipse.
+struct CurveOverlay {
+  Eigen::MatrixX2d points;
+  std::array<unsigned char, 3> rgb{255, 255, 255};
+  float width = 1.0f;
+};
+
 struct HeatMapSpec {
   // Sequential: 0..max on a dark-to-bright ramp (brightest = densest). Diverging: blue-white-red
   // symmetric about 0 (for differences p_A - p_B).
@@ -27,6 +34,7 @@ struct HeatMapSpec {
   DensityGrid background;
   Palette palette = Palette::kSequential;
   std::vector<ContourOverlay> contours;
+  std::vector<CurveOverlay> curves;  // drawn over the contours, under the points
   Eigen::MatrixX2d points;  // data overlaid as small dots (rows = (x, y))
   std::string title, x_label, y_label, value_label = "density";
   int width = 800, height = 600;

@@ -138,25 +138,33 @@ ModelSlice SliceModel(const MotionModel& model, const SliceSpec& spec, const std
   return slice;
 }
 
+Eigen::MatrixXd RawSamples(const SampleSet& set, int command) {
+  std::vector<int> rows;
+  for (int i = 0; i < set.size(); ++i) {
+    if (set.command(i) == command) rows.push_back(i);
+  }
+  const int d = static_cast<int>(set.pose_dim() + set.terrain_dim());
+  Eigen::MatrixXd samples(static_cast<Eigen::Index>(rows.size()), d);
+  for (size_t r = 0; r < rows.size(); ++r) {
+    Eigen::VectorXd y = set.Joint(rows[r]);
+    if (!set.transform.empty()) {
+      y = set.transform.offset.array() + set.transform.scale.array() * y.array();
+    }
+    samples.row(static_cast<Eigen::Index>(r)) = y.transpose();
+  }
+  return samples;
+}
+
 Eigen::MatrixX2d SlicePoints(const SampleSet& set, int command, int x_index, int y_index) {
   const int d = static_cast<int>(set.pose_dim() + set.terrain_dim());
   if (x_index >= d || y_index >= d) {
     throw MakeInputError("", "data", "the sample set has only " + std::to_string(d) +
                                          " dimensions");
   }
-  std::vector<int> rows;
-  for (int i = 0; i < set.size(); ++i) {
-    if (set.command(i) == command) rows.push_back(i);
-  }
-  Eigen::MatrixX2d points(static_cast<Eigen::Index>(rows.size()), 2);
-  for (size_t r = 0; r < rows.size(); ++r) {
-    Eigen::VectorXd y = set.Joint(rows[r]);
-    if (!set.transform.empty()) {
-      y = set.transform.offset.array() + set.transform.scale.array() * y.array();
-    }
-    points(static_cast<Eigen::Index>(r), 0) = y(x_index);
-    points(static_cast<Eigen::Index>(r), 1) = y(y_index);
-  }
+  const Eigen::MatrixXd samples = RawSamples(set, command);
+  Eigen::MatrixX2d points(samples.rows(), 2);
+  points.col(0) = samples.col(x_index);
+  points.col(1) = samples.col(y_index);
   return points;
 }
 

@@ -41,6 +41,10 @@ Mixture RawMixture(const MotionModel& model, int command);
 // leftover dimensions without `marginalise`.
 ModelSlice SliceModel(const MotionModel& model, const SliceSpec& spec, const std::string& file);
 
+// y = x || z in raw units for every sample of the set with that command (the set's own
+// standardisation undone); rows = samples, columns = dimensions of y.
+Eigen::MatrixXd RawSamples(const SampleSet& set, int command);
+
 // (y[x_index], y[y_index]) in raw units for every sample of the set with that command
 // (the set's own standardisation undone); rows = samples.
 Eigen::MatrixX2d SlicePoints(const SampleSet& set, int command, int x_index, int y_index);

@@ -18,45 +18,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string Slurp(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
-// stderr without the lines xvfb-run writes itself (e.g. "xvfb-run: error: problem while
-// cleaning up temporary directory", seen under load): the tests judge dgmm's own output.
-std::string WithoutXvfbRunLines(const std::string& err) {
-  std::istringstream in(err);
-  std::string line, kept;
-  while (std::getline(in, line)) {
-    if (line.rfind("xvfb-run: ", 0) == 0) continue;
-    kept += line + "\n";
-  }
-  return kept;
-}
-
-// Runs `dgmm args...` under xvfb-run through the shell (arguments must not need quoting).
-RunResult RunUnderXvfb(const std::vector<std::string>& args, const fs::path& dir) {
-  const char* exe = std::getenv("DGMM_EXE");
-  std::string binary = exe ? exe : std::string(DGMM_BINARY_DIR) + "/app/dgmm";
-  // scripts/with-display.sh: $DISPLAY when set (scripts/test.sh starts one), else xvfb-run -a.
-  std::string command = std::string(DGMM_SOURCE_DIR) + "/scripts/with-display.sh " + binary;
-  for (const auto& a : args) command += " '" + a + "'";
-  command += " >" + (dir / "out").string() + " 2>" + (dir / "err").string();
-  RunResult r;
-  // Concurrent `xvfb-run -a` calls (parallel ctest) can race for a display number: retry then.
-  for (int attempt = 0; attempt < 3; ++attempt) {
-    int status = std::system(command.c_str());
-    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    r.out = Slurp(dir / "out");
-    r.err = WithoutXvfbRunLines(Slurp(dir / "err"));
-    if (r.err.find("cannot open an X display") == std::string::npos) break;
-  }
-  return r;
-}
-
 // Width and height from the PNG's IHDR chunk (bytes 16..23, big-endian).
 std::pair<int, int> PngSize(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
