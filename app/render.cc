@@ -16,6 +16,7 @@
 #include "render/heat_map.h"
 #include "render/model_slice.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -101,6 +102,7 @@ PlotRange CombinedRange(const std::vector<const ModelSlice*>& slices,
 
 void Run(const RenderArgs& args) {
   // Before any VTK call: a missing display is one clear line, never a crash.
+  RefuseOutputThatIsAnInput(args.output, args.models);
   RequireDisplay();
   if (args.diff != (args.models.size() == 2)) {
     throw MakeInputError("", "models", args.diff ? "--diff needs exactly two model files"
