@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <map>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -51,6 +52,20 @@ void RunCv(const CvArgs& args) {
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
+  // Stratified folds: every command's samples are spread over the folds, so no fold may be
+  // empty for any command (and a huge --folds must not run for minutes on empty folds).
+  std::map<int, int> per_command;
+  for (int i = 0; i < set.size(); ++i) ++per_command[set.command[i]];
+  for (const auto& [id, count] : per_command) {
+    if (args.folds > count) {
+      const std::string label =
+          id < static_cast<int>(set.command_labels.size()) ? " '" + set.command_labels[id] + "'" : "";
+      throw MakeInputError(args.path, "--folds",
+                           fmt::format("{} folds, but command {}{} has {} samples ({} in all); at "
+                                       "most {} folds expected",
+                                       args.folds, id, label, count, set.size(), count));
+    }
+  }
   CvOptions options;
   options.dgmm.k = args.k;
   options.dgmm.variant = args.variant == "improved" ? DgmmOptions::Variant::kImproved

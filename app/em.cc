@@ -17,6 +17,7 @@
 #include "io/streaming.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -38,6 +39,7 @@ nlohmann::json OptionsJson(const EmArgs& args) {
 void Run(const EmArgs& args) {
   std::string error;
   if (!args.em.IsValid(&error)) throw MakeInputError(args.set, "options", error);
+  RefuseOutputThatIsAnInput(args.output, {args.set});
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const SampleSet set = ReadSampleSet(args.set);
   MotionModel model = ModelHeaderFor(set, !args.without_terrain);

@@ -3,6 +3,7 @@
 #include <memory>
 
 #include "app/command.h"
+#include "util/output_guard.h"
 #include "io/model_io.h"
 #include "util/atomic_file.h"
 
@@ -14,6 +15,7 @@ struct ExportArgs {
 };
 
 void Run(const ExportArgs& args) {
+  RefuseOutputThatIsAnInput(args.output, {args.model});
   { AtomicFile probe(args.output); }  // fail before reading when the output is unwritable
   const MotionModel model = ReadModel(args.model);
   WriteModelJson(model, args.output);

@@ -16,6 +16,7 @@
 #include "io/streaming.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -28,8 +29,17 @@ struct FitArgs {
   std::uint64_t seed = 1;
   bool without_terrain = false;
   int chunk_rows = 65536;
+  long long max_components = -1;  // -1: DefaultMaxComponents
   bool json = false;
 };
+
+// Default cap on components per mixture (docs/reliability.md, "Bounded work"): the square-root
+// rule ceil(sqrt(N)), at most N / (d + 1) (a component's covariance needs d + 1 samples), and
+// never below 50 so that small sets are never capped by default.
+long long DefaultMaxComponents(long long n, int dim) {
+  const long long root = static_cast<long long>(std::ceil(std::sqrt(static_cast<double>(n))));
+  return std::max<long long>(50, std::min(root, n / (dim + 1)));
+}
 
 // DGMM options from the flags, checked against the set's dimension.
 MotionModelOptions Options(const FitArgs& args) {
@@ -51,8 +61,15 @@ MotionModelOptions Options(const FitArgs& args) {
     throw MakeInputError(args.set, "--variant",
                          "'" + args.variant + "', expected faithful or improved");
   }
-  const SampleSet header = SampleSetReader(args.set).header();
+  const SampleSetReader reader(args.set);
+  const SampleSet& header = reader.header();
   const int dim = header.pose_dim() + (o.with_terrain ? header.terrain_dim() : 0);
+  if (args.max_components == 0 || args.max_components < -1 || args.max_components > 1000000000) {
+    throw MakeInputError(args.set, "--max-components",
+                         fmt::format("{}; expected 1 to 1e9", args.max_components));
+  }
+  o.dgmm.max_components = static_cast<int>(
+      args.max_components > 0 ? args.max_components : DefaultMaxComponents(reader.size(), dim));
   if (args.init_cov.size() == 1) {
     o.dgmm.initial_covariance_diagonal = Eigen::VectorXd::Constant(dim, args.init_cov[0]);
   } else if (!args.init_cov.empty()) {
@@ -71,6 +88,7 @@ MotionModelOptions Options(const FitArgs& args) {
 }
 
 void Run(const FitArgs& args) {
+  RefuseOutputThatIsAnInput(args.output, {args.set});
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const MotionModelOptions options = Options(args);
   const auto start = std::chrono::steady_clock::now();
@@ -80,6 +98,15 @@ void Run(const FitArgs& args) {
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   model.metadata["training_set"] = std::filesystem::path(args.set).filename().string();
+  for (const auto& [id, hit] : model.max_components_hit) {
+    if (!hit) continue;
+    auto label = model.command_labels.find(id);
+    std::cerr << fmt::format(
+        "dgmm: warning: {}: command {}{}: the mixture reached --max-components {} and stopped "
+        "growing (later samples merged); raise --max-components or k\n",
+        args.set, id, label == model.command_labels.end() ? "" : " '" + label->second + "'",
+        options.dgmm.max_components);
+  }
   WriteModel(model, args.output);
 
   long long samples = 0;
@@ -91,12 +118,14 @@ void Run(const FitArgs& args) {
     commands.push_back({{"command", id},
                         {"label", label == model.command_labels.end() ? "" : label->second},
                         {"components", mixture.size()},
+                        {"max_components_hit", model.max_components_hit.count(id) > 0},
                         {"samples", n}});
   }
   if (args.json) {
     nlohmann::json out = {{"set", args.set},     {"model", args.output}, {"kind", model.kind},
                           {"k", args.k},         {"seed", args.seed},    {"variant", args.variant},
                           {"dim", model.dim()},  {"samples", samples},   {"seconds", seconds},
+                          {"max_components", options.dgmm.max_components},
                           {"commands", commands}};
     std::cout << out.dump(2) << "\n";
     return;
@@ -134,7 +163,10 @@ void Setup(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--chunk-rows", args->chunk_rows, "samples read per chunk")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 100000000));
+  cmd->add_option("--max-components", args->max_components,
+                  "cap on components per mixture; at the cap every sample merges (default: "
+                  "max(50, min(ceil(sqrt(N)), N / (d + 1))) for N samples of dimension d)");
   cmd->add_flag("--json", args->json, "print the summary as JSON");
   cmd->callback([args] { Run(*args); });
 }

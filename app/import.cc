@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "util/output_guard.h"
 #include "io/csv_import.h"
 #include "io/sample_set_io.h"
 #include "util/atomic_file.h"
@@ -19,6 +20,7 @@ struct ImportArgs {
 };
 
 void Run(const ImportArgs& args) {
+  RefuseOutputThatIsAnInput(args.output, {args.input});
   { AtomicFile probe(args.output); }  // fail before reading when the output is unwritable
   const SampleSet set = ImportCsv(args.input, args.csv);
   WriteSampleSet(set, args.output);

@@ -1,6 +1,7 @@
 // The `dgmm` command: parses arguments with CLI11 and dispatches to the registered subcommands.
 // User-input problems arrive as exceptions and are printed as one line with a non-zero exit.
 #include <algorithm>
+#include <csignal>
 #include <cstdio>
 #include <exception>
 #include <iostream>
@@ -9,6 +10,8 @@
 #include "util/error.h"
 
 int main(int argc, char** argv) {
+  // A file-size limit (ulimit -f) becomes a write error with a message, not a SIGXFSZ kill.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App root{"dgmm: Dynamic Gaussian Mixture motion models for legged robots"};
   root.require_subcommand(1);
   auto& registry = dgmm::app::CommandRegistry();

@@ -9,6 +9,7 @@
 #include "render/chart.h"
 #include "render/display.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -88,6 +89,7 @@ Table ReadTable(const std::string& path) {
 }
 
 void Run(const PlotArgs& args) {
+  RefuseOutputThatIsAnInput(args.output, {args.csv});
   RequireDisplay();
   if (args.kind != "line" && args.kind != "bar") {
     throw MakeInputError("", "--kind", "must be line or bar");

@@ -15,6 +15,7 @@
 #include "render/model_slice.h"
 #include "render/slice_figure.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -50,6 +51,7 @@ nlohmann::json ModeJson(const Mixture& mixture, const PlotLayout& layout) {
 
 void Run(const RenderArgs& args) {
   // Before any VTK call: a missing display is one clear line, never a crash.
+  RefuseOutputThatIsAnInput(args.output, args.models);
   RequireDisplay();
   if (args.diff != (args.models.size() == 2)) {
     throw MakeInputError("", "models", args.diff ? "--diff needs exactly two model files"

@@ -1,5 +1,6 @@
 // `dgmm score`: total and mean log-likelihood of a sample set under a model, streamed from the
 // file chunk by chunk, with a per-command breakdown.
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -8,6 +9,7 @@
 #include "app/command.h"
 #include "io/model_io.h"
 #include "io/streaming.h"
+#include "util/error.h"
 
 namespace dgmm::app {
 namespace {
@@ -24,6 +26,11 @@ void Run(const ScoreArgs& args) {
       model, args.set, args.chunk_rows,
       [](long long done, long long total) { ReportProgress("score", done, total); });
   const ScoreSummary& s = score.summary;
+  if (std::isnan(s.total_log_likelihood) || s.samples == 0) {
+    throw MakeInputError(args.model, "",
+                         "the score of " + args.set + " is not a number (" +
+                             std::to_string(s.samples) + " samples); nothing to report");
+  }
   if (args.json) {
     nlohmann::json commands = nlohmann::json::array();
     for (const auto& [id, c] : score.by_command) {
@@ -60,7 +67,7 @@ void Setup(CLI::App& root) {
   cmd->add_option("set", args->set, "sample set file (.h5)")->required();
   cmd->add_option("--chunk-rows", args->chunk_rows, "samples read per chunk")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1, 100000000));
   cmd->add_flag("--json", args->json,
                 "print total_log_likelihood, mean_log_likelihood, samples and per-command "
                 "figures as JSON");

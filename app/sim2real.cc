@@ -1,5 +1,6 @@
 // `dgmm sim2real`: where the simulation fails on real recordings, what physics it left out, the
 // corrected model, and how much of the gap it closes (lib/sim2real, docs/sim2real.md).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -17,7 +18,9 @@
 #include "sim2real/recalibrate.h"
 #include "sim2real/report.h"
 #include "sim2real/verdict.h"
+#include "util/atomic_dir.h"
 #include "util/atomic_file.h"
+#include "util/output_guard.h"
 #include "util/error.h"
 
 namespace dgmm::app {
@@ -43,18 +46,39 @@ void WriteText(const std::filesystem::path& path, const std::string& text) {
   file.Commit();
 }
 
+// Refuses, before any output exists, what has no answer: identical --sim and --real files,
+// inputs inside the output folder, a --sim-config that cannot be loaded.
+void CheckInputs(const Sim2RealArgs& args) {
+  namespace fs = std::filesystem;
+  if (SameFile(args.sim, args.real) || SameContent(args.sim, args.real)) {
+    throw MakeInputError(args.real, "--real",
+                         "is the same data as --sim " + args.sim +
+                             "; expected a real set to compare with the simulation");
+  }
+  CheckOutputDir(args.out, "report.json");
+  std::error_code ec;
+  const fs::path out = fs::weakly_canonical(args.out, ec);
+  for (const std::string& input : {args.sim, args.real, args.sim_config}) {
+    if (input.empty()) continue;
+    const fs::path in = fs::weakly_canonical(input, ec);
+    auto mismatch = std::mismatch(out.begin(), out.end(), in.begin(), in.end());
+    if (!out.empty() && mismatch.first == out.end()) {
+      throw MakeInputError(input, "-o",
+                           "is inside the output folder " + args.out +
+                               ", which is replaced as a whole; move it or choose another -o");
+    }
+  }
+  if (!args.sim_config.empty()) sim::LoadSimConfig(args.sim_config);  // refuse up front
+}
+
 void Run(const Sim2RealArgs& args) {
   namespace fs = std::filesystem;
   const SampleSet sim = ReadSampleSet(args.sim);
   const SampleSet real = ReadSampleSet(args.real);
-  std::error_code ec;
-  fs::create_directories(args.out, ec);
-  if (ec || !fs::is_directory(args.out)) {
-    throw MakeInputError(args.out, "-o", "cannot create the output folder");
-  }
-  if (!args.sim_config.empty() && !fs::exists(args.sim_config)) {
-    throw MakeInputError(args.sim_config, "--sim-config", "no such file");
-  }
+  CheckInputs(args);
+  // Everything is written into a sibling folder that replaces -o whole at the end.
+  AtomicDir output(args.out, "report.json");
+  const fs::path out_dir = output.temp_path();
   sim2real::Sim2RealOptions options;
   options.seed = args.seed;
   options.selection.bootstrap_selection = args.bootstrap;
@@ -67,8 +91,8 @@ void Run(const Sim2RealArgs& args) {
   ctx.real_path = args.real;
   ctx.corrected_model_file = "corrected_model.h5";
   ctx.sim_model_file = "sim_model.h5";
-  WriteModel(sim2real::BuildCorrectedModel(result, sim), (fs::path(args.out) / ctx.corrected_model_file).string());
-  WriteModel(sim2real::BuildSimModel(result, sim), (fs::path(args.out) / ctx.sim_model_file).string());
+  WriteModel(sim2real::BuildCorrectedModel(result, sim), (out_dir / ctx.corrected_model_file).string());
+  WriteModel(sim2real::BuildSimModel(result, sim), (out_dir / ctx.sim_model_file).string());
   sim2real::Verdict verdict = sim2real::VerdictFromEffects(result);
   if (!args.sim_config.empty()) {
     if (ShowProgress()) std::cerr << "sim2real: simulator knobs (signatures, selection, refinement)\n";
@@ -93,7 +117,7 @@ void Run(const Sim2RealArgs& args) {
     // The recalibrated config on its own, ready for `dgmm simulate --config`.
     const auto recal_json = nlohmann::json::parse(ctx.recalibration_json, nullptr, false);
     if (!recal_json.is_discarded() && recal_json.contains("recalibrated_config")) {
-      WriteText(fs::path(args.out) / "recalibrated_config.json",
+      WriteText(out_dir / "recalibrated_config.json",
                 recal_json["recalibrated_config"].dump(2) + "\n");
     }
   }
@@ -101,12 +125,13 @@ void Run(const Sim2RealArgs& args) {
     ctx.notes.push_back("figures skipped: --no-figures");
   } else {
     std::string note;
-    ctx.figures = sim2real::RenderFigures(result, sim, real, args.out, &note);
+    ctx.figures = sim2real::RenderFigures(result, sim, real, out_dir, &note);
     if (!note.empty()) ctx.notes.push_back(note);
   }
   const std::string json = sim2real::ReportJson(result, ctx);
-  WriteText(fs::path(args.out) / "report.json", json);
-  WriteText(fs::path(args.out) / "report.html", sim2real::ReportHtml(result, ctx, args.out));
+  WriteText(out_dir / "report.html", sim2real::ReportHtml(result, ctx, out_dir));
+  WriteText(out_dir / "report.json", json);  // the marker of a complete result, last
+  output.Commit();
   if (args.json) {
     std::cout << json;
     return;

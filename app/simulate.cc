@@ -10,6 +10,7 @@
 #include "sim/protocol.h"
 #include "sim/sim_config.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -33,6 +34,7 @@ void RunSimulate(const SimulateArgs& args) {
     return;
   }
   if (args.output.empty()) throw MakeInputError("", "--output", "required (the .h5 file to write)");
+  RefuseOutputThatIsAnInput(args.output, {args.config_path});
   const std::filesystem::path folder =
       std::filesystem::absolute(args.output).parent_path();
   if (!std::filesystem::is_directory(folder)) {

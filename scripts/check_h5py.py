@@ -49,7 +49,7 @@ def check_set(path, data, standardized):
     raw = np.array([d[1:5] for d in data])
     with h5py.File(path, "r") as f:
         check(f.attrs["dgmm_format"] == "sample_set", "set: dgmm_format")
-        check(int(f.attrs["dgmm_format_version"]) == 1, "set: dgmm_format_version")
+        check(int(f.attrs["dgmm_format_version"]) == 2, "set: dgmm_format_version")
         check(f.attrs["source"] == "real", "set: source")
         n = len(data)
         check(f["x"].shape == (n, 2) and f["x"].dtype == np.float64, "set: x shape/dtype")
@@ -85,7 +85,7 @@ def check_set(path, data, standardized):
 def check_model(path):
     with h5py.File(path, "r") as f:
         check(f.attrs["dgmm_format"] == "model", "model: dgmm_format")
-        check(int(f.attrs["dgmm_format_version"]) == 1, "model: version")
+        check(int(f.attrs["dgmm_format_version"]) == 2, "model: version")
         check(f.attrs["kind"] == "dgmm", "model: kind")
         d = int(f.attrs["pose_dim"]) + int(f.attrs["terrain_dim"])
         check((int(f.attrs["pose_dim"]), int(f.attrs["terrain_dim"])) == (2, 2), "model: dims")

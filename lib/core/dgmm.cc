@@ -25,6 +25,10 @@ bool DgmmOptions::IsValid(std::string* error) const {
     return Fail(
         error, "covariance floor must be finite and >= 0, got " + std::to_string(covariance_floor));
   }
+  if (max_components < 0) {
+    return Fail(error, "max components must be >= 0 (0: no cap), got " +
+                           std::to_string(max_components));
+  }
   for (int i = 0; i < initial_covariance_diagonal.size(); ++i) {
     const double v = initial_covariance_diagonal[i];
     if (!std::isfinite(v) || !(v > 0)) {
@@ -82,9 +86,29 @@ double Dgmm::MaxLogDensity() const {
     if (mixture_.empty()) {
       max_log_density_ = kNegInf;
     } else {
-      Mixture::Mode mode = mixture_.MaxDensity();
+      // Searching from every mean costs O(K^2) per call, O(N^3) over a fit that starts a
+      // component per sample. Between full searches (whenever K has doubled) only the last mode
+      // and the means of components changed since the last search are starting points: the
+      // unchanged components scale uniformly by W_old / W_new, so only the changed ones can
+      // raise a mode above the last one (docs/reliability.md, "Bounded work").
+      const int k = mixture_.size();
+      std::vector<Eigen::VectorXd> starts;
+      if (last_mode_.size() != dim_ || k >= 2 * std::max(full_search_size_, 1)) {
+        for (int i = 0; i < k; ++i) starts.push_back(mixture_.component(i).mean());
+        full_search_size_ = k;
+      } else {
+        starts.push_back(last_mode_);
+        for (int i = 0; i < k; ++i) {
+          if (i >= static_cast<int>(searched_weights_.size()) ||
+              searched_weights_[i] != mixture_.weight(i)) {
+            starts.push_back(mixture_.component(i).mean());
+          }
+        }
+      }
+      Mixture::Mode mode = mixture_.MaxDensityFrom(starts);
       max_log_density_ = mode.log_density;
       last_mode_ = std::move(mode.x);
+      searched_weights_ = mixture_.weights();
     }
     max_valid_ = true;
   }
@@ -118,6 +142,13 @@ AddSampleResult Dgmm::DecideMerge(const Eigen::Ref<const Eigen::VectorXd>& x,
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   const double r = uniform(rng);
   const double decay = std::exp(-options_.k * static_cast<double>(num_samples_));
+  if (options_.max_components > 0 && mixture_.size() >= options_.max_components) {
+    // Bounded work: at the cap every sample merges (no density needed).
+    max_components_hit_ = true;
+    result.threshold = 1.0;
+    result.merged = true;
+    return result;
+  }
   if (mixture_.empty()) {
     // p(x) = 0 for an empty model: d = 0 and t = 1 - exp(0) = 0, so r < t never holds.
     result.threshold = 0.0;

@@ -22,6 +22,9 @@ struct DgmmOptions {
   Eigen::VectorXd initial_covariance_diagonal;
   // Floor added to keep covariances positive definite (see docs/dgmm.md for where it applies).
   double covariance_floor = 1e-6;
+  // At most this many components (0: no cap). At the cap every sample merges (the component is
+  // chosen as usual) and max_components_hit() turns true (issue #13: bounded work).
+  int max_components = 0;
 
   // k finite and > 0, floor finite and >= 0, initial diagonal (if given) positive and finite.
   bool IsValid(std::string* error) const;
@@ -71,6 +74,8 @@ class Dgmm {
   double MaxLogDensity() const;
   // Upper bound log sum_i w_i max_x N_i(x) / W >= log max p, O(k).
   double PeakLogDensityBound() const;
+  // True once options().max_components stopped the mixture from growing.
+  bool max_components_hit() const { return max_components_hit_; }
 
  private:
   // Algorithm 2 as written (options_.variant == kFaithful).
@@ -102,6 +107,11 @@ class Dgmm {
   mutable bool max_valid_ = false;    // max_log_density_ is up to date
   mutable double max_log_density_ = 0.0;
   mutable Eigen::VectorXd last_mode_;   // argmax of the last mode search (a lower bound)
+  // Incremental mode search: weights at the last search (a changed weight marks a changed
+  // component) and the component count at the last search from every mean.
+  mutable std::vector<double> searched_weights_;
+  mutable int full_search_size_ = 0;
+  bool max_components_hit_ = false;
   std::vector<double> log_choice_;      // scratch for ChooseComponent
   Eigen::MatrixXd covariance_scratch_;  // scratch for RefreshComponent
   Eigen::VectorXd delta_scratch_;       // scratch for MergeInto

@@ -124,6 +124,14 @@ Eigen::MatrixXd Mixture::Sample(int n, std::mt19937_64& rng) const {
 }
 
 Mixture::Mode Mixture::MaxDensity(const ModeSearchOptions& options) const {
+  std::vector<Eigen::VectorXd> starts;
+  starts.reserve(components_.size());
+  for (const Gaussian& g : components_) starts.push_back(g.mean());
+  return MaxDensityFrom(starts, options);
+}
+
+Mixture::Mode Mixture::MaxDensityFrom(const std::vector<Eigen::VectorXd>& starts,
+                                      const ModeSearchOptions& options) const {
   Mode best;
   best.log_density = kNegInf;
   if (empty()) return best;
@@ -140,8 +148,8 @@ Mixture::Mode Mixture::MaxDensity(const ModeSearchOptions& options) const {
   }
   Eigen::MatrixXd a(d, d);
   Eigen::VectorXd b(d);
-  for (int start = 0; start < k; ++start) {
-    Eigen::VectorXd x = components_[start].mean();
+  for (const Eigen::VectorXd& start : starts) {
+    Eigen::VectorXd x = start;
     for (int it = 0; it < options.max_iterations; ++it) {
       // x <- (sum r_i P_i)^-1 sum r_i P_i mu_i, r_i the responsibilities at x. Each step does
       // not decrease p (it is EM on the mode; Carreira-Perpinan 2000).

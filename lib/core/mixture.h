@@ -75,6 +75,10 @@ class Mixture {
     double log_density = 0.0;
   };
   Mode MaxDensity(const ModeSearchOptions& options = {}) const;
+  // The same fixed-point search from the given starting points only (O(starts x K) instead of
+  // O(K^2)): the best local mode reached, a lower bound of the global one.
+  Mode MaxDensityFrom(const std::vector<Eigen::VectorXd>& starts,
+                      const ModeSearchOptions& options = {}) const;
 
  private:
   int dim_ = 0;

@@ -120,7 +120,11 @@ MotionModel MotionModelLearner::Finish() const {
   model.dgmm_options = options_.dgmm;
   model.seed = options_.seed;
   model.mixtures.clear();
-  for (const auto& [command, learner] : learners_) model.mixtures[command] = learner.mixture();
+  model.max_components_hit.clear();
+  for (const auto& [command, learner] : learners_) {
+    model.mixtures[command] = learner.mixture();
+    if (learner.max_components_hit()) model.max_components_hit[command] = true;
+  }
   return model;
 }
 

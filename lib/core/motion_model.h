@@ -23,6 +23,7 @@ struct MotionModel {
   std::map<int, Eigen::VectorXd> command_values;  // command id -> its row of the command table
   std::map<int, std::string> command_labels;
   std::map<int, Mixture> mixtures;                // command id -> mixture over y (dim pose+terrain)
+  std::map<int, bool> max_components_hit;         // command id -> a component cap stopped growth
   DgmmOptions dgmm_options;                       // when kind == "dgmm"
   std::uint64_t seed = 0;
   Standardization transform;                      // of y, copied from the training set

@@ -1,5 +1,6 @@
 // Datasets: small dense tables, strings, and chunked per-sample arrays read by hyperslab.
 #include <algorithm>
+#include <cstdio>
 
 #include "io/hdf5_util.h"
 #include "util/error.h"
@@ -34,6 +35,11 @@ void WriteDense(hid_t loc, const std::string& name, const std::vector<hsize_t>& 
 
 Dataset OpenDataset(hid_t loc, const std::string& name, const std::string& path) {
   if (!Exists(loc, name)) throw MakeInputError(path, name, "dataset missing");
+  H5O_info_t info{};
+  if (H5Oget_info_by_name2(loc, name.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) < 0 ||
+      info.type != H5O_TYPE_DATASET) {
+    throw MakeInputError(path, name, "not a dataset or corrupt");
+  }
   Dataset d(H5Dopen2(loc, name.c_str(), H5P_DEFAULT));
   if (!d.valid()) throw MakeInputError(path, name, "not a dataset or corrupt");
   return d;
@@ -54,20 +60,11 @@ std::string DimsText(const std::vector<hsize_t>& dims) {
 }
 
 template <typename T>
-std::vector<T> ReadAll(hid_t loc, const std::string& name, int rank, H5T_class_t cls,
-                       hid_t mem_type, std::vector<hsize_t>* dims, const std::string& path) {
-  Dataset d = OpenDataset(loc, name, path);
-  Datatype type(H5Dget_type(d.get()));
-  if (H5Tget_class(type.get()) != cls) {
-    throw MakeInputError(
-        path, name, cls == H5T_FLOAT ? "expected floating-point numbers" : "expected integers");
-  }
-  *dims = DimsOf(d.get());
-  if (static_cast<int>(dims->size()) != rank) {
-    throw MakeInputError(
-        path, name,
-        "expected " + std::to_string(rank) + " dimensions, found shape " + DimsText(*dims));
-  }
+std::vector<T> ReadAll(hid_t loc, const std::string& name, const std::vector<long long>& extents,
+                       hid_t file_type, hid_t mem_type, std::vector<hsize_t>* dims,
+                       const std::string& path) {
+  DatasetSpec spec{file_type, extents};
+  Dataset d = OpenCheckedDataset(loc, name, spec, path, dims);
   hsize_t n = 1;
   for (hsize_t v : *dims) n *= v;
   std::vector<T> data(n);
@@ -75,6 +72,11 @@ std::vector<T> ReadAll(hid_t loc, const std::string& name, int rank, H5T_class_t
     throw MakeInputError(path, name, "cannot read (truncated or corrupt file)");
   }
   return data;
+}
+
+// Filters dgmm writes (shuffle, deflate) or h5py users may add (fletcher32); others refused.
+bool KnownFilter(H5Z_filter_t f) {
+  return f == H5Z_FILTER_DEFLATE || f == H5Z_FILTER_SHUFFLE || f == H5Z_FILTER_FLETCHER32;
 }
 
 }  // namespace
@@ -89,37 +91,138 @@ void WriteInts(hid_t loc, const std::string& name, const std::vector<hsize_t>& d
   WriteDense(loc, name, dims, H5T_STD_I32LE, H5T_NATIVE_INT, data, path);
 }
 
-void WriteStrings(hid_t loc, const std::string& name, const std::vector<std::string>& values,
-                  const std::string& path) {
-  Datatype type(H5Tcopy(H5T_C_S1));
-  H5Tset_size(type.get(), H5T_VARIABLE);
-  H5Tset_cset(type.get(), H5T_CSET_UTF8);
-  std::vector<const char*> ptrs;
-  for (const auto& v : values) ptrs.push_back(v.c_str());
-  WriteDense(loc, name, {static_cast<hsize_t>(values.size())}, type.get(), type.get(), ptrs.data(),
-             path);
-}
-
 DoubleArray ReadDoubles(hid_t loc, const std::string& name, int rank, const std::string& path) {
   DoubleArray a;
-  a.data = ReadAll<double>(loc, name, rank, H5T_FLOAT, H5T_NATIVE_DOUBLE, &a.dims, path);
+  return ReadDoubles(loc, name, std::vector<long long>(std::max(rank, 0), -1), path);
+}
+
+DoubleArray ReadDoubles(hid_t loc, const std::string& name, const std::vector<long long>& extents,
+                        const std::string& path) {
+  DoubleArray a;
+  a.data = ReadAll<double>(loc, name, extents, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &a.dims, path);
   return a;
 }
 
 IntArray ReadInts(hid_t loc, const std::string& name, int rank, const std::string& path) {
   IntArray a;
-  a.data = ReadAll<int>(loc, name, rank, H5T_INTEGER, H5T_NATIVE_INT, &a.dims, path);
+  a.data = ReadAll<int>(loc, name, std::vector<long long>(std::max(rank, 0), -1), H5T_STD_I32LE,
+                        H5T_NATIVE_INT, &a.dims, path);
   return a;
 }
 
-std::vector<std::string> ReadStrings(hid_t loc, const std::string& name, const std::string& path) {
+std::vector<std::string> ReadStrings(hid_t loc, const std::string& name, const std::string& path,
+                                     long long expected_count) {
   Dataset d = OpenDataset(loc, name, path);
-  return ReadStringsFromDataset(d.get(), path, name);
+  return ReadStringsFromDataset(d.get(), path, name, expected_count);
 }
 
 std::vector<hsize_t> DatasetDims(hid_t loc, const std::string& name, const std::string& path) {
   Dataset d = OpenDataset(loc, name, path);
   return DimsOf(d.get());
+}
+
+std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const std::string& path,
+                                  const std::string& field) {
+  const bool is_double = H5Tequal(spec.type, H5T_IEEE_F64LE) > 0;
+  Datatype type(H5Dget_type(dataset));
+  if (!type.valid() || H5Tequal(type.get(), spec.type) <= 0) {
+    throw MakeInputError(path, field,
+                         std::string("expected ") +
+                             (is_double ? "float64 little-endian numbers"
+                                        : "int32 little-endian integers") +
+                             (type.valid() && H5Tget_class(type.get()) == H5T_STRING
+                                  ? ", found strings"
+                                  : ""));
+  }
+  Dataspace space(H5Dget_space(dataset));
+  const int rank = space.valid() ? H5Sget_simple_extent_ndims(space.get()) : -1;
+  if (rank < 0 || rank > 32) throw MakeInputError(path, field, "corrupt dataspace");
+  std::vector<hsize_t> dims(rank);
+  if (rank > 0) H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+  if (rank != static_cast<int>(spec.extents.size())) {
+    throw MakeInputError(path, field,
+                         "expected " + std::to_string(spec.extents.size()) +
+                             " dimensions, found shape " + DimsText(dims));
+  }
+  // Element count with overflow checks, and every extent against the schema.
+  long double elements = 1;
+  for (int i = 0; i < rank; ++i) {
+    if (spec.extents[i] >= 0 && dims[i] != static_cast<hsize_t>(spec.extents[i])) {
+      throw MakeInputError(path, field,
+                           "shape " + DimsText(dims) + ": dimension " + std::to_string(i) +
+                               " should be " + std::to_string(spec.extents[i]));
+    }
+    if (dims[i] > spec.max_extent) {
+      throw MakeInputError(path, field,
+                           "shape " + DimsText(dims) + ": at most " +
+                               std::to_string(spec.max_extent) + " per dimension expected");
+    }
+    elements *= static_cast<long double>(dims[i]);
+  }
+  if (elements > static_cast<long double>(spec.max_elements)) {
+    char declared[32];
+    std::snprintf(declared, sizeof declared, "%.3Lg", elements);
+    throw MakeInputError(path, field,
+                         "declares shape " + DimsText(dims) + " (" + declared +
+                             " values); at most " + std::to_string(spec.max_elements) +
+                             " expected");
+  }
+  const hsize_t raw_bytes = static_cast<hsize_t>(elements) * (is_double ? 8 : 4);
+  PropertyList dcpl(H5Dget_create_plist(dataset));
+  if (!dcpl.valid()) throw MakeInputError(path, field, "corrupt dataset properties");
+  if (H5Pget_external_count(dcpl.get()) != 0) {
+    throw MakeInputError(path, field, "stored in external files; expected the data in the file");
+  }
+  const H5D_layout_t layout = H5Pget_layout(dcpl.get());
+  if (layout == H5D_CHUNKED) {
+    hsize_t chunk[32];
+    const int chunk_rank = H5Pget_chunk(dcpl.get(), 32, chunk);
+    long double chunk_bytes = is_double ? 8 : 4;
+    for (int i = 0; i < chunk_rank; ++i) chunk_bytes *= static_cast<long double>(chunk[i]);
+    if (chunk_rank != rank || chunk_bytes <= 0 ||
+        chunk_bytes > static_cast<long double>(kMaxChunkBytes)) {
+      throw MakeInputError(path, field,
+                           "chunks of rank " + std::to_string(chunk_rank) + " and " +
+                               std::to_string(static_cast<unsigned long long>(chunk_bytes)) +
+                               " bytes; rank " + std::to_string(rank) + " and at most " +
+                               std::to_string(kMaxChunkBytes) + " bytes expected");
+    }
+    const int filters = H5Pget_nfilters(dcpl.get());
+    if (filters < 0 || filters > 8) throw MakeInputError(path, field, "corrupt filter pipeline");
+    for (int i = 0; i < filters; ++i) {
+      unsigned flags = 0;
+      size_t nelmts = 0;
+      H5Z_filter_t id = H5Pget_filter2(dcpl.get(), i, &flags, &nelmts, nullptr, 0, nullptr, nullptr);
+      if (!KnownFilter(id)) {
+        throw MakeInputError(path, field,
+                             "uses HDF5 filter " + std::to_string(id) +
+                                 "; expected only shuffle, deflate or fletcher32");
+      }
+    }
+  } else if (layout != H5D_CONTIGUOUS && layout != H5D_COMPACT) {
+    throw MakeInputError(path, field, "unsupported storage layout (virtual?)");
+  }
+  // The bytes stored must be able to hold what the shape declares (compressed at most
+  // kMaxCompressionRatio : 1), so a few corrupt bytes cannot ask for gigabytes.
+  const hsize_t stored = H5Dget_storage_size(dataset);
+  const bool plausible =
+      layout == H5D_CHUNKED
+          ? raw_bytes <= stored * kMaxCompressionRatio + kStorageSlackBytes
+          : layout == H5D_COMPACT || raw_bytes == 0 || stored >= raw_bytes;
+  if (!plausible) {
+    throw MakeInputError(path, field,
+                         "declares " + std::to_string(raw_bytes) + " bytes but stores " +
+                             std::to_string(stored) + " (truncated or corrupt file)");
+  }
+  return dims;
+}
+
+Dataset OpenCheckedDataset(hid_t loc, const std::string& name, const DatasetSpec& spec,
+                           const std::string& path, std::vector<hsize_t>* dims) {
+  Dataset d = OpenDataset(loc, name, path);
+  std::vector<hsize_t> checked = CheckDataset(d.get(), spec, path, name);
+  if (dims) *dims = std::move(checked);
+  return d;
 }
 
 RowAppender::RowAppender(hid_t loc, const std::string& name, bool is_double, hsize_t cols,

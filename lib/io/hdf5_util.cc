@@ -1,4 +1,4 @@
-// Files, groups and attributes (datasets are in hdf5_dataset.cc).
+// Files, groups and number attributes (strings: hdf5_strings.cc, datasets: hdf5_dataset.cc).
 #include "io/hdf5_util.h"
 
 #include <filesystem>
@@ -9,13 +9,6 @@
 
 namespace dgmm::h5 {
 namespace {
-
-Datatype VlenStringType() {
-  Datatype t(H5Tcopy(H5T_C_S1));
-  H5Tset_size(t.get(), H5T_VARIABLE);
-  H5Tset_cset(t.get(), H5T_CSET_UTF8);
-  return t;
-}
 
 PropertyList NoTimesGroupPlist() {
   PropertyList p(H5Pcreate(H5P_GROUP_CREATE));
@@ -35,42 +28,6 @@ Attribute OpenAttribute(hid_t obj, const std::string& name, const std::string& p
   return a;
 }
 
-// Reads n strings (vlen or fixed length) from an attribute or dataset of type `file_type`.
-template <typename ReadFn>
-std::vector<std::string> ReadStringsOf(hid_t file_type, hsize_t n, ReadFn read,
-                                       const std::string& path, const std::string& field) {
-  if (H5Tget_class(file_type) != H5T_STRING) {
-    throw MakeInputError(path, field, "expected strings");
-  }
-  std::vector<std::string> out;
-  out.reserve(n);
-  if (n == 0) return out;
-  if (H5Tis_variable_str(file_type) > 0) {
-    Datatype mem = VlenStringType();
-    std::vector<char*> buf(n, nullptr);
-    if (read(mem.get(), buf.data()) < 0) throw MakeInputError(path, field, "cannot read");
-    for (char* s : buf) out.emplace_back(s ? s : "");
-    Dataspace space(H5Screate_simple(1, &n, nullptr));
-    H5Dvlen_reclaim(mem.get(), space.get(), H5P_DEFAULT, buf.data());
-  } else {
-    size_t size = H5Tget_size(file_type);
-    Datatype mem(H5Tcopy(H5T_C_S1));
-    H5Tset_size(mem.get(), size);
-    std::vector<char> buf(n * size, '\0');
-    if (read(mem.get(), buf.data()) < 0) throw MakeInputError(path, field, "cannot read");
-    for (hsize_t i = 0; i < n; ++i) {
-      std::string s(buf.data() + i * size, size);
-      out.push_back(s.substr(0, s.find('\0')));
-    }
-  }
-  return out;
-}
-
-hsize_t NumElements(hid_t space) {
-  hssize_t n = H5Sget_simple_extent_npoints(space);
-  return n < 0 ? 0 : static_cast<hsize_t>(n);
-}
-
 template <typename T>
 void WriteScalarAttribute(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_type,
                           const T& value, const std::string& path) {
@@ -79,15 +36,16 @@ void WriteScalarAttribute(hid_t obj, const std::string& name, hid_t file_type, h
   if (!a.valid() || H5Awrite(a.get(), mem_type, &value) < 0) WriteFailed(path, name);
 }
 
+// One number of exactly the file type `file_type` (the schema's), checked before the read.
 template <typename T>
-T ReadScalarAttribute(hid_t obj, const std::string& name, hid_t mem_type, const std::string& path,
-                      const std::string& field) {
+T ReadScalarAttribute(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_type,
+                      const char* expected, const std::string& path, const std::string& field) {
   Attribute a = OpenAttribute(obj, name, path, field);
   Dataspace space(H5Aget_space(a.get()));
   Datatype type(H5Aget_type(a.get()));
-  H5T_class_t cls = H5Tget_class(type.get());
-  if (NumElements(space.get()) != 1 || (cls != H5T_INTEGER && cls != H5T_FLOAT)) {
-    throw MakeInputError(path, field, "expected a single number");
+  if (!space.valid() || !type.valid() || H5Sget_simple_extent_npoints(space.get()) != 1 ||
+      H5Tequal(type.get(), file_type) <= 0) {
+    throw MakeInputError(path, field, std::string("expected a single ") + expected);
   }
   T value{};
   if (H5Aread(a.get(), mem_type, &value) < 0) throw MakeInputError(path, field, "cannot read");
@@ -96,24 +54,47 @@ T ReadScalarAttribute(hid_t obj, const std::string& name, hid_t mem_type, const 
 
 }  // namespace
 
+herr_t CloseFile(hid_t file) {
+  // After a failed flush (disk full) H5Fclose fails too and leaves the file half closed: closing
+  // it again, or letting libhdf5's exit handler flush it, crashed (SIGSEGV in H5F__close). The
+  // id is dropped instead (Init() turned the exit handler off); the caller's AtomicFile removes
+  // the temporary file.
+  return H5Fclose(file);
+}
+
 void Init() {
   static std::once_flag once;
-  std::call_once(once, [] { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); });
+  std::call_once(once, [] {
+    // No flush of still-open files at exit: after a failed write it crashed (exit 139).
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  });
 }
 
 File CreateFile(const std::string& file_path, const std::string& display_path) {
   Init();
-  File f(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT));
+  // Version 2: checksummed superblock, object headers and B-trees (libver bounds V110..LATEST).
+  PropertyList fapl(H5Pcreate(H5P_FILE_ACCESS));
+  if (H5Pset_libver_bounds(fapl.get(), H5F_LIBVER_V110, H5F_LIBVER_LATEST) < 0) {
+    throw MakeInputError(display_path, "output path", "cannot set HDF5 format bounds");
+  }
+  PropertyList fcpl(H5Pcreate(H5P_FILE_CREATE));
+  H5Pset_obj_track_times(fcpl.get(), false);
+  File f(H5Fcreate(file_path.c_str(), H5F_ACC_TRUNC, fcpl.get(), fapl.get()));
   if (!f.valid()) throw MakeInputError(display_path, "output path", "cannot create HDF5 file");
   return f;
 }
 
 File OpenFile(const std::string& path) {
   Init();
+  namespace fs = std::filesystem;
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw MakeInputError(path, "", "file not found");
-  if (std::filesystem::is_directory(path, ec)) {
+  if (!fs::exists(path, ec)) throw MakeInputError(path, "", "file not found");
+  if (fs::is_directory(path, ec)) {
     throw MakeInputError(path, "", "is a folder, expected an HDF5 file");
+  }
+  if (!fs::is_regular_file(path, ec)) {
+    throw MakeInputError(path, "", "not a regular file, expected an HDF5 file");
   }
   if (!std::ifstream(path).good()) throw MakeInputError(path, "", "cannot open for reading");
   htri_t is_hdf5 = H5Fis_hdf5(path.c_str());
@@ -127,21 +108,44 @@ File OpenFile(const std::string& path) {
   return f;
 }
 
+std::int64_t ReadFormatVersion(hid_t file, const std::string& path) {
+  if (!HasAttribute(file, "dgmm_format_version")) {
+    throw MakeInputError(path, "dgmm_format_version",
+                         "attribute missing: an HDF5 file not written by dgmm");
+  }
+  const std::int64_t version =
+      ReadInt64Attribute(file, "dgmm_format_version", path, "dgmm_format_version");
+  if (version == 1 && !TrustedLegacyRead::active()) {
+    throw MakeInputError(path, "dgmm_format_version",
+                         "1 is the old format; convert a trusted file with dgmm upgrade");
+  }
+  if (version != 1 && version != kFormatVersion) {
+    throw MakeInputError(path, "dgmm_format_version",
+                         "unsupported version " + std::to_string(version) + " (this dgmm reads " +
+                             std::to_string(kFormatVersion) + ")");
+  }
+  if (version == kFormatVersion) {
+    // Version 2 is written with checksummed metadata; an older superblock is not ours.
+    H5F_info2_t info{};
+    if (H5Fget_info2(file, &info) < 0 || info.super.version < 2) {
+      throw MakeInputError(path, "superblock",
+                           "version " + std::to_string(info.super.version) +
+                               " without checksums; expected a file written by dgmm (>= 2)");
+    }
+  }
+  return version;
+}
+
 std::string ReadFormat(hid_t file, const std::string& path) {
   if (!HasAttribute(file, "dgmm_format")) {
     throw MakeInputError(path, "dgmm_format",
                          "attribute missing: an HDF5 file not written by dgmm");
   }
+  // The version first: it is a plain number, and it decides how strings may be read.
+  ReadFormatVersion(file, path);
   std::string format = ReadStringAttribute(file, "dgmm_format", path, "dgmm_format");
   if (format != "sample_set" && format != "model") {
-    throw MakeInputError(path, "dgmm_format", "unknown kind '" + format + "'");
-  }
-  std::int64_t version =
-      ReadInt64Attribute(file, "dgmm_format_version", path, "dgmm_format_version");
-  if (version != kFormatVersion) {
-    throw MakeInputError(path, "dgmm_format_version",
-                         "unsupported version " + std::to_string(version) + " (this dgmm reads " +
-                             std::to_string(kFormatVersion) + ")");
+    throw MakeInputError(path, "dgmm_format", "unknown kind '" + format.substr(0, 80) + "'");
   }
   return format;
 }
@@ -160,6 +164,11 @@ Group CreateGroup(hid_t loc, const std::string& name, const std::string& path) {
 
 Group OpenGroup(hid_t loc, const std::string& name, const std::string& path) {
   if (!Exists(loc, name)) throw MakeInputError(path, name, "group missing");
+  H5O_info_t info{};
+  if (H5Oget_info_by_name2(loc, name.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) < 0 ||
+      info.type != H5O_TYPE_GROUP) {
+    throw MakeInputError(path, name, "not a group or corrupt");
+  }
   Group g(H5Gopen2(loc, name.c_str(), H5P_DEFAULT));
   if (!g.valid()) throw MakeInputError(path, name, "not a group or corrupt");
   return g;
@@ -170,13 +179,6 @@ bool Exists(hid_t loc, const std::string& name) {
 }
 
 bool HasAttribute(hid_t obj, const std::string& name) { return H5Aexists(obj, name.c_str()) > 0; }
-
-void WriteStringAttribute(hid_t obj, const std::string& name, const std::string& value,
-                          const std::string& path) {
-  Datatype type = VlenStringType();
-  const char* c = value.c_str();
-  WriteScalarAttribute(obj, name, type.get(), type.get(), c, path);
-}
 
 void WriteDoubleAttribute(hid_t obj, const std::string& name, double value,
                           const std::string& path) {
@@ -193,65 +195,35 @@ void WriteUint64Attribute(hid_t obj, const std::string& name, std::uint64_t valu
   WriteScalarAttribute(obj, name, H5T_STD_U64LE, H5T_NATIVE_UINT64, value, path);
 }
 
-void WriteStringListAttribute(hid_t obj, const std::string& name,
-                              const std::vector<std::string>& values, const std::string& path) {
-  if (values.empty()) return;
-  Datatype type = VlenStringType();
-  std::vector<const char*> ptrs;
-  for (const auto& v : values) ptrs.push_back(v.c_str());
-  hsize_t n = values.size();
-  Dataspace space(H5Screate_simple(1, &n, nullptr));
-  Attribute a(H5Acreate2(obj, name.c_str(), type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT));
-  if (!a.valid() || H5Awrite(a.get(), type.get(), ptrs.data()) < 0) WriteFailed(path, name);
-}
-
-std::string ReadStringAttribute(hid_t obj, const std::string& name, const std::string& path,
-                                const std::string& field) {
-  Attribute a = OpenAttribute(obj, name, path, field);
-  Datatype type(H5Aget_type(a.get()));
-  Dataspace space(H5Aget_space(a.get()));
-  if (NumElements(space.get()) != 1) throw MakeInputError(path, field, "expected one string");
-  auto v = ReadStringsOf(
-      type.get(), 1, [&](hid_t mem, void* buf) { return H5Aread(a.get(), mem, buf); }, path, field);
-  return v.front();
-}
-
 double ReadDoubleAttribute(hid_t obj, const std::string& name, const std::string& path,
                            const std::string& field) {
-  return ReadScalarAttribute<double>(obj, name, H5T_NATIVE_DOUBLE, path, field);
+  return ReadScalarAttribute<double>(obj, name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE,
+                                     "float64 number", path, field);
 }
 
 std::int64_t ReadInt64Attribute(hid_t obj, const std::string& name, const std::string& path,
                                 const std::string& field) {
-  return ReadScalarAttribute<std::int64_t>(obj, name, H5T_NATIVE_INT64, path, field);
+  return ReadScalarAttribute<std::int64_t>(obj, name, H5T_STD_I64LE, H5T_NATIVE_INT64,
+                                           "int64 number", path, field);
 }
 
 std::uint64_t ReadUint64Attribute(hid_t obj, const std::string& name, const std::string& path,
                                   const std::string& field) {
-  return ReadScalarAttribute<std::uint64_t>(obj, name, H5T_NATIVE_UINT64, path, field);
-}
-
-std::vector<std::string> ReadStringListAttribute(hid_t obj, const std::string& name,
-                                                 const std::string& path,
-                                                 const std::string& field) {
-  if (!HasAttribute(obj, name)) return {};
-  Attribute a = OpenAttribute(obj, name, path, field);
-  Datatype type(H5Aget_type(a.get()));
-  Dataspace space(H5Aget_space(a.get()));
-  return ReadStringsOf(
-      type.get(), NumElements(space.get()),
-      [&](hid_t mem, void* buf) { return H5Aread(a.get(), mem, buf); }, path, field);
+  return ReadScalarAttribute<std::uint64_t>(obj, name, H5T_STD_U64LE, H5T_NATIVE_UINT64,
+                                            "uint64 number", path, field);
 }
 
 std::vector<std::string> AttributeNames(hid_t obj, const std::string& path) {
   std::vector<std::string> names;
   auto collect = [](hid_t, const char* name, const H5A_info_t*, void* data) -> herr_t {
-    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+    auto* out = static_cast<std::vector<std::string>*>(data);
+    if (out->size() >= 10000) return -1;  // more attributes than any dgmm file has
+    out->emplace_back(name);
     return 0;
   };
   hsize_t idx = 0;
   if (H5Aiterate2(obj, H5_INDEX_NAME, H5_ITER_INC, &idx, collect, &names) < 0) {
-    throw MakeInputError(path, "attributes", "cannot list (corrupt file?)");
+    throw MakeInputError(path, "attributes", "cannot list (corrupt file or over 10000?)");
   }
   return names;
 }
@@ -259,7 +231,9 @@ std::vector<std::string> AttributeNames(hid_t obj, const std::string& path) {
 std::vector<std::string> LinkNames(hid_t group, const std::string& path) {
   std::vector<std::string> names;
   auto collect = [](hid_t, const char* name, const H5L_info_t*, void* data) -> herr_t {
-    static_cast<std::vector<std::string>*>(data)->emplace_back(name);
+    auto* out = static_cast<std::vector<std::string>*>(data);
+    if (out->size() >= 1000000) return -1;
+    out->emplace_back(name);
     return 0;
   };
   hsize_t idx = 0;
@@ -267,21 +241,6 @@ std::vector<std::string> LinkNames(hid_t group, const std::string& path) {
     throw MakeInputError(path, "groups", "cannot list (corrupt file?)");
   }
   return names;
-}
-
-std::vector<std::string> ReadStringsFromDataset(hid_t dataset, const std::string& path,
-                                                const std::string& field) {
-  Datatype type(H5Dget_type(dataset));
-  Dataspace space(H5Dget_space(dataset));
-  if (H5Sget_simple_extent_ndims(space.get()) != 1) {
-    throw MakeInputError(path, field, "expected a 1-D list of strings");
-  }
-  return ReadStringsOf(
-      type.get(), NumElements(space.get()),
-      [&](hid_t mem, void* buf) {
-        return H5Dread(dataset, mem, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf);
-      },
-      path, field);
 }
 
 }  // namespace dgmm::h5

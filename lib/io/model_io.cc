@@ -2,6 +2,7 @@
 #include "io/model_io.h"
 
 #include <cmath>
+#include <cstdio>
 
 #include "io/hdf5_util.h"
 #include "io/schema.h"
@@ -14,6 +15,13 @@ namespace {
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 std::string Str(long long v) { return std::to_string(v); }
+
+// A double as printf's %.3g would print it (1e+308, 0.5, nan).
+std::string Num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
 
 const char* VariantName(DgmmOptions::Variant v) {
   return v == DgmmOptions::Variant::kImproved ? "improved" : "faithful";
@@ -68,7 +76,8 @@ void ReadModelCommands(hid_t file, MotionModel* model, const std::string& path) 
   }
 }
 
-void WriteMixture(hid_t parent, int id, const Mixture& mixture, int dim, const std::string& path) {
+void WriteMixture(hid_t parent, int id, const Mixture& mixture, int dim, bool capped,
+                  const std::string& path) {
   const std::string field = "mixtures/" + Str(id);
   if (mixture.dim() != dim && !mixture.empty()) {
     throw MakeInputError(path, field,
@@ -87,34 +96,64 @@ void WriteMixture(hid_t parent, int id, const Mixture& mixture, int dim, const s
   h5::Group g = h5::CreateGroup(parent, Str(id), path);
   h5::WriteInt64Attribute(g.get(), "command_id", id, path);
   h5::WriteInt64Attribute(g.get(), "num_components", static_cast<std::int64_t>(k), path);
+  if (capped) h5::WriteInt64Attribute(g.get(), "max_components_hit", 1, path);
   h5::WriteDoubles(g.get(), "weights", {k}, weights.data(), path);
   h5::WriteDoubles(g.get(), "means", {k, d}, means.data(), path);
   h5::WriteDoubles(g.get(), "covariances", {k, d, d}, covariances.data(), path);
 }
 
+// Largest |C - C^T| relative to the largest |C| entry (0 for a symmetric matrix).
+double RelativeAsymmetry(const Eigen::MatrixXd& c) {
+  const double scale = c.cwiseAbs().maxCoeff();
+  if (!(scale > 0)) return 0;
+  return (c - c.transpose()).cwiseAbs().maxCoeff() / scale;
+}
+
+// One mixture, every dataset checked against (K, d) / (K, d, d) before it is read; covariances
+// as stored must be symmetric (kMaxRelativeAsymmetry) and positive definite.
 Mixture ReadMixture(hid_t parent, const std::string& name, int dim, const std::string& path) {
+  constexpr double kMaxRelativeAsymmetry = 1e-12;  // docs/file-format.md, version 2
   const std::string field = "mixtures/" + name;
   h5::Group g = h5::OpenGroup(parent, name, path);
   auto weights = h5::ReadDoubles(g.get(), "weights", 1, path);
-  auto means = h5::ReadDoubles(g.get(), "means", 2, path);
-  auto covariances = h5::ReadDoubles(g.get(), "covariances", 3, path);
-  const hsize_t k = weights.dims[0], d = static_cast<hsize_t>(dim);
-  if (means.dims != std::vector<hsize_t>{k, d} ||
-      covariances.dims != std::vector<hsize_t>{k, d, d}) {
-    throw MakeInputError(path, field,
-                         "means/covariances do not have shapes (" + Str(k) + ", " + Str(d) +
-                             ") and (" + Str(k) + ", " + Str(d) + ", " + Str(d) + ")");
+  const long long k = static_cast<long long>(weights.dims[0]), d = dim;
+  if (k == 0) {
+    throw MakeInputError(path, field + "/weights", "0 components; at least one expected");
   }
+  if (h5::HasAttribute(g.get(), "num_components") &&
+      h5::ReadInt64Attribute(g.get(), "num_components", path, field + "/num_components") != k) {
+    throw MakeInputError(path, field + "/num_components",
+                         "differs from the " + Str(k) + " weights");
+  }
+  if (static_cast<double>(k) * d * d > static_cast<double>(h5::kMaxDenseElements)) {
+    throw MakeInputError(path, field,
+                         Str(k) + " components of dimension " + Str(d) + "; at most " +
+                             Str(h5::kMaxDenseElements) + " covariance entries expected");
+  }
+  auto means = h5::ReadDoubles(g.get(), "means", {k, d}, path);
+  auto covariances = h5::ReadDoubles(g.get(), "covariances", {k, d, d}, path);
   Mixture mixture(dim);
-  for (hsize_t i = 0; i < k; ++i) {
+  double total = 0;
+  for (long long i = 0; i < k; ++i) {
     const double w = weights.data[i];
-    if (!std::isfinite(w) || w <= 0) {
-      throw MakeInputError(
-          path, field + "/weights",
-          "component " + Str(i) + " has weight " + std::to_string(w) + ", expected finite and > 0");
+    total += w;
+    if (!std::isfinite(w) || w <= 0 || !std::isfinite(total)) {
+      throw MakeInputError(path, field + "/weights",
+                           "component " + Str(i) + " has weight " + Num(w) +
+                               (std::isfinite(total) ? "" : " (the sum overflows)") +
+                               ", expected finite and > 0 with a finite sum");
     }
     Eigen::VectorXd mean = Eigen::Map<Eigen::VectorXd>(means.data.data() + i * d, dim);
     Eigen::MatrixXd cov = Eigen::Map<RowMatrix>(covariances.data.data() + i * d * d, dim, dim);
+    if (!cov.allFinite()) {
+      throw MakeInputError(path, field + "/covariances",
+                           "component " + Str(i) + " is not finite");
+    }
+    if (const double a = RelativeAsymmetry(cov); a > kMaxRelativeAsymmetry) {
+      throw MakeInputError(path, field + "/covariances",
+                           "component " + Str(i) + " is not symmetric (relative asymmetry " +
+                               Num(a) + ", at most 1e-12 expected)");
+    }
     auto gaussian = Gaussian::Create(std::move(mean), std::move(cov));
     if (!gaussian) {
       throw MakeInputError(
@@ -152,6 +191,18 @@ DgmmOptions ReadOptions(hid_t file, const std::string& path) {
   auto diag = h5::ReadDoubles(g.get(), "initial_covariance_diagonal", 1, path);
   o.initial_covariance_diagonal =
       Eigen::Map<Eigen::VectorXd>(diag.data.data(), static_cast<Eigen::Index>(diag.data.size()));
+  if (!std::isfinite(o.k) || o.k <= 0) {
+    throw MakeInputError(path, "dgmm_options/k", Num(o.k) + ", expected finite and > 0");
+  }
+  if (!std::isfinite(o.covariance_floor) || o.covariance_floor < 0) {
+    throw MakeInputError(path, "dgmm_options/covariance_floor",
+                         Num(o.covariance_floor) + ", expected finite and >= 0");
+  }
+  if (!o.initial_covariance_diagonal.allFinite() ||
+      (o.initial_covariance_diagonal.array() <= 0).any()) {
+    throw MakeInputError(path, "dgmm_options/initial_covariance_diagonal",
+                         "expected finite values > 0");
+  }
   return o;
 }
 
@@ -181,7 +232,9 @@ void WriteModel(const MotionModel& model, const std::string& path) {
     WriteModelCommands(f, model, path);
     h5::Group mixtures = h5::CreateGroup(f, "mixtures", path);
     for (const auto& [id, mixture] : model.mixtures) {
-      WriteMixture(mixtures.get(), id, mixture, model.dim(), path);
+      auto hit = model.max_components_hit.find(id);
+      WriteMixture(mixtures.get(), id, mixture, model.dim(),
+                   hit != model.max_components_hit.end() && hit->second, path);
     }
     WriteOptions(f, model.dgmm_options, path);
     Standardization t = model.transform;
@@ -217,10 +270,26 @@ MotionModel ReadModel(const std::string& path) {
   ReadModelCommands(f, &model, path);
   h5::Group mixtures = h5::OpenGroup(f, "mixtures", path);
   for (const std::string& name : h5::LinkNames(mixtures.get(), path)) {
+    const std::string field = "mixtures/" + name;
     h5::Group g = h5::OpenGroup(mixtures.get(), name, path);
-    const std::int64_t id =
-        h5::ReadInt64Attribute(g.get(), "command_id", path, "mixtures/" + name + "/command_id");
+    const std::int64_t id = h5::ReadInt64Attribute(g.get(), "command_id", path, field + "/command_id");
+    if (model.command_values.count(static_cast<int>(id)) == 0 || id != static_cast<int>(id) ||
+        model.mixtures.count(static_cast<int>(id)) > 0) {
+      throw MakeInputError(path, field + "/command_id",
+                           Str(id) + " is not a unique id of /commands/ids");
+    }
     model.mixtures[static_cast<int>(id)] = ReadMixture(mixtures.get(), name, model.dim(), path);
+    if (h5::HasAttribute(g.get(), "max_components_hit")) {
+      const std::int64_t hit =
+          h5::ReadInt64Attribute(g.get(), "max_components_hit", path, field + "/max_components_hit");
+      if (hit != 0 && hit != 1) {
+        throw MakeInputError(path, field + "/max_components_hit", Str(hit) + ", expected 0 or 1");
+      }
+      model.max_components_hit[static_cast<int>(id)] = hit == 1;
+    }
+  }
+  if (model.mixtures.empty()) {
+    throw MakeInputError(path, "mixtures", "none; a model needs at least one mixture");
   }
   model.dgmm_options = ReadOptions(f, path);
   if (h5::Exists(f, "transform")) {

@@ -33,24 +33,31 @@ void ReadNamesOf(hid_t file, const std::string& dataset, long long cols,
                  const std::string& path) {
   h5::Dataset d(H5Dopen2(file, dataset.c_str(), H5P_DEFAULT));
   if (!d.valid()) throw MakeInputError(path, dataset, "cannot open (corrupt file?)");
-  *names = h5::ReadStringListAttribute(d.get(), "names", path, dataset + "/names");
-  *units = h5::ReadStringListAttribute(d.get(), "units", path, dataset + "/units");
+  *names = h5::ReadStringListAttribute(d.get(), "names", path, dataset + "/names", cols);
+  *units = h5::ReadStringListAttribute(d.get(), "units", path, dataset + "/units", cols);
   CheckCount(*names, cols, path, dataset + "/names");
   CheckCount(*units, cols, path, dataset + "/units");
 }
 
-// Length of a per-sample dataset with the given rank; InputError unless it has n rows.
-long long CheckPerSample(hid_t file, const std::string& name, int rank, long long n,
-                         const std::string& path) {
-  auto dims = h5::DatasetDims(file, name, path);
-  if (static_cast<int>(dims.size()) != rank) {
+// Columns of a per-sample dataset of the given rank (0 for 1-D), checked before any read: type,
+// n rows (any number up to h5::kMaxRows when n < 0), at most h5::kMaxColumns columns.
+long long CheckPerSample(hid_t file, const std::string& name, hid_t type, int rank, long long n,
+                         const std::string& path, long long* rows = nullptr) {
+  h5::DatasetSpec spec{type, std::vector<long long>(rank, -1)};
+  spec.max_elements = hsize_t{1} << 40;  // memory is bounded by the stored bytes (CheckDataset)
+  std::vector<hsize_t> dims = h5::DatasetDims(file, name, path);  // the dataspace only
+  if (n >= 0 && static_cast<int>(dims.size()) == rank && static_cast<long long>(dims[0]) != n) {
     throw MakeInputError(path, name,
-                         "expected " + Str(rank) + " dimensions, found " + Str(dims.size()));
+                         std::to_string(dims[0]) + " rows, expected one per sample (" +
+                             std::to_string(n) + ")");
   }
-  if (n >= 0 && static_cast<long long>(dims[0]) != n) {
+  h5::OpenCheckedDataset(file, name, spec, path, &dims);
+  if (rank == 2 && (dims[1] == 0 || dims[1] > h5::kMaxColumns)) {
     throw MakeInputError(path, name,
-                         Str(dims[0]) + " rows, expected one per sample (" + Str(n) + ")");
+                         std::to_string(dims[1]) + " columns; 1 to " +
+                             std::to_string(h5::kMaxColumns) + " expected");
   }
+  if (rows) *rows = static_cast<long long>(dims[0]);
   return rank == 2 ? static_cast<long long>(dims[1]) : 0;
 }
 
@@ -123,10 +130,11 @@ void ReadCommandTable(hid_t group, const std::string& group_name, Eigen::MatrixX
   *values = Eigen::Map<RowMatrix>(v.data.data(), rows, cols);
   if (!values->allFinite()) throw MakeInputError(path, field, "non-finite command value");
   h5::Dataset d(H5Dopen2(group, "values", H5P_DEFAULT));
-  *dim_names = h5::ReadStringListAttribute(d.get(), "dim_names", path, field + "/dim_names");
+  *dim_names =
+      h5::ReadStringListAttribute(d.get(), "dim_names", path, field + "/dim_names", cols);
   CheckCount(*dim_names, cols, path, field + "/dim_names");
   labels->clear();
-  if (h5::Exists(group, "labels")) *labels = h5::ReadStrings(group, "labels", path);
+  if (h5::Exists(group, "labels")) *labels = h5::ReadStrings(group, "labels", path, rows);
   CheckCount(*labels, rows, path, group_name + "/labels");
 }
 
@@ -150,23 +158,20 @@ SampleSet ReadSampleSetHeader(hid_t file, const std::string& path, long long* nu
   if (h5::HasAttribute(file, "source")) {
     s.source = h5::ReadStringAttribute(file, "source", path, "source");
   }
-  auto x_dims = h5::DatasetDims(file, "x", path);
-  if (x_dims.size() != 2 || x_dims[1] == 0) {
-    throw MakeInputError(path, "x", "expected a 2-D array N x dx with dx >= 1");
-  }
-  const long long n = static_cast<long long>(x_dims[0]);
-  const long long dx = static_cast<long long>(x_dims[1]);
-  CheckPerSample(file, "command", 1, n, path);
+  long long n = 0;
+  const long long dx = CheckPerSample(file, "x", H5T_IEEE_F64LE, 2, -1, path, &n);
+  if (n == 0) throw MakeInputError(path, "x", "0 rows; a sample set needs at least one sample");
+  CheckPerSample(file, "command", H5T_STD_I32LE, 1, n, path);
   long long dz = 0;
-  if (h5::Exists(file, "z")) dz = CheckPerSample(file, "z", 2, n, path);
+  if (h5::Exists(file, "z")) dz = CheckPerSample(file, "z", H5T_IEEE_F64LE, 2, n, path);
   bool has_episode = h5::Exists(file, "episode"), has_step = h5::Exists(file, "step");
   if (has_episode != has_step) {
     throw MakeInputError(path, has_episode ? "step" : "episode",
                          "missing (episode and step come together)");
   }
   if (has_episode) {
-    CheckPerSample(file, "episode", 1, n, path);
-    CheckPerSample(file, "step", 1, n, path);
+    CheckPerSample(file, "episode", H5T_STD_I32LE, 1, n, path);
+    CheckPerSample(file, "step", H5T_STD_I32LE, 1, n, path);
   }
   h5::Group commands = h5::OpenGroup(file, "commands", path);
   ReadCommandTable(commands.get(), "commands", &s.commands, &s.command_dim_names, &s.command_labels,

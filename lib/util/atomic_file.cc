@@ -1,17 +1,23 @@
 #include "util/atomic_file.h"
 
+#include <fcntl.h>
 #include <unistd.h>
 
-#include <atomic>
 #include <cstdio>
 #include <system_error>
 
 #include "util/error.h"
+#include "util/temp_registry.h"
 
 namespace dgmm {
-namespace {
-std::atomic<int> counter{0};
-}  // namespace
+
+bool SyncPath(const std::filesystem::path& path, bool is_directory) {
+  const int fd = ::open(path.c_str(), (is_directory ? O_RDONLY | O_DIRECTORY : O_RDONLY) | O_CLOEXEC);
+  if (fd < 0) return false;
+  const bool ok = ::fsync(fd) == 0;
+  ::close(fd);
+  return ok;
+}
 
 AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
   namespace fs = std::filesystem;
@@ -29,8 +35,9 @@ AtomicFile::AtomicFile(std::filesystem::path target) : target_(std::move(target)
     throw MakeInputError(target_.string(), "output path",
                          "folder '" + dir.string() + "' is not writable");
   }
-  temp_ = dir / (target_.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                 std::to_string(counter++));
+  RemoveStaleTemps(dir, target_.filename().string());
+  temp_ = NextTempPath(dir, target_.filename().string());
+  slot_ = RegisterTempPath(temp_);
 }
 
 AtomicFile::~AtomicFile() {
@@ -38,15 +45,23 @@ AtomicFile::~AtomicFile() {
     std::error_code ec;
     std::filesystem::remove(temp_, ec);
   }
+  UnregisterTempPath(slot_);
 }
 
 void AtomicFile::Commit() {
+  if (!SyncPath(temp_, false)) {
+    throw MakeInputError(target_.string(), "output path", "cannot write (fsync failed)");
+  }
   std::error_code ec;
   std::filesystem::rename(temp_, target_, ec);
   if (ec) {
     throw MakeInputError(target_.string(), "output path", "cannot write: " + ec.message());
   }
   committed_ = true;
+  UnregisterTempPath(slot_);
+  slot_ = -1;
+  std::filesystem::path dir = target_.parent_path();
+  SyncPath(dir.empty() ? "." : dir, true);  // the rename itself survives a crash
 }
 
 }  // namespace dgmm
