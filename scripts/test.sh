@@ -21,3 +21,9 @@ fi
 
 cd "$build"
 ctest --output-on-failure -j "${DGMM_JOBS:-$(nproc)}" --timeout 600
+
+# libFuzzer smoke run of each reader (docs/reliability.md), only when clang-14 is present; built
+# apart in build-fuzz/ so the main build stays g++. DGMM_FUZZ_SECONDS=0 skips it.
+if [ "${DGMM_FUZZ_SECONDS:-20}" -gt 0 ] && command -v clang++-14 > /dev/null; then
+  DGMM_FUZZ_BUILD_DIR="$build-fuzz" "$root/scripts/fuzz.sh" "${DGMM_FUZZ_SECONDS:-20}"
+fi

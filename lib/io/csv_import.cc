@@ -1,7 +1,10 @@
 #include "io/csv_import.h"
 
 #include <charconv>
+#include <deque>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -18,6 +21,43 @@ std::string Trim(const std::string& s) {
 }
 
 std::string Line(long long n) { return "line " + std::to_string(n); }
+
+// A cell as echoed in a message: control characters shown as '?', at most 80 characters.
+std::string Echo(const std::string& text) {
+  constexpr size_t kMaxEcho = 80;
+  std::string s = text.substr(0, kMaxEcho);
+  for (char& c : s) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
+  }
+  if (text.size() > kMaxEcho) s += "... (" + std::to_string(text.size()) + " characters)";
+  return s;
+}
+
+// Lines ending in \n, \r\n or a lone \r (old Mac files are one line per record too).
+class LineReader {
+ public:
+  explicit LineReader(std::istream& in) : in_(in) {}
+  bool Next(std::string* line) {
+    if (pending_.empty()) {
+      std::string raw;
+      if (!std::getline(in_, raw)) return false;
+      if (!raw.empty() && raw.back() == '\r') raw.pop_back();
+      size_t start = 0;
+      for (size_t cr = raw.find('\r'); cr != std::string::npos; cr = raw.find('\r', start)) {
+        pending_.push_back(raw.substr(start, cr - start));
+        start = cr + 1;
+      }
+      pending_.push_back(raw.substr(start));
+    }
+    *line = std::move(pending_.front());
+    pending_.pop_front();
+    return true;
+  }
+
+ private:
+  std::istream& in_;
+  std::deque<std::string> pending_;
+};
 
 // Splits one CSV record at commas; fields may be "quoted" (with "" for a quote).
 std::vector<std::string> SplitRecord(const std::string& line, const std::string& path,
@@ -55,18 +95,26 @@ std::vector<std::string> SplitRecord(const std::string& line, const std::string&
 // The value of one cell; InputError naming the line and column unless finite and numeric.
 double ParseNumber(const std::string& cell, const std::string& path, long long line_no,
                    const std::string& column) {
-  const std::string field = Line(line_no) + ", column '" + column + "'";
+  const std::string field = Line(line_no) + ", column '" + Echo(column) + "'";
   std::string text = Trim(cell);
   if (text.empty()) throw MakeInputError(path, field, "empty value, expected a number");
   const char* begin = text.c_str();
   if (*begin == '+') ++begin;
   double value = 0;
   auto [end, ec] = std::from_chars(begin, text.c_str() + text.size(), value);
-  if (ec == std::errc::result_out_of_range) {
-    throw MakeInputError(path, field, "'" + text + "' is out of range (infinite)");
+  if (ec == std::errc::result_out_of_range && end == text.c_str() + text.size()) {
+    // Underflow (1e-400, 0.000...1) reads as 0 or a subnormal; overflow is refused.
+    value = std::strtod(begin, nullptr);
+    if (std::isinf(value)) {
+      throw MakeInputError(path, field,
+                           "'" + Echo(text) +
+                               "' is infinite as a double (beyond +-1.8e308), expected a finite "
+                               "number");
+    }
+    ec = std::errc();
   }
   if (ec != std::errc() || end != text.c_str() + text.size()) {
-    throw MakeInputError(path, field, "'" + text + "' is not a number");
+    throw MakeInputError(path, field, "'" + Echo(text) + "' is not a number");
   }
   if (std::isnan(value)) throw MakeInputError(path, field, "NaN value, expected a finite number");
   if (std::isinf(value)) {
@@ -75,9 +123,13 @@ double ParseNumber(const std::string& cell, const std::string& path, long long l
   return value;
 }
 
+// The names joined with commas, each echoed, cut after about 200 characters.
 std::string JoinNames(const std::vector<std::string>& names) {
   std::string s;
-  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  for (const auto& n : names) {
+    if (s.size() > 200) return s + ", ... (" + std::to_string(names.size()) + " columns)";
+    s += (s.empty() ? "" : ", ") + Echo(n);
+  }
   return s;
 }
 
@@ -91,12 +143,12 @@ std::vector<int> FindColumns(const std::vector<std::string>& wanted,
     for (int i = 0; i < static_cast<int>(header.size()); ++i) {
       if (header[i] != name) continue;
       if (found >= 0) {
-        throw MakeInputError(path, "column '" + name + "'", "appears twice in the header");
+        throw MakeInputError(path, "column '" + Echo(name) + "'", "appears twice in the header");
       }
       found = i;
     }
     if (found < 0) {
-      throw MakeInputError(path, "column '" + name + "'",
+      throw MakeInputError(path, "column '" + Echo(name) + "'",
                            "not found (have: " + JoinNames(header) + ")");
     }
     if (!used->insert(name).second) {
@@ -115,12 +167,16 @@ Standardization Standardize(Eigen::MatrixXd* x, Eigen::MatrixXd* z) {
   t.scale.resize(dx + dz);
   for (Eigen::Index j = 0; j < dx + dz; ++j) {
     auto column = j < dx ? x->col(j) : z->col(j - dx);
-    const double mean = column.mean();
-    const double sd = std::sqrt((column.array() - mean).square().sum() / static_cast<double>(n));
-    const double scale = sd > 0 && std::isfinite(sd) ? sd : 1.0;
-    column = ((column.array() - mean) / scale).matrix();
-    t.offset[j] = mean;
-    t.scale[j] = scale;
+    // In units of the largest magnitude m, so that sums of values near 1e308 cannot overflow.
+    const double m = column.cwiseAbs().maxCoeff();
+    const double unit = m > 0 ? m : 1.0;
+    const Eigen::ArrayXd u = column.array() / unit;
+    const double mean_u = u.mean();
+    const double sd_u = std::sqrt((u - mean_u).square().sum() / static_cast<double>(n));
+    const double scale_u = sd_u > 0 ? sd_u : 1.0 / unit;  // a constant column keeps scale 1
+    column = ((u - mean_u) / scale_u).matrix();
+    t.offset[j] = mean_u * unit;
+    t.scale[j] = scale_u * unit;
   }
   return t;
 }
@@ -132,6 +188,9 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
     throw MakeInputError(path, "pose columns", "none chosen (expected at least one)");
   }
   std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw MakeInputError(path, "", "is a folder, expected a CSV file");
+  }
   if (!std::filesystem::is_regular_file(path, ec)) {
     throw MakeInputError(path, "", "file not found");
   }
@@ -141,9 +200,9 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
   std::string line;
   long long line_no = 0;
   std::vector<std::string> header;
-  while (std::getline(in, line)) {
+  LineReader lines(in);
+  while (lines.Next(&line)) {
     ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
     if (Trim(line).empty()) continue;
     header = SplitRecord(line, path, line_no);
@@ -167,9 +226,8 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
   std::vector<std::vector<double>> command_rows;
   std::vector<std::string> labels;
   std::map<int, int> steps_so_far;
-  while (std::getline(in, line)) {
+  while (lines.Next(&line)) {
     ++line_no;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (Trim(line).empty()) continue;
     const auto fields = SplitRecord(line, path, line_no);
     if (fields.size() != header.size()) {
@@ -195,8 +253,11 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
     if (!episode_idx.empty()) {
       const double e = number(episode_idx[0]);
       if (e != std::floor(e) || std::abs(e) > 2e9) {
-        throw MakeInputError(path, Line(line_no) + ", column '" + header[episode_idx[0]] + "'",
-                             "episode id must be an integer");
+        char shown[32];
+        std::snprintf(shown, sizeof shown, "%.6g", e);
+        throw MakeInputError(path, Line(line_no) + ", column '" + Echo(header[episode_idx[0]]) + "'",
+                             std::string("episode id ") + shown +
+                                 ", expected an integer between -2e9 and 2e9");
       }
       episodes.push_back(static_cast<int>(e));
       steps.push_back(steps_so_far[static_cast<int>(e)]++);

@@ -123,6 +123,16 @@ ModelSlice SliceModel(const MotionModel& model, const SliceSpec& spec, const std
     std::vector<int> given_local;
     for (size_t g = 0; g < given.size(); ++g) given_local.push_back(2 + static_cast<int>(g));
     kept = kept.Conditional(given_local, values);
+    bool usable = !kept.empty() && std::isfinite(kept.total_weight()) && kept.total_weight() > 0;
+    for (int i = 0; usable && i < kept.size(); ++i) {
+      usable = std::isfinite(kept.weight(i)) && kept.component(i).mean().allFinite();
+    }
+    if (!usable) {
+      throw MakeInputError(file, "condition",
+                           "values" + condition_text.substr(1) +
+                               " are so far from every component that the conditional density "
+                               "is not a number; expected values near the data");
+    }
   }
   slice.mixture = kept;
   slice.x_label = Label(model, slice.x_index, names[slice.x_index]);

@@ -150,8 +150,10 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
   json root;
   try {
     root = json::parse(json_text);
-  } catch (const json::parse_error& e) {
-    throw MakeInputError(source_name, "", std::string("not valid JSON: ") + e.what());
+  } catch (const json::exception& e) {  // parse errors, and numbers like 1e400 (out_of_range)
+    std::string what = e.what();
+    if (what.size() > 200) what = what.substr(0, 200) + "...";
+    throw MakeInputError(source_name, "", "not valid JSON: " + what);
   }
   SimConfig c;
   ObjectReader r(root, "", source_name);
@@ -223,6 +225,11 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
 }
 
 SimConfig LoadSimConfig(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw MakeInputError(path, "", "is a folder, expected a JSON config file");
+  }
+  if (!std::filesystem::exists(path, ec)) throw MakeInputError(path, "", "file not found");
   std::ifstream in(path);
   if (!in) throw MakeInputError(path, "", "cannot open the config file");
   std::stringstream text;

@@ -169,3 +169,44 @@ TEST(CsvImport, MissingFileIsAnInputError) {
 
 }  // namespace
 }  // namespace dgmm
+
+namespace dgmm {
+namespace {
+
+// Issue #13: underflow reads as 0, CR-only files are read line by line, a huge cell is echoed
+// cut short, a folder is named as a folder, a huge episode id says what is expected.
+TEST(CsvImportMessages, UnderflowCrOnlyHugeCellsAndFolders) {
+  const fs::path dir = test::TestDir();
+  test::WriteText(dir / "tiny.csv", "x,y\n1e-400,0." + std::string(400, '0') + "1\n2,3\n");
+  const SampleSet tiny = ImportCsv(dir / "tiny.csv", PoseXY());
+  EXPECT_EQ(tiny.x(0, 0), 0.0);
+  EXPECT_EQ(tiny.x(0, 1), 0.0);
+
+  test::WriteText(dir / "cr.csv", "x,y\r1,2\r3,4\r5,6\r");
+  EXPECT_EQ(ImportCsv(dir / "cr.csv", PoseXY()).size(), 3);
+  test::WriteText(dir / "cr_bad.csv", "x,y\r1,2\r3,oops\r5,6\r");
+  try {
+    ImportCsv(dir / "cr_bad.csv", PoseXY());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 3"), std::string::npos) << e.what();
+  }
+
+  const std::string message = ImportError("x,y\n1," + std::string(100000, 'a') + "\n", PoseXY());
+  EXPECT_LT(message.size(), 300u) << message.substr(0, 300);
+  EXPECT_NE(message.find("100000 characters"), std::string::npos) << message.substr(0, 300);
+
+  try {
+    ImportCsv(dir.string(), PoseXY());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a folder"), std::string::npos) << e.what();
+  }
+  CsvImportOptions episodes = PoseXY();
+  episodes.episode_column = "e";
+  EXPECT_NE(ImportError("e,x,y\n1e12,1,2\n", episodes).find("expected an integer between"),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace dgmm
