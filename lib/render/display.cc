@@ -39,7 +39,13 @@ void* SharedDisplay() {
   }
   if (display == nullptr) {
     const char* name = std::getenv("DISPLAY");
-    if (name != nullptr && *name != '\0') display = XOpenDisplay(name);
+    // Like DisplayProblem: a loaded Xvfb can refuse a connection made right after another
+    // client closed (seen with `dgmm view`, whose window takes a while to tear down).
+    for (int attempt = 0; attempt < 8 && display == nullptr && name != nullptr && *name != '\0';
+         ++attempt) {
+      if (attempt > 0) std::this_thread::sleep_for(std::chrono::milliseconds(250));
+      display = XOpenDisplay(name);
+    }
     if (display == nullptr) {
       throw std::runtime_error("cannot open an X display for rendering (DISPLAY=" +
                                std::string(name ? name : "<unset>") +

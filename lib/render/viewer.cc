@@ -402,7 +402,12 @@ Viewer::Viewer(SliceExplorer explorer, ViewerOptions options)
 }
 
 Viewer::~Viewer() {
-  if (impl_ && impl_->recorder) impl_->recorder->Off();
+  if (!impl_) return;
+  if (impl_->recorder) impl_->recorder->Off();
+  // Destroy the X window and its GL context while the connection is open, rather than leaving
+  // the X server to clean up after the process exits (a loaded Xvfb can then refuse the next
+  // client for a while).
+  impl_->window->Finalize();
 }
 
 void Viewer::Redraw() { Impl::Dispatch(nullptr, vtkCommand::ModifiedEvent, impl_.get(), nullptr); }

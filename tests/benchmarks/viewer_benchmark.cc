@@ -45,7 +45,7 @@ void Describe(benchmark::State& state, const SliceExplorer& explorer) {
   const MotionModel& m = Model();
   state.counters["dims"] = m.dim();
   state.counters["commands"] = static_cast<double>(m.mixtures.size());
-  state.counters["components"] = explorer.slices().front().mixture.size();
+  state.counters["components"] = explorer.slices().front().mixture.size();  // first command
 }
 
 // Alternates slider 0 between 25% and 75% of its span (every iteration is a real change).
@@ -64,7 +64,14 @@ void BM_SliderRedraw(benchmark::State& state) {
     options.figure.width = 560;
     options.figure.height = 448;
   }
-  Viewer viewer(SliceExplorer(Inputs(compare), options), {});
+  std::unique_ptr<Viewer> owned;
+  try {
+    owned = std::make_unique<Viewer>(SliceExplorer(Inputs(compare), options), ViewerOptions{});
+  } catch (const std::exception& e) {  // e.g. the display went away
+    state.SkipWithError(e.what());
+    return;
+  }
+  Viewer& viewer = *owned;
   if (viewer.explorer().terrain().empty()) {
     state.SkipWithError("the model has no terrain dimension");
     return;
