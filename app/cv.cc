@@ -1,6 +1,7 @@
 // `dgmm cv`: repeated stratified K-fold cross-validation of a sample set (Table I of the paper):
 // held-out log-likelihood of the DGMM with and without terrain and of an EM-BIC baseline.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <map>
@@ -9,6 +10,8 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "app/dgmm_flags.h"
+#include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "tune/cross_validation.h"
 #include "tune/dimensions.h"
@@ -28,8 +31,8 @@ struct CvArgs {
   bool no_em = false;
   int em_max_components = 5;
   int em_n_init = 3;
-  std::string variant = "faithful";
-  std::vector<double> init_cov;
+  DgmmFlags dgmm;
+  bool stratified = false;
   std::vector<std::string> pose_dims, terrain_dims;
   bool json = false;
 };
@@ -67,22 +70,9 @@ void RunCv(const CvArgs& args) {
     }
   }
   CvOptions options;
+  options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
   options.dgmm.k = args.k;
-  options.dgmm.variant = args.variant == "improved" ? DgmmOptions::Variant::kImproved
-                                                    : DgmmOptions::Variant::kFaithful;
-  if (!args.init_cov.empty()) {
-    const int dim = set.pose_dim() + set.terrain_dim();
-    if (static_cast<int>(args.init_cov.size()) != dim && args.init_cov.size() != 1) {
-      throw MakeInputError(
-          "", "--init-cov",
-          fmt::format("needs 1 or {} values (x || z), got {}", dim, args.init_cov.size()));
-    }
-    // One value applies to every dimension; the without-terrain model uses the x part.
-    options.dgmm.initial_covariance_diagonal =
-        args.init_cov.size() == 1
-            ? Eigen::VectorXd::Constant(dim, args.init_cov[0])
-            : Eigen::Map<const Eigen::VectorXd>(args.init_cov.data(), dim).eval();
-  }
+  options.group_by_episode = !args.stratified;
   options.folds = args.folds;
   options.repeats = args.repeats;
   options.seed = args.seed;
@@ -114,6 +104,8 @@ void RunCv(const CvArgs& args) {
                           {"repeats", summary.repeats},
                           {"k", args.k},
                           {"seed", args.seed},
+                          {"folds_by", summary.folds_by},
+                          {"dgmm_options", DgmmOptionsJson(options.dgmm)},
                           {"shuffle_training", args.shuffle_training},
                           {"has_terrain", summary.has_terrain},
                           {"scored_per_repeat", summary.scored_per_repeat},
@@ -126,9 +118,11 @@ void RunCv(const CvArgs& args) {
     return;
   }
   std::cout << fmt::format(
-      "{}: {} samples, {} commands; {} x {}-fold cross-validation, k = {}, seed {} ({:.1f} s)\n",
+      "{}: {} samples, {} commands; {} x {}-fold cross-validation, k = {}, seed {} ({:.1f} s)\n"
+      "folds: {}; DGMM: {} variant, covariance {}, S0 {}\n",
       args.path, summary.samples, summary.commands, summary.repeats, summary.folds, args.k,
-      args.seed, summary.seconds);
+      args.seed, summary.seconds, summary.folds_by, args.dgmm.variant, args.dgmm.covariance,
+      fmt::format("{}", fmt::join(args.dgmm.init_cov, ",")));
   if (summary.unscored_per_repeat > 0) {
     std::cout << fmt::format(
         "note: {} held-out samples per repeat not scored (their command has no other sample)\n",
@@ -156,7 +150,8 @@ void SetupCv(CLI::App& root) {
       "without terrain");
   cmd->add_option("set", args->path, "Sample set (.h5)")->required();
   cmd->add_option("--k", args->k, "DGMM merge rate k > 0")->capture_default_str();
-  cmd->add_option("--folds", args->folds, "Folds (stratified by command), >= 2")
+  cmd->add_option("--folds", args->folds,
+                  "Folds (whole episodes when the set has them, else stratified by command), >= 2")
       ->capture_default_str();
   cmd->add_option("--repeats", args->repeats, "Repeats with new folds")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of folds and merges")->capture_default_str();
@@ -169,12 +164,10 @@ void SetupCv(CLI::App& root) {
                   "EM-BIC: largest number of components tried per command")
       ->capture_default_str();
   cmd->add_option("--em-n-init", args->em_n_init, "EM restarts per fit")->capture_default_str();
-  cmd->add_option("--variant", args->variant, "DGMM variant")
-      ->check(CLI::IsMember({"faithful", "improved"}))
-      ->capture_default_str();
-  cmd->add_option("--init-cov", args->init_cov,
-                  "Initial covariance diagonal of new components (1 value or one per x||z dim)")
-      ->delimiter(',');
+  AddDgmmFlags(cmd, &args->dgmm);
+  cmd->add_flag("--stratified", args->stratified,
+                "Folds stratified by command even when the set has episodes (default: whole "
+                "episodes per fold when it has them)");
   cmd->add_option("--pose-dims", args->pose_dims,
                   "Pose dimensions to model, by name (default: all)")
       ->delimiter(',');

@@ -17,6 +17,7 @@
 #include <numeric>
 
 #include "app/command.h"
+#include "core/data_scale.h"
 #include "core/dgmm.h"
 #include "core/mise.h"
 #include "core/motion_model.h"
@@ -36,6 +37,8 @@ struct ExperimentArgs {
   int grid_points = 19, seeds_per_k = 50, runs = 100, target = 2, max_attempts = 20000;
   int folds = 10, cv_seeds = 10;
   std::uint64_t seed = 1;
+  std::string init_cov = "identity";                      // S0: identity (the paper's) or data
+  double prior_count = DgmmOptions{}.prior_pseudo_count;  // nu0 of the prior rule
   bool json = false;
 };
 
@@ -47,12 +50,34 @@ struct Pass {
   int last_new_component_at = 0;
 };
 
-DgmmOptions OptionsFor(const std::string& variant, double k) {
+// "<faithful|improved>[-<literal|blend|prior>]" (the rule defaults to the library's) with S0
+// from a.init_cov, resolved against y's per-dimension variance (one command: pooled = total).
+// Throws InputError for an unknown name.
+DgmmOptions OptionsFor(const std::string& variant, double k, const ExperimentArgs& a,
+                       const Eigen::MatrixXd& y) {
   DgmmOptions o;
   o.k = k;
-  o.variant = variant == "improved" ? DgmmOptions::Variant::kImproved
-                                    : DgmmOptions::Variant::kFaithful;
-  return o;
+  const std::size_t dash = variant.find('-');
+  const auto v = ParseVariant(variant.substr(0, dash));
+  const auto rule = dash == std::string::npos ? std::optional(o.covariance_rule)
+                                              : ParseCovarianceRule(variant.substr(dash + 1));
+  if (!v || !rule) {
+    throw MakeInputError("", "--variants",
+                         "'" + variant +
+                             "', expected faithful or improved, optionally followed "
+                             "by -literal, -blend or -prior");
+  }
+  o.variant = *v;
+  o.covariance_rule = *rule;
+  o.prior_pseudo_count = a.prior_count;
+  const auto init = ParseInitialCovarianceRule(a.init_cov);
+  if (!init || *init == DgmmOptions::InitialCovarianceRule::kUser) {
+    throw MakeInputError("", "--init-cov", "'" + a.init_cov + "', expected identity or data");
+  }
+  o.initial_covariance_rule = *init;
+  DataScaleAccumulator scale(static_cast<int>(y.cols()));
+  for (Eigen::Index i = 0; i < y.rows(); ++i) scale.Add(0, y.row(i).transpose());
+  return ResolveDgmmOptions(o, scale.PooledVariance());
 }
 
 Pass ShuffledPass(const Eigen::MatrixXd& y, const std::vector<int>& rows, const DgmmOptions& o,
@@ -134,8 +159,8 @@ nlohmann::json RunVariant(const ExperimentArgs& a, const std::string& variant,
     const double k = std::pow(10.0, -2.0 + 3.0 * g / std::max(1, a.grid_points - 1));
     std::vector<double> counts;
     for (int s = 0; s < a.seeds_per_k; ++s) {
-      counts.push_back(ShuffledPass(y, all, OptionsFor(variant, k), a.seed * 100003 + s)
-                           .mixture.size());
+      counts.push_back(
+          ShuffledPass(y, all, OptionsFor(variant, k, a, y), a.seed * 100003 + s).mixture.size());
       ReportProgress(variant + " k sweep", g * a.seeds_per_k + s + 1,
                      static_cast<long long>(a.grid_points) * a.seeds_per_k);
     }
@@ -155,7 +180,7 @@ nlohmann::json RunVariant(const ExperimentArgs& a, const std::string& variant,
   int attempts = 0;
   for (; attempts < a.max_attempts && static_cast<int>(ise.size()) < a.runs; ++attempts) {
     const std::uint64_t seed = a.seed * 7919 + attempts;
-    Pass pass = ShuffledPass(y, all, OptionsFor(variant, a.k), seed);
+    Pass pass = ShuffledPass(y, all, OptionsFor(variant, a.k, a, y), seed);
     all_counts.push_back(pass.mixture.size());
     if (pass.mixture.size() != a.target) continue;
     const double v = IntegratedSquaredError(pass.mixture, em);
@@ -164,9 +189,9 @@ nlohmann::json RunVariant(const ExperimentArgs& a, const std::string& variant,
     impurity.push_back(Impurity(pass, em, y));
     frozen_at.push_back(pass.last_new_component_at);
     by_ise.emplace_back(v, seed);
-    runs_csv += fmt::format("{},{},{},{:.6g},{:.6g},{:.6g},{}\n", ise.size(), seed,
-                            pass.mixture.size(), v, v / jacobian, impurity.back(),
-                            pass.last_new_component_at);
+    runs_csv +=
+        fmt::format("{},{},{},{:.6g},{:.6g},{:.6g},{}\n", ise.size(), seed, pass.mixture.size(), v,
+                    v / jacobian, impurity.back(), pass.last_new_component_at);
     ReportProgress(variant + " MISE runs", static_cast<long long>(ise.size()), a.runs);
   }
   WriteText(fs::path(a.out_dir) / (variant + "_mise_runs.csv"), runs_csv);
@@ -189,13 +214,13 @@ nlohmann::json RunVariant(const ExperimentArgs& a, const std::string& variant,
     const std::uint64_t seed = by_ise[by_ise.size() / 2].second;
     MotionModel model = header;
     model.kind = "dgmm";
-    model.dgmm_options = OptionsFor(variant, a.k);
+    model.dgmm_options = OptionsFor(variant, a.k, a, y);
     model.seed = seed;
     model.mixtures.clear();
     model.mixtures[em_model.mixtures.begin()->first] =
-        ShuffledPass(y, all, OptionsFor(variant, a.k), seed).mixture;
-    model.metadata["experiment"] = "old-faithful median-ISE run, shuffled order seed " +
-                                   std::to_string(seed);
+        ShuffledPass(y, all, OptionsFor(variant, a.k, a, y), seed).mixture;
+    model.metadata["experiment"] =
+        "old-faithful median-ISE run, shuffled order seed " + std::to_string(seed);
     const std::string path = (fs::path(a.out_dir) / (variant + "_dgmm_median.h5")).string();
     WriteModel(model, path);
     out["median_model"] = path;
@@ -207,14 +232,10 @@ nlohmann::json RunVariant(const ExperimentArgs& a, const std::string& variant,
 void Run(const ExperimentArgs& a) {
   namespace fs = std::filesystem;
   if (!fs::is_directory(a.out_dir)) throw MakeInputError(a.out_dir, "", "not a directory");
-  for (const auto& v : a.variants) {
-    if (v != "faithful" && v != "improved") {
-      throw MakeInputError("", "--variants", "'" + v + "', expected faithful or improved");
-    }
-  }
-  if (!(a.k > 0) || a.runs < 1 || a.folds < 2 || a.grid_points < 2 || a.seeds_per_k < 1 ||
-      a.cv_seeds < 1 || a.target < 1) {
-    throw MakeInputError("", "options", "k > 0, runs >= 1, folds >= 2, grid >= 2 needed");
+  if (!(a.k > 0) || !(a.prior_count > 0) || a.runs < 1 || a.folds < 2 || a.grid_points < 2 ||
+      a.seeds_per_k < 1 || a.cv_seeds < 1 || a.target < 1) {
+    throw MakeInputError("", "options",
+                         "k > 0, prior count > 0, runs >= 1, folds >= 2, grid >= 2 needed");
   }
   const SampleSet set = ReadSampleSet(a.set);
   const MotionModel em_model = ReadModel(a.em);
@@ -223,13 +244,16 @@ void Run(const ExperimentArgs& a) {
     throw MakeInputError(a.set, "", "expects one command, no terrain, and an EM model of it");
   }
   const Eigen::MatrixXd& y = set.x;
+  for (const auto& v : a.variants) OptionsFor(v, a.k, a, y);  // unknown names fail here
   const double log_jacobian =
       set.transform.empty() ? 0.0 : set.transform.scale.array().abs().log().sum();
   MotionModelOptions header_options;
-  header_options.dgmm = OptionsFor("faithful", a.k);
+  header_options.dgmm = OptionsFor(a.variants.front(), a.k, a, y);
   const MotionModel header = LearnMotionModel(set.Subset({0}), header_options);
 
-  nlohmann::json report = {{"set", a.set}, {"em", a.em}, {"samples", set.size()},
+  nlohmann::json report = {{"set", a.set},
+                           {"em", a.em},
+                           {"samples", set.size()},
                            {"standardised", !set.transform.empty()},
                            {"em_components", em_model.mixtures.begin()->second.size()}};
   for (const auto& v : a.variants) report[v] = RunVariant(a, v, y, em_model, header, log_jacobian);
@@ -253,14 +277,14 @@ void Run(const ExperimentArgs& a) {
     em_options.components = em_model.mixtures.begin()->second.size();
     em_options.n_init = 10;
     em_options.seed = a.seed + f;
-    const double em_ll = MeanHeldOutLogLikelihood(FitEm(y_train, em_options).mixture, y, test,
-                                                  log_jacobian);
+    const double em_ll =
+        MeanHeldOutLogLikelihood(FitEm(y_train, em_options).mixture, y, test, log_jacobian);
     scores["em"].push_back(em_ll);
     cv += fmt::format("{},{:.6g}", f, em_ll);
     for (const auto& v : a.variants) {
       std::vector<double> lls;
       for (int s = 0; s < a.cv_seeds; ++s) {
-        Pass pass = ShuffledPass(y, train, OptionsFor(v, a.k), a.seed * 31 + f * 1000 + s);
+        Pass pass = ShuffledPass(y, train, OptionsFor(v, a.k, a, y), a.seed * 31 + f * 1000 + s);
         lls.push_back(MeanHeldOutLogLikelihood(pass.mixture, y, test, log_jacobian));
       }
       scores[v].push_back(Mean(lls));
@@ -298,11 +322,14 @@ void Setup(CLI::App& root) {
   CLI::App* cmd = experiment->add_subcommand(
       "old-faithful", "Section VI-A protocol: k sweep, MISE against EM, cross-validation");
   cmd->add_option("set", a->set, "standardised sample set (one command, 2-D)")
-      ->required()->check(CLI::ExistingFile);
-  cmd->add_option("--em", a->em, "EM model of the set (dgmm em)")->required()
+      ->required()
+      ->check(CLI::ExistingFile);
+  cmd->add_option("--em", a->em, "EM model of the set (dgmm em)")
+      ->required()
       ->check(CLI::ExistingFile);
   cmd->add_option("--out-dir", a->out_dir, "folder for CSV, JSON and model files")->required();
-  cmd->add_option("--variants", a->variants, "faithful,improved")->delimiter(',')
+  cmd->add_option("--variants", a->variants, "faithful,improved[-literal|-blend|-prior],...")
+      ->delimiter(',')
       ->capture_default_str();
   cmd->add_option("--k", a->k, "merge rate of the MISE runs and CV")->capture_default_str();
   cmd->add_option("--grid-points", a->grid_points, "k values, log grid 0.01..10")
@@ -317,6 +344,10 @@ void Setup(CLI::App& root) {
   cmd->add_option("--folds", a->folds, "cross-validation folds")->capture_default_str();
   cmd->add_option("--cv-seeds", a->cv_seeds, "DGMM shuffles per fold")->capture_default_str();
   cmd->add_option("--seed", a->seed, "base seed")->capture_default_str();
+  cmd->add_option("--init-cov", a->init_cov, "S0: identity (the paper's) or data")
+      ->capture_default_str();
+  cmd->add_option("--prior-count", a->prior_count, "nu0 of the prior rule (> 0)")
+      ->capture_default_str();
   cmd->add_flag("--json", a->json, "print the summary as JSON");
   cmd->callback([a] { Run(*a); });
 }

@@ -1,6 +1,7 @@
 // `dgmm fit`: one DGMM per command (Algorithm 2, ADDSAMPLE), streamed from a sample set file
 // chunk by chunk, so memory does not grow with the file.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "app/dgmm_flags.h"
 #include "io/model_io.h"
 #include "io/sample_stream.h"
 #include "io/streaming.h"
@@ -22,10 +24,9 @@ namespace dgmm::app {
 namespace {
 
 struct FitArgs {
-  std::string set, output, variant = "faithful";
+  std::string set, output;
   double k = 0.7;
-  double floor = DgmmOptions{}.covariance_floor;
-  std::vector<double> init_cov;
+  DgmmFlags dgmm;
   std::uint64_t seed = 1;
   bool without_terrain = false;
   int chunk_rows = 65536;
@@ -47,43 +48,26 @@ MotionModelOptions Options(const FitArgs& args) {
     throw MakeInputError(args.set, "--k",
                          fmt::format("must be a finite number > 0, got {}", args.k));
   }
-  if (!std::isfinite(args.floor) || args.floor < 0) {
-    throw MakeInputError(args.set, "--floor", "must be a finite number >= 0");
-  }
   MotionModelOptions o;
-  o.dgmm.k = args.k;
-  o.dgmm.covariance_floor = args.floor;
   o.seed = args.seed;
   o.with_terrain = !args.without_terrain;
-  if (args.variant == "improved") {
-    o.dgmm.variant = DgmmOptions::Variant::kImproved;
-  } else if (args.variant != "faithful") {
-    throw MakeInputError(args.set, "--variant",
-                         "'" + args.variant + "', expected faithful or improved");
-  }
   const SampleSetReader reader(args.set);
   const SampleSet& header = reader.header();
   const int dim = header.pose_dim() + (o.with_terrain ? header.terrain_dim() : 0);
+  try {
+    o.dgmm = DgmmOptionsFromFlags(args.dgmm, dim);
+  } catch (const InputError& e) {
+    throw MakeInputError(args.set, "", e.what());
+  }
   if (args.max_components == 0 || args.max_components < -1 || args.max_components > 1000000000) {
     throw MakeInputError(args.set, "--max-components",
                          fmt::format("{}; expected 1 to 1e9", args.max_components));
   }
   o.dgmm.max_components = static_cast<int>(
       args.max_components > 0 ? args.max_components : DefaultMaxComponents(reader.size(), dim));
-  if (args.init_cov.size() == 1) {
-    o.dgmm.initial_covariance_diagonal = Eigen::VectorXd::Constant(dim, args.init_cov[0]);
-  } else if (!args.init_cov.empty()) {
-    if (static_cast<int>(args.init_cov.size()) != dim) {
-      throw MakeInputError(args.set, "--init-cov",
-                           std::to_string(args.init_cov.size()) + " values for " +
-                               std::to_string(dim) + " dimensions (give 1 or " +
-                               std::to_string(dim) + ")");
-    }
-    o.dgmm.initial_covariance_diagonal =
-        Eigen::Map<const Eigen::VectorXd>(args.init_cov.data(), dim);
-  }
+  o.dgmm.k = args.k;
   std::string error;
-  if (!o.dgmm.IsValid(dim, &error)) throw MakeInputError(args.set, "options", error);
+  if (!o.dgmm.IsValid(&error)) throw MakeInputError(args.set, "options", error);
   return o;
 }
 
@@ -92,9 +76,11 @@ void Run(const FitArgs& args) {
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const MotionModelOptions options = Options(args);
   const auto start = std::chrono::steady_clock::now();
+  std::string warning;
   MotionModel model = LearnMotionModelFromFile(
       args.set, options, args.chunk_rows,
-      [](long long done, long long total) { ReportProgress("fit", done, total); });
+      [](long long done, long long total) { ReportProgress("fit", done, total); }, &warning);
+  if (!warning.empty()) std::cerr << "warning: " << args.set << ": " << warning << "\n";
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   model.metadata["training_set"] = std::filesystem::path(args.set).filename().string();
@@ -122,9 +108,16 @@ void Run(const FitArgs& args) {
                         {"samples", n}});
   }
   if (args.json) {
-    nlohmann::json out = {{"set", args.set},     {"model", args.output}, {"kind", model.kind},
-                          {"k", args.k},         {"seed", args.seed},    {"variant", args.variant},
-                          {"dim", model.dim()},  {"samples", samples},   {"seconds", seconds},
+    nlohmann::json out = {{"set", args.set},
+                          {"model", args.output},
+                          {"kind", model.kind},
+                          {"k", args.k},
+                          {"seed", args.seed},
+                          {"variant", args.dgmm.variant},
+                          {"dgmm_options", DgmmOptionsJson(model.dgmm_options)},
+                          {"dim", model.dim()},
+                          {"samples", samples},
+                          {"seconds", seconds},
                           {"max_components", options.dgmm.max_components},
                           {"commands", commands}};
     std::cout << out.dump(2) << "\n";
@@ -132,8 +125,17 @@ void Run(const FitArgs& args) {
   }
   std::printf(
       "fitted a DGMM per command (k = %g, seed %llu, %s, d = %d) on %lld samples in %.2f s\n",
-      args.k, static_cast<unsigned long long>(args.seed), args.variant.c_str(), model.dim(),
+      args.k, static_cast<unsigned long long>(args.seed), args.dgmm.variant.c_str(), model.dim(),
       samples, seconds);
+  const DgmmOptions& o = model.dgmm_options;
+  std::printf("  covariance %s%s, S0 %s (diagonal %s), floor %.3g\n",
+              CovarianceRuleName(o.covariance_rule),
+              o.covariance_rule == DgmmOptions::CovarianceRule::kPrior
+                  ? fmt::format(" (nu0 = {:g})", o.prior_pseudo_count).c_str()
+                  : "",
+              InitialCovarianceRuleName(o.initial_covariance_rule),
+              fmt::format("{:.3g}", fmt::join(o.initial_covariance_diagonal, ", ")).c_str(),
+              o.covariance_floor);
   for (const auto& c : commands) {
     std::printf("  command %d '%s': %d components from %lld samples\n", c["command"].get<int>(),
                 c["label"].get<std::string>().c_str(), c["components"].get<int>(),
@@ -154,13 +156,7 @@ void Setup(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "seed of the random generator")->capture_default_str();
   cmd->add_flag("--without-terrain", args->without_terrain, "model x alone, ignoring z");
-  cmd->add_option("--init-cov", args->init_cov,
-                  "diagonal of a new component's covariance: one value for every dimension or "
-                  "one per dimension, comma-separated (default: identity)")
-      ->delimiter(',');
-  cmd->add_option("--floor", args->floor, "covariance floor (docs/dgmm.md)")->capture_default_str();
-  cmd->add_option("--variant", args->variant, "faithful (the paper's Algorithm 2) or improved")
-      ->capture_default_str();
+  AddDgmmFlags(cmd, &args->dgmm);
   cmd->add_option("--chunk-rows", args->chunk_rows, "samples read per chunk")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000000));

@@ -108,9 +108,10 @@ json ModelInfo(const std::string& path) {
           {"terrain_names", m.terrain_names},
           {"seed", m.seed},
           {"k", o.k},
-          {"variant", o.variant == DgmmOptions::Variant::kImproved ? "improved" : "faithful"},
+          {"variant", VariantName(o.variant)},
           {"covariance_floor", o.covariance_floor},
           {"initial_covariance_diagonal", Vec(o.initial_covariance_diagonal)},
+          {"dgmm_options", DgmmOptionsJson(o)},
           {"commands", commands},
           {"table_commands", m.command_values.size()},
           {"standardized", !m.transform.empty()},
@@ -162,9 +163,13 @@ void PrintModel(const json& j) {
   std::printf("%s: %s model, %d pose + %d terrain dims (%s)\n",
               j["file"].get<std::string>().c_str(), j["model_kind"].get<std::string>().c_str(),
               j["pose_dim"].get<int>(), j["terrain_dim"].get<int>(), Join(j["pose_names"]).c_str());
-  std::printf("  k %g, %s, floor %g, seed %llu\n", j["k"].get<double>(),
-              j["variant"].get<std::string>().c_str(), j["covariance_floor"].get<double>(),
-              j["seed"].get<unsigned long long>());
+  const json& o = j["dgmm_options"];
+  std::printf("  k %g, %s, covariance %s (nu0 %g), S0 %s, floor %g, seed %llu\n",
+              j["k"].get<double>(), j["variant"].get<std::string>().c_str(),
+              o["covariance_rule"].get<std::string>().c_str(),
+              o["prior_pseudo_count"].get<double>(),
+              o["initial_covariance_rule"].get<std::string>().c_str(),
+              j["covariance_floor"].get<double>(), j["seed"].get<unsigned long long>());
   for (const auto& c : j["commands"]) {
     std::printf("    command %d '%s': %d components, total weight %g\n", c["command"].get<int>(),
                 c["label"].get<std::string>().c_str(), c["components"].get<int>(),

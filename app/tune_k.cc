@@ -1,16 +1,19 @@
-// `dgmm tune-k`: the DGMM merge rate k that maximises the cross-validated held-out
+// `dgmm tune` (alias `tune-k`): the DGMM merge rate k that maximises the cross-validated held-out
 // log-likelihood, found with Ceres on a smooth fit of the curve (lib/tune/tune_k.h).
 #include "tune/tune_k.h"
 
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "app/dgmm_flags.h"
+#include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "render/chart.h"
 #include "tune/dimensions.h"
@@ -29,7 +32,11 @@ struct TuneKArgs {
   double k_min = 1e-3, k_max = 10;
   int grid_points = 9, refine_points = 4;
   bool shuffle_training = false;
-  std::string variant = "faithful";
+  bool stratified = false;
+  double plateau_tolerance = 0;
+  std::vector<double> init_scales = TuneKOptions{}.init_scales;
+  std::vector<double> prior_counts = TuneKOptions{}.prior_counts;
+  DgmmFlags dgmm;
   std::string plot, curve_csv;
   std::vector<std::string> pose_dims, terrain_dims;
   bool json = false;
@@ -103,16 +110,26 @@ void RunTuneK(const TuneKArgs& args) {
   options.cv.seed = args.seed;
   options.cv.threads = args.threads;
   options.cv.shuffle_training = args.shuffle_training;
-  options.cv.dgmm.variant = args.variant == "improved" ? DgmmOptions::Variant::kImproved
-                                                       : DgmmOptions::Variant::kFaithful;
+  options.cv.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
+  options.cv.group_by_episode = !args.stratified;
+  options.plateau_tolerance = args.plateau_tolerance;
+  options.init_scales = args.init_scales;
+  options.prior_counts = args.prior_counts;
   options.k_min = args.k_min;
   options.k_max = args.k_max;
   options.grid_points = args.grid_points;
   options.refine_points = args.refine_points;
-  options.progress = [](int done, int total) { ReportProgress("tune-k evaluations", done, total); };
+  options.progress = [](int done, int total) {
+    if (total >= 0) {
+      ReportProgress("tune cross-validations", done, total);
+    } else if (ShowProgress()) {
+      std::fprintf(stderr, "\rtune cross-validations %d", done);
+    }
+  };
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "options", error);
   const TuneKSummary s = TuneK(set, options);
+  const std::string folds_by = s.folds_by;
   if (!args.curve_csv.empty()) WriteCurveCsv(s, args.curve_csv);
   if (!args.plot.empty()) PlotCurve(s, args.plot);
 
@@ -124,8 +141,20 @@ void RunTuneK(const TuneKArgs& args) {
                        {"sd", p.sd},
                        {"standard_error", p.standard_error},
                        {"smoothed", s.Smoothed(p.k)},
+                       {"components", p.components},
                        {"role", p.role}});
     }
+    auto side = [](const std::vector<TuneKPoint>& pts) {
+      nlohmann::json a = nlohmann::json::array();
+      for (const auto& p : pts) {
+        a.push_back({{"init_scale", p.init_scale},
+                     {"prior_count", p.prior_count},
+                     {"log_likelihood", p.log_likelihood},
+                     {"standard_error", p.standard_error},
+                     {"components", p.components}});
+      }
+      return a;
+    };
     nlohmann::json out = {
         {"file", args.path},
         {"k", s.k},
@@ -143,30 +172,89 @@ void RunTuneK(const TuneKArgs& args) {
         {"best_evaluated",
          {{"k", s.best_evaluated_k}, {"log_likelihood", s.best_evaluated_log_likelihood}}},
         {"curve", curve},
+        {"folds_by", folds_by},
+        {"plateau",
+         {{"flat", s.plateau},
+          {"k_range", {s.plateau_k_lo, s.plateau_k_hi}},
+          {"points", s.plateau_points},
+          {"tolerance", s.plateau_tolerance}}},
+        {"k_rule", s.k_rule},
+        {"components", s.components},
+        {"init_scale", s.init_scale_tuned ? nlohmann::json(s.init_scale) : nlohmann::json()},
+        {"init_scale_plateau", s.init_scale_plateau},
+        {"prior_count", s.prior_count_tuned ? nlohmann::json(s.prior_count) : nlohmann::json()},
+        {"prior_count_plateau", s.prior_count_plateau},
+        {"scale_curve", side(s.scale_curve)},
+        {"prior_curve", side(s.prior_curve)},
+        {"evaluations", s.evaluations},
+        {"cycles", s.cycles},
+        {"start_dgmm_options", DgmmOptionsJson(options.cv.dgmm)},
         {"seconds", s.seconds}};
     std::cout << out.dump(2) << "\n";
     return;
   }
-  std::cout << fmt::format("{}: {} samples, {} x {}-fold, {} terrain, seed {} ({:.1f} s)\n",
-                           args.path, s.samples, s.repeats, s.folds,
-                           s.with_terrain ? "with" : "without", args.seed, s.seconds);
-  std::cout << fmt::format("{:>12}{:>16}{:>12}{:>14}  {}\n", "k", "log-likelihood", "std. error",
-                           "smoothed", "");
+  std::cout << fmt::format(
+      "{}: {} samples, {} x {}-fold, {} terrain, seed {}; {} cross-validations in {} cycle(s) "
+      "({:.1f} s)\n",
+      args.path, s.samples, s.repeats, s.folds, s.with_terrain ? "with" : "without", args.seed,
+      s.evaluations, s.cycles, s.seconds);
+  std::cout << "last k step (at the final S0 scale and nu0):\n";
+  std::cout << "folds: " << folds_by << "\n";
+  std::cout << fmt::format("{:>12}{:>16}{:>12}{:>14}{:>10}  {}\n", "k", "log-likelihood",
+                           "std. error", "smoothed", "mean K", "");
   for (const auto& p : s.curve) {
-    std::cout << fmt::format("{:>12.5g}{:>16.2f}{:>12.2f}{:>14.2f}  {}\n", p.k, p.log_likelihood,
-                             p.standard_error, s.Smoothed(p.k), p.role);
+    std::cout << fmt::format("{:>12.5g}{:>16.2f}{:>12.2f}{:>14.2f}{:>10.2f}  {}\n", p.k,
+                             p.log_likelihood, p.standard_error, s.Smoothed(p.k), p.components,
+                             p.role);
   }
   std::cout << fmt::format(
       "bracket [{:.4g}, {:.4g}]{}; quadratic fit on {} points\n", s.bracket_lo, s.bracket_hi,
       s.at_grid_edge ? " (best grid point at the edge: widen --k-min/--k-max)" : "", s.fit_points);
-  std::cout << fmt::format("chosen k = {:.5g}: held-out log-likelihood {:.2f} +- {:.2f} (s.e.)\n",
-                           s.k, s.log_likelihood, s.standard_error);
+  if (s.plateau) {
+    std::cout << fmt::format(
+        "PLATEAU: {} evaluations within {:.3g} of the best, k from {:.4g} to {:.4g} are "
+        "equivalent; k = {:.5g} is the simplest model there, not a sharp optimum\n",
+        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, s.k);
+  } else {
+    std::cout << "k: " << s.k_rule << "\n";
+  }
+  auto print_side = [](const char* name, const std::vector<TuneKPoint>& pts, bool scale) {
+    for (const auto& p : pts) {
+      std::cout << fmt::format("  {} {:<8.3g} log-likelihood {:.2f} +- {:.2f}, mean K {:.2f}\n",
+                               name, scale ? p.init_scale : p.prior_count, p.log_likelihood,
+                               p.standard_error, p.components);
+    }
+  };
+  if (s.init_scale_tuned) {
+    print_side("S0 scale", s.scale_curve, true);
+    std::cout << fmt::format(
+        "S0 scale f = {:.3g}{}\n", s.init_scale,
+        s.init_scale_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
+  }
+  if (s.prior_count_tuned) {
+    print_side("nu0", s.prior_curve, false);
+    std::cout << fmt::format(
+        "prior pseudo-count nu0 = {:.3g}{}\n", s.prior_count,
+        s.prior_count_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
+  }
+  std::cout << fmt::format(
+      "chosen k = {:.5g}: held-out log-likelihood {:.2f} +- {:.2f} (s.e.), {:.2f} Gaussians per "
+      "command\n",
+      s.k, s.log_likelihood, s.standard_error, s.components);
+  std::cout << fmt::format(
+      "fit with: dgmm fit {} --k {:.5g}{}{}{} -o model.h5\n", args.path, s.k,
+      s.init_scale_tuned ? fmt::format(" --init-scale {:g}", s.init_scale) : "",
+      s.prior_count_tuned ? fmt::format(" --prior-count {:g}", s.prior_count) : "",
+      s.with_terrain ? "" : " --without-terrain");
 }
 
 void SetupTuneK(CLI::App& root) {
   auto args = std::make_shared<TuneKArgs>();
   CLI::App* cmd = root.add_subcommand(
-      "tune-k", "Choose the DGMM merge rate k by cross-validated log-likelihood (Ceres)");
+      "tune",
+      "Choose the DGMM merge rate k (Ceres), then the S0 scale and prior strength, by "
+      "cross-validated log-likelihood; reports plateaus");
+  cmd->alias("tune-k");
   cmd->add_option("set", args->path, "Sample set (.h5)")->required();
   cmd->add_flag("--with-terrain", args->with_terrain, "Maximise p(x | c, z) (the default)");
   cmd->add_flag("--without-terrain", args->without_terrain, "Maximise p(x | c)");
@@ -184,9 +272,19 @@ void SetupTuneK(CLI::App& root) {
       ->capture_default_str();
   cmd->add_flag("--shuffle-training", args->shuffle_training,
                 "Stream training folds in a seeded random order");
-  cmd->add_option("--variant", args->variant, "DGMM variant")
-      ->check(CLI::IsMember({"faithful", "improved"}))
+  AddDgmmFlags(cmd, &args->dgmm);
+  cmd->add_flag("--stratified", args->stratified,
+                "Folds stratified by command even when the set has episodes");
+  cmd->add_option("--plateau-tolerance", args->plateau_tolerance,
+                  "Nats of held-out log-likelihood within which evaluations are equivalent "
+                  "(0: one standard error of the best)")
       ->capture_default_str();
+  cmd->add_option("--init-scales", args->init_scales,
+                  "Grid of S0 scales f tried at the chosen k (--init-cov data); empty: keep")
+      ->delimiter(',');
+  cmd->add_option("--prior-counts", args->prior_counts,
+                  "Grid of nu0 tried at the chosen k (--covariance prior); empty: keep")
+      ->delimiter(',');
   cmd->add_option("--plot", args->plot, "Write the curve as a PNG line chart (needs X)");
   cmd->add_option("--curve-csv", args->curve_csv, "Write the curve as CSV");
   cmd->add_option("--pose-dims", args->pose_dims,
@@ -201,6 +299,6 @@ void SetupTuneK(CLI::App& root) {
 
 }  // namespace
 
-DGMM_REGISTER_COMMAND("tune-k", SetupTuneK);
+DGMM_REGISTER_COMMAND("tune", SetupTuneK);
 
 }  // namespace dgmm::app

@@ -29,8 +29,16 @@ trap 'rm -rf "$work"' EXIT
 common=(--folds "$folds" --repeats "$repeats" --seed "$seed")
 
 echo "check_tune_k: $set_path, $repeats x $folds-fold, seed $seed, ${terrain_flag#--}"
-"$dgmm" tune-k "$set_path" "${common[@]}" "$terrain_flag" --k-min "$k_min" --k-max "$k_max" \
+"$dgmm" tune "$set_path" "${common[@]}" "$terrain_flag" --k-min "$k_min" --k-max "$k_max" \
   --json > "$work/tune.json"
+# The grid over k is run at tune's final S0 scale and prior pseudo-count.
+read -r -a tuned < <(python3 -c '
+import json, sys
+t = json.load(open(sys.argv[1]))
+flags = []
+if t.get("init_scale") is not None: flags += ["--init-scale", repr(t["init_scale"])]
+if t.get("prior_count") is not None: flags += ["--prior-count", repr(t["prior_count"])]
+print(" ".join(flags))' "$work/tune.json")
 python3 - "$k_min" "$k_max" "$grid" > "$work/grid.txt" <<'EOF'
 import math, sys
 lo, hi, n = math.log(float(sys.argv[1])), math.log(float(sys.argv[2])), int(sys.argv[3])
@@ -38,7 +46,7 @@ for i in range(n):
     print(f"{math.exp(lo + (hi - lo) * i / (n - 1)):.8g}")
 EOF
 while read -r k; do
-  "$dgmm" cv "$set_path" "${common[@]}" --no-em --k "$k" --json > "$work/cv_$k.json"
+  "$dgmm" cv "$set_path" "${common[@]}" "${tuned[@]}" --no-em --k "$k" --json > "$work/cv_$k.json"
 done < "$work/grid.txt"
 
 python3 - "$work" "$row" "${JSON_OUT:-}" <<'EOF'
@@ -55,6 +63,10 @@ print(f"{'k':>12} {'held-out LL':>14} {'std. error':>11}")
 for k, ll, se in grid:
     print(f"{k:12.5g} {ll:14.2f} {se:11.2f}{'  <- grid best' if (k, ll, se) == best else ''}")
 gap = best[1] - tune["log_likelihood"]
+plateau = tune["plateau"]
+if plateau["flat"]:
+    print(f"tune reported a PLATEAU: k in [{plateau['k_range'][0]:.4g}, {plateau['k_range'][1]:.4g}] "
+          f"within {plateau['tolerance']:.3g} of the best; it chose the simplest model there")
 ok = gap <= best[2]
 print(f"tune-k: k = {tune['k']:.5g}, held-out LL {tune['log_likelihood']:.2f} +- "
       f"{tune['standard_error']:.2f} ({len(tune['curve'])} evaluations, {tune['seconds']:.1f} s)")
@@ -67,6 +79,7 @@ if json_out:
                           "standard_error": tune["standard_error"],
                           "evaluations": len(tune["curve"]), "seconds": tune["seconds"]},
                "grid_best": {"k": best[0], "log_likelihood": best[1], "standard_error": best[2]},
-               "grid_points": len(grid), "gap": gap, "pass": ok}, open(json_out, "w"), indent=2)
+               "grid_points": len(grid), "gap": gap, "pass": ok, "plateau": plateau,
+               "init_scale": tune.get("init_scale"), "prior_count": tune.get("prior_count")}, open(json_out, "w"), indent=2)
 sys.exit(0 if ok else 1)
 EOF

@@ -31,19 +31,19 @@ echo "== import (standardised) and EM reference" >&2
 
 echo "== k sweep, MISE runs and cross-validation (faithful and improved)" >&2
 "$dgmm" experiment old-faithful "$work/of.h5" --em "$work/em.h5" --out-dir "$work" \
-  --variants faithful,improved --k 0.7 --grid-points 19 --seeds-per-k 50 --runs 100 \
+  --variants faithful-blend,improved-prior --init-cov identity --prior-count 1 --k 0.7 --grid-points 19 --seeds-per-k 50 --runs 100 \
   --target 2 --folds 10 --cv-seeds 10 --seed 1 --json > "$work/summary.json"
 
 echo "== figures" >&2
 python3 "$root/scripts/old_faithful_report.py" join "$work" > "$work/k_sweep.csv"
-xvfb "$dgmm" plot --csv "$work/k_sweep.csv" --x k --y faithful_mean,improved_mean \
-  --yerr faithful_sd,improved_sd --names "paper's algorithm,improved variant" --log-x \
+xvfb "$dgmm" plot --csv "$work/k_sweep.csv" --x k --y faithful-blend_mean,improved-prior_mean \
+  --yerr faithful-blend_sd,improved-prior_sd --names "Algorithm 2 (blend reading),improved variant" --log-x \
   --title "Old Faithful: Gaussians after one pass (mean +- sd over 50 shuffles)" \
   --x-label "k (log scale)" --y-label "number of Gaussians" -o "$fig/figure2_k_sweep.png" >/dev/null
-for variant in faithful improved; do
+for variant in faithful-blend improved-prior; do
   xvfb "$dgmm" render --diff "$work/em.h5" "$work/${variant}_dgmm_median.h5" --data "$work/of.h5" \
     --labels "EM, 2 components, 10 restarts" "DGMM k=0.7 ($variant), median-MISE run" \
-    --size 620x520 -o "$fig/figure3_em_vs_dgmm_${variant}.png" >/dev/null
+    --size 620x520 -o "$fig/figure3_em_vs_dgmm_${variant%%-*}.png" >/dev/null
 done
 xvfb "$dgmm" render "$work/em.h5" --data "$work/of.h5" --size 700x560 \
   --title "EM (2 components, 10 restarts) on Old Faithful, raw units" -o "$fig/em.png" >/dev/null

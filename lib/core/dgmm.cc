@@ -10,51 +10,12 @@ namespace {
 
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
 
-bool Fail(std::string* error, const std::string& message) {
-  if (error) *error = message;
-  return false;
-}
-
 }  // namespace
-
-bool DgmmOptions::IsValid(std::string* error) const {
-  if (!std::isfinite(k) || !(k > 0)) {
-    return Fail(error, "k must be a finite number > 0, got " + std::to_string(k));
-  }
-  if (!std::isfinite(covariance_floor) || covariance_floor < 0) {
-    return Fail(
-        error, "covariance floor must be finite and >= 0, got " + std::to_string(covariance_floor));
-  }
-  if (max_components < 0) {
-    return Fail(error, "max components must be >= 0 (0: no cap), got " +
-                           std::to_string(max_components));
-  }
-  for (int i = 0; i < initial_covariance_diagonal.size(); ++i) {
-    const double v = initial_covariance_diagonal[i];
-    if (!std::isfinite(v) || !(v > 0)) {
-      return Fail(error, "initial covariance diagonal entry " + std::to_string(i) +
-                             " must be finite and > 0, got " + std::to_string(v));
-    }
-  }
-  return true;
-}
-
-bool DgmmOptions::IsValid(int dim, std::string* error) const {
-  if (!IsValid(error)) return false;
-  if (initial_covariance_diagonal.size() != 0 && initial_covariance_diagonal.size() != dim) {
-    return Fail(error, "initial covariance diagonal has " +
-                           std::to_string(initial_covariance_diagonal.size()) +
-                           " entries, the model has " + std::to_string(dim) + " dimensions");
-  }
-  return true;
-}
 
 Dgmm::Dgmm(int dim, DgmmOptions options) : dim_(dim), options_(std::move(options)), mixture_(dim) {
   assert(dim > 0);
   assert(options_.IsValid(dim, nullptr));
-  initial_diagonal_ = options_.initial_covariance_diagonal.size() == dim
-                          ? options_.initial_covariance_diagonal
-                          : Eigen::VectorXd::Ones(dim);
+  initial_diagonal_ = options_.ResolvedInitialDiagonal(dim);
 }
 
 Eigen::MatrixXd Dgmm::SampleCovariance(int i) const {
@@ -71,13 +32,33 @@ Eigen::MatrixXd Dgmm::FlooredCovariance(const DgmmComponentStats& stats) const {
 
 void Dgmm::FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const {
   const double n = static_cast<double>(stats.count);
-  const double nu = std::max(0.0, dim_ + 1.0 - n);  // prior pseudo-samples of S0
-  const double scale = 1.0 / (n - 1.0 + nu);
+  double scatter_scale = 0.0, prior_weight = 0.0;  // cov = M2 * scatter_scale + prior_weight * S0
+  using Rule = DgmmOptions::CovarianceRule;
+  switch (options_.covariance_rule) {
+    case Rule::kLiteral:  // eq. 13: M2 / (n - 1); S0 until a second sample arrives
+      if (stats.count < 2) {
+        prior_weight = 1.0;
+      } else {
+        scatter_scale = 1.0 / (n - 1.0);
+      }
+      break;
+    case Rule::kBlend: {  // (M2 + nu S0) / (n - 1 + nu), nu = max(0, d + 1 - n)
+      const double nu = std::max(0.0, dim_ + 1.0 - n);
+      scatter_scale = 1.0 / (n - 1.0 + nu);
+      prior_weight = nu * scatter_scale;
+      break;
+    }
+    case Rule::kPrior: {  // (M2 + nu0 S0) / (n + nu0)
+      const double nu0 = options_.prior_pseudo_count;
+      scatter_scale = 1.0 / (n + nu0);
+      prior_weight = nu0 * scatter_scale;
+      break;
+    }
+  }
   cov->resize(dim_, dim_);  // no reallocation when already dim x dim
-  *cov = stats.scatter * scale;
+  *cov = stats.scatter * scatter_scale;
   for (int i = 0; i < dim_; ++i) {
-    (*cov)(i, i) =
-        (stats.scatter(i, i) + nu * initial_diagonal_[i]) * scale + options_.covariance_floor;
+    (*cov)(i, i) += prior_weight * initial_diagonal_[i] + options_.covariance_floor;
   }
 }
 

@@ -8,29 +8,10 @@
 #include <string>
 #include <vector>
 
+#include "core/dgmm_options.h"
 #include "core/mixture.h"
 
 namespace dgmm {
-
-struct DgmmOptions {
-  // Which ADDSAMPLE: the paper's (default) or the improved single-pass variant (docs/dgmm.md).
-  enum class Variant { kFaithful, kImproved };
-  Variant variant = Variant::kFaithful;
-  // Merge rate k > 0 in t = 1 - (1 - d) exp(-k n).
-  double k = 0.7;
-  // Diagonal of a new component's covariance; empty means the identity (the paper's choice).
-  Eigen::VectorXd initial_covariance_diagonal;
-  // Floor added to keep covariances positive definite (see docs/dgmm.md for where it applies).
-  double covariance_floor = 1e-6;
-  // At most this many components (0: no cap). At the cap every sample merges (the component is
-  // chosen as usual) and max_components_hit() turns true (issue #13: bounded work).
-  int max_components = 0;
-
-  // k finite and > 0, floor finite and >= 0, initial diagonal (if given) positive and finite.
-  bool IsValid(std::string* error) const;
-  // As above, and the initial diagonal (if given) has `dim` entries.
-  bool IsValid(int dim, std::string* error) const;
-};
 
 // Sufficient statistics of one component: n samples, their mean and scatter
 // M2 = sum (x - mean)(x - mean)^T; nothing else about the samples is kept.
@@ -66,9 +47,8 @@ class Dgmm {
   // ADDSAMPLE (Algorithm 2) for x (dim entries, finite: asserted).
   AddSampleResult AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng);
 
-  // Covariance the model uses for a component with these statistics (docs/dgmm.md, "floor"):
-  // (M2 + nu S0) / (n - 1 + nu) + floor I with nu = max(0, dim + 1 - n), S0 the initial
-  // covariance; equals S0 + floor I for n = 1 and M2 / (n - 1) + floor I once n > dim.
+  // Covariance the model uses for a component with these statistics: the options' covariance
+  // rule (core/dgmm_options.h: literal, blend or prior) applied to (n, M2, S0), plus floor I.
   Eigen::MatrixXd FlooredCovariance(const DgmmComponentStats& stats) const;
   // log max_x p(x) (cached until the components change); -inf when empty.
   double MaxLogDensity() const;
@@ -93,7 +73,8 @@ class Dgmm {
   void MergeInto(int i, const Eigen::Ref<const Eigen::VectorXd>& x);
   // Component index drawn with probability proportional to w_i exp(-1/2 m_i^2(x)).
   int ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng);
-  // FlooredCovariance written into *cov (reusing its storage).
+  // FlooredCovariance written into *cov (reusing its storage); for the improved variant M2 is
+  // its weighted scatter (n - 1) C_w.
   void FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const;
   // Rebuilds mixture_ component i from stats_[i] with the floor.
   void RefreshComponent(int i);
@@ -103,7 +84,7 @@ class Dgmm {
   std::int64_t num_samples_ = 0;
   Mixture mixture_;
   std::vector<DgmmComponentStats> stats_;
-  Eigen::VectorXd initial_diagonal_;  // S0's diagonal, resolved (ones by default)
+  Eigen::VectorXd initial_diagonal_;  // S0's diagonal, resolved (ones for identity)
   mutable bool max_valid_ = false;    // max_log_density_ is up to date
   mutable double max_log_density_ = 0.0;
   mutable Eigen::VectorXd last_mode_;   // argmax of the last mode search (a lower bound)

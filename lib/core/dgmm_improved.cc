@@ -13,9 +13,10 @@
 //     totals W = n(n+1)/2 and S2 = n(n+1)(2n+1)/6 follow from n, so the statistics stay
 //     (count, mean, scatter): `mean` is the weighted mean, `scatter` = (n - 1) C_w where
 //     C_w = M2_w / (W - S2 / W) is the (reliability-weighted, unbiased) weighted covariance.
-//  3. The initial covariance S0 counts as one pseudo-sample for the component's whole life:
-//     covariance = ((n - 1) C_w + S0) / n + floor I. A component that received a few close
-//     samples is never so tight that it stops winning samples of its own cluster.
+//  3. The covariance is the options' covariance rule applied to M2 = (n - 1) C_w (version 1
+//     hard-wired ((n - 1) C_w + S0) / n, which the `prior` rule with nu0 = 1 approximates as
+//     ((n - 1) C_w + S0) / (n + 1)). Under `prior` or `blend` a component that received a few
+//     close samples is never so tight that it stops winning samples of its own cluster.
 // Mixture weights remain the sample counts n_i (eq. 3).
 #include <algorithm>
 #include <cmath>
@@ -24,13 +25,6 @@
 #include "core/dgmm.h"
 
 namespace dgmm {
-namespace {
-
-// Pseudo-samples of S0 in every improved covariance (change 3).
-constexpr double kPriorSamples = 1.0;
-
-}  // namespace
-
 AddSampleResult Dgmm::AddSampleImproved(const Eigen::Ref<const Eigen::VectorXd>& x,
                                         std::mt19937_64& rng) {
   // The decision to merge or start a Gaussian is Algorithm 2's (unchanged).
@@ -65,17 +59,8 @@ AddSampleResult Dgmm::AddSampleImproved(const Eigen::Ref<const Eigen::VectorXd>&
   s.count += 1;
   mixture_.SetWeight(best, static_cast<double>(s.count));
 
-  // 3. Covariance with S0 as one pseudo-sample, plus the floor.
-  Eigen::MatrixXd covariance = s.scatter;
-  covariance.diagonal() += kPriorSamples * initial_diagonal_;
-  covariance /= (m - 1.0 + kPriorSamples);
-  covariance.diagonal().array() += options_.covariance_floor;
-  max_valid_ = false;
-  Gaussian& g = mixture_.mutable_component(best);
-  if (!g.Set(s.mean, covariance)) {
-    // Cannot happen for finite inputs (S0 / m alone is positive definite): keep S0.
-    g.Set(s.mean, initial_diagonal_.asDiagonal().toDenseMatrix());
-  }
+  // 3. Covariance by the options' rule, plus the floor.
+  RefreshComponent(best);
   ++num_samples_;
   return result;
 }

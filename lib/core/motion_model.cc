@@ -1,8 +1,10 @@
 #include "core/motion_model.h"
 
+#include <cassert>
 #include <cmath>
 #include <numeric>
 
+#include "core/data_scale.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -148,9 +150,39 @@ MotionModel ModelHeaderFor(const SampleSet& set, bool with_terrain) {
   return header;
 }
 
-MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options) {
-  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
+MotionModelOptions ResolveMotionModelOptions(const SampleSet& set,
+                                             const MotionModelOptions& options,
+                                             std::string* warning) {
   const bool terrain = options.with_terrain && set.terrain_dim() > 0;
+  return ResolveMotionModelOptions(set, options, PooledWithinCommandVariance(set, terrain),
+                                   warning);
+}
+
+MotionModelOptions ResolveMotionModelOptions(const SampleSet& set,
+                                             const MotionModelOptions& options,
+                                             const Eigen::VectorXd& v, std::string* warning) {
+  const bool terrain = options.with_terrain && set.terrain_dim() > 0;
+  const int dim = set.pose_dim() + (terrain ? set.terrain_dim() : 0);
+  std::string error;
+  if (!options.dgmm.IsValid(&error)) throw MakeInputError("", "dgmm options", error);
+  if (options.dgmm.initial_covariance_rule == DgmmOptions::InitialCovarianceRule::kUser &&
+      options.dgmm.initial_covariance_diagonal.size() != dim) {
+    throw MakeInputError("", "initial covariance",
+                         std::to_string(options.dgmm.initial_covariance_diagonal.size()) +
+                             " values for " + std::to_string(dim) + " dimensions");
+  }
+  std::vector<std::string> names = set.x_names;
+  if (terrain) names.insert(names.end(), set.z_names.begin(), set.z_names.end());
+  MotionModelOptions resolved = options;
+  assert(v.size() == dim);
+  resolved.dgmm = ResolveDgmmOptions(options.dgmm, v, names, warning);
+  return resolved;
+}
+
+MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options_in) {
+  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
+  const bool terrain = options_in.with_terrain && set.terrain_dim() > 0;
+  const MotionModelOptions options = ResolveMotionModelOptions(set, options_in);
   MotionModelLearner learner(ModelHeaderFor(set, options.with_terrain), options);
   Eigen::VectorXd y(learner.Finish().dim());
   for (int i = 0; i < set.size(); ++i) {

@@ -53,6 +53,7 @@ struct MotionModelOptions {
 // a chunked HDF5 reader. `header` carries dims, names, command table and transform.
 class MotionModelLearner {
  public:
+  // options.dgmm must be resolved for dim(y) (DgmmOptions::IsValid(dim); InputError otherwise).
   MotionModelLearner(MotionModel header, const MotionModelOptions& options);
   // y = x || z when the header has terrain_dim > 0, else x alone.
   void Add(int command, const Eigen::Ref<const Eigen::VectorXd>& y);
@@ -71,8 +72,19 @@ class MotionModelLearner {
 // source: y = x || z when with_terrain and the set has terrain, else x alone.
 MotionModel ModelHeaderFor(const SampleSet& set, bool with_terrain);
 
+// The options with the DGMM's S0 and floor resolved against the set's pooled within-command
+// variance of y (core/data_scale.h, ResolveDgmmOptions); *warning as there. For kUser the
+// diagonal must have dim(y) entries (InputError otherwise).
+MotionModelOptions ResolveMotionModelOptions(const SampleSet& set, const MotionModelOptions& options,
+                                             std::string* warning = nullptr);
+// As above with v given (e.g. from a file pass); `header` supplies names and dimensions only.
+MotionModelOptions ResolveMotionModelOptions(const SampleSet& header,
+                                             const MotionModelOptions& options,
+                                             const Eigen::VectorXd& v, std::string* warning);
+
 // Streams the samples in set order through one Dgmm per command (a command with no samples has
-// no model). The rng is seeded once from options.seed, so same seed, same model.
+// no model), after resolving the options against the set (ResolveMotionModelOptions, a first
+// pass). The rng is seeded once from options.seed, so same seed, same model.
 MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& options);
 
 // Total log-likelihood of the set under the model: sum_i log p(x_i | c_i [, z_i]), using the

@@ -23,10 +23,6 @@ std::string Num(double v) {
   return buf;
 }
 
-const char* VariantName(DgmmOptions::Variant v) {
-  return v == DgmmOptions::Variant::kImproved ? "improved" : "faithful";
-}
-
 // Command table of the model: ids (sorted), values and labels. Labels are either absent or
 // given for every id that has values.
 void WriteModelCommands(hid_t file, const MotionModel& model, const std::string& path) {
@@ -170,24 +166,55 @@ void WriteOptions(hid_t file, const DgmmOptions& o, const std::string& path) {
   h5::WriteStringAttribute(g.get(), "variant", VariantName(o.variant), path);
   h5::WriteDoubleAttribute(g.get(), "k", o.k, path);
   h5::WriteDoubleAttribute(g.get(), "covariance_floor", o.covariance_floor, path);
+  h5::WriteDoubleAttribute(g.get(), "covariance_floor_relative", o.covariance_floor_relative, path);
+  h5::WriteStringAttribute(g.get(), "covariance_rule", CovarianceRuleName(o.covariance_rule), path);
+  const bool prior = o.covariance_rule == DgmmOptions::CovarianceRule::kPrior;
+  h5::WriteDoubleAttribute(g.get(), "prior_pseudo_count", prior ? o.prior_pseudo_count : 0.0, path);
+  h5::WriteStringAttribute(g.get(), "initial_covariance_rule",
+                           InitialCovarianceRuleName(o.initial_covariance_rule), path);
+  h5::WriteDoubleAttribute(g.get(), "initial_covariance_fraction", o.initial_covariance_fraction,
+                           path);
   const hsize_t n = o.initial_covariance_diagonal.size();
   h5::WriteDoubles(g.get(), "initial_covariance_diagonal", {n},
                    o.initial_covariance_diagonal.data(), path);
 }
 
+// A string attribute parsed by `parse`; absent (a file written before issue #10): `fallback`.
+template <typename T, typename Parse>
+T ReadRule(hid_t g, const char* name, const std::string& path, const char* expected, T fallback,
+           Parse parse) {
+  if (!h5::HasAttribute(g, name)) return fallback;
+  const std::string field = std::string("dgmm_options/") + name;
+  const std::string value = h5::ReadStringAttribute(g, name, path, field);
+  if (auto parsed = parse(value)) return *parsed;
+  throw MakeInputError(path, field, "'" + value + "', expected " + expected);
+}
+
+// An optional float64 attribute; absent: `fallback`.
+double ReadOptionalDouble(hid_t g, const char* name, const std::string& path, double fallback) {
+  if (!h5::HasAttribute(g, name)) return fallback;
+  return h5::ReadDoubleAttribute(g, name, path, std::string("dgmm_options/") + name);
+}
+
 DgmmOptions ReadOptions(hid_t file, const std::string& path) {
   DgmmOptions o;
   h5::Group g = h5::OpenGroup(file, "dgmm_options", path);
-  std::string variant = h5::ReadStringAttribute(g.get(), "variant", path, "dgmm_options/variant");
-  if (variant == "improved") {
-    o.variant = DgmmOptions::Variant::kImproved;
-  } else if (variant != "faithful") {
-    throw MakeInputError(path, "dgmm_options/variant",
-                         "'" + variant + "', expected faithful or improved");
-  }
+  o.variant = ReadRule(g.get(), "variant", path, "faithful or improved",
+                       DgmmOptions::Variant::kFaithful, ParseVariant);
   o.k = h5::ReadDoubleAttribute(g.get(), "k", path, "dgmm_options/k");
   o.covariance_floor =
       h5::ReadDoubleAttribute(g.get(), "covariance_floor", path, "dgmm_options/covariance_floor");
+  // Items of issue #10; a model written before them used the blend, identity S0 and an
+  // absolute floor.
+  o.covariance_floor_relative = ReadOptionalDouble(g.get(), "covariance_floor_relative", path, 0);
+  o.covariance_rule = ReadRule(g.get(), "covariance_rule", path, "literal, blend or prior",
+                               DgmmOptions::CovarianceRule::kBlend, ParseCovarianceRule);
+  o.prior_pseudo_count = ReadOptionalDouble(g.get(), "prior_pseudo_count", path, 0);
+  o.initial_covariance_rule =
+      ReadRule(g.get(), "initial_covariance_rule", path, "identity, data or user",
+               DgmmOptions::InitialCovarianceRule::kIdentity, ParseInitialCovarianceRule);
+  o.initial_covariance_fraction = ReadOptionalDouble(g.get(), "initial_covariance_fraction", path,
+                                                     o.initial_covariance_fraction);
   auto diag = h5::ReadDoubles(g.get(), "initial_covariance_diagonal", 1, path);
   o.initial_covariance_diagonal =
       Eigen::Map<Eigen::VectorXd>(diag.data.data(), static_cast<Eigen::Index>(diag.data.size()));
@@ -203,6 +230,9 @@ DgmmOptions ReadOptions(hid_t file, const std::string& path) {
     throw MakeInputError(path, "dgmm_options/initial_covariance_diagonal",
                          "expected finite values > 0");
   }
+  if (o.covariance_rule != DgmmOptions::CovarianceRule::kPrior) o.prior_pseudo_count = 1.0;
+  std::string error;
+  if (!o.IsValid(&error)) throw MakeInputError(path, "dgmm_options", error);
   return o;
 }
 

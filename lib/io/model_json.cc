@@ -41,6 +41,19 @@ void Components(const Mixture& mixture, const Standardization* to_raw, int dim, 
 
 }  // namespace
 
+json DgmmOptionsJson(const DgmmOptions& o) {
+  const bool prior = o.covariance_rule == DgmmOptions::CovarianceRule::kPrior;
+  return {{"variant", VariantName(o.variant)},
+          {"k", o.k},
+          {"covariance_rule", CovarianceRuleName(o.covariance_rule)},
+          {"prior_pseudo_count", prior ? o.prior_pseudo_count : 0.0},
+          {"initial_covariance_rule", InitialCovarianceRuleName(o.initial_covariance_rule)},
+          {"initial_covariance_fraction", o.initial_covariance_fraction},
+          {"initial_covariance_diagonal", Vector(o.initial_covariance_diagonal)},
+          {"covariance_floor", o.covariance_floor},
+          {"covariance_floor_relative", o.covariance_floor_relative}};
+}
+
 void WriteModelJson(const MotionModel& model, const std::string& path) {
   json j;
   j["dgmm_format"] = "model";
@@ -54,11 +67,7 @@ void WriteModelJson(const MotionModel& model, const std::string& path) {
   j["command_dim_names"] = model.command_dim_names;
   j["seed"] = model.seed;
   const DgmmOptions& o = model.dgmm_options;
-  j["dgmm_options"] = {
-      {"variant", o.variant == DgmmOptions::Variant::kImproved ? "improved" : "faithful"},
-      {"k", o.k},
-      {"covariance_floor", o.covariance_floor},
-      {"initial_covariance_diagonal", Vector(o.initial_covariance_diagonal)}};
+  j["dgmm_options"] = DgmmOptionsJson(o);
   const bool has_transform = !model.transform.empty();
   if (has_transform &&
       (model.transform.offset.size() < model.dim() || model.transform.scale.size() < model.dim())) {

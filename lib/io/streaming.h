@@ -14,8 +14,12 @@ using StreamProgress = std::function<void(long long done, long long total)>;
 
 // Same model as LearnMotionModel(ReadSampleSet(path), options), streaming the samples through
 // a MotionModelLearner. Throws InputError naming the file.
+// Two passes: the first resolves the options against the file's pooled within-command variance
+// (ResolveMotionModelOptions), the second streams the samples through the learner. *warning
+// (if given) receives ResolveDgmmOptions' scale warning (empty when none).
 MotionModel LearnMotionModelFromFile(const std::string& path, const MotionModelOptions& options,
-                                     int chunk_rows = 65536, const StreamProgress& progress = {});
+                                     int chunk_rows = 65536, const StreamProgress& progress = {},
+                                     std::string* warning = nullptr);
 
 // Score of one command of the set: sum log p(x | c [, z]) over its samples.
 struct CommandScore {

@@ -33,8 +33,9 @@ std::uint64_t SplitMix64(std::uint64_t x) {
 // What one (repeat, fold) task produced.
 struct FoldResult {
   std::array<std::vector<double>, kVariants> per_sample;  // scored validation samples
-  std::array<double, kVariants> components{};             // EM: sum of chosen K over commands
+  std::array<double, kVariants> components{};             // sum of K over commands
   int em_commands = 0;
+  int dgmm_commands = 0;  // per terrain setting
   int unscored = 0;
 };
 
@@ -104,6 +105,10 @@ FoldResult RunFold(const SampleSet& set, const std::vector<int>& fold_of, int re
     model_options.with_terrain = terrain;
     model_options.seed = seed;  // the same stream with and without terrain, and for every k
     const MotionModel dgmm_model = LearnMotionModel(train, model_options);
+    result.dgmm_commands = static_cast<int>(dgmm_model.mixtures.size());
+    for (const auto& [c, mixture] : dgmm_model.mixtures) {
+      result.components[terrain ? kDgmmWith : kDgmmWithout] += mixture.size();
+    }
     MotionModel em_model;
     const int em_variant = terrain ? kEmWith : kEmWithout;
     if (options.em_baseline) {
@@ -159,6 +164,24 @@ std::vector<int> StratifiedFolds(const Eigen::VectorXi& command, int folds, std:
       fold_of[i] = next;
       next = (next + 1) % folds;
     }
+  }
+  return fold_of;
+}
+
+std::vector<int> EpisodeFolds(const Eigen::VectorXi& episode, int folds, std::mt19937_64& rng) {
+  assert(folds >= 1);
+  std::map<int, std::vector<int>> rows_of;  // ordered by episode id: deterministic
+  for (int i = 0; i < episode.size(); ++i) rows_of[episode(i)].push_back(i);
+  assert(static_cast<int>(rows_of.size()) >= folds);
+  std::vector<const std::vector<int>*> order;
+  for (const auto& [e, rows] : rows_of) order.push_back(&rows);
+  std::shuffle(order.begin(), order.end(), rng);
+  std::vector<int> fold_of(episode.size(), 0);
+  std::vector<long long> size(folds, 0);
+  for (const std::vector<int>* rows : order) {
+    const int f = static_cast<int>(std::min_element(size.begin(), size.end()) - size.begin());
+    for (int i : *rows) fold_of[i] = f;
+    size[f] += static_cast<long long>(rows->size());
   }
   return fold_of;
 }
@@ -227,10 +250,28 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
       static_cast<int>(std::unique(distinct.begin(), distinct.end()) - distinct.begin());
 
   // Fold assignments first (serially), then every (repeat, fold) task on the worker threads.
+  int episodes = 0;
+  if (set.has_sequence()) {
+    std::vector<int> ids(set.episode.data(), set.episode.data() + set.size());
+    std::sort(ids.begin(), ids.end());
+    episodes = static_cast<int>(std::unique(ids.begin(), ids.end()) - ids.begin());
+  }
+  const bool by_episode = options.group_by_episode && episodes >= options.folds;
+  if (by_episode) {
+    summary.folds_by = "episodes (" + std::to_string(episodes) + " whole episodes)";
+  } else if (!options.group_by_episode) {
+    summary.folds_by = "stratified by command (asked)";
+  } else if (!set.has_sequence()) {
+    summary.folds_by = "stratified by command (the set has no episode data)";
+  } else {
+    summary.folds_by = "stratified by command (only " + std::to_string(episodes) +
+                       " episodes for " + std::to_string(options.folds) + " folds)";
+  }
   std::vector<std::vector<int>> fold_of(options.repeats);
   for (int r = 0; r < options.repeats; ++r) {
     std::mt19937_64 rng(DeriveSeed(options.seed, r, 0, 0));
-    fold_of[r] = StratifiedFolds(set.command, options.folds, rng);
+    fold_of[r] = by_episode ? EpisodeFolds(set.episode, options.folds, rng)
+                            : StratifiedFolds(set.command, options.folds, rng);
   }
   const int tasks = options.repeats * options.folds;
   std::vector<FoldResult> results(tasks);
@@ -266,7 +307,7 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
                                             &summary.dgmm_with_terrain, &summary.em_without_terrain,
                                             &summary.em_with_terrain};
   double components_total[kVariants] = {0, 0, 0, 0};
-  int em_commands = 0;
+  int em_commands = 0, dgmm_commands = 0;
   for (int v = 0; v < kVariants; ++v) {
     scores[v]->per_fold = Eigen::MatrixXd::Zero(options.repeats, options.folds);
   }
@@ -277,6 +318,7 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
       const FoldResult& fr = results[r * options.folds + f];
       unscored += fr.unscored;
       em_commands += fr.em_commands;
+      dgmm_commands += fr.dgmm_commands;
       for (int v = 0; v < kVariants; ++v) {
         scores[v]->per_fold(r, f) =
             std::accumulate(fr.per_sample[v].begin(), fr.per_sample[v].end(), 0.0);
@@ -301,6 +343,9 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
     s.sd = SampleSd(s.per_repeat);
     s.mean_per_sample = summary.scored_per_repeat > 0 ? s.mean / summary.scored_per_repeat : 0;
     if (v >= kEmWithout && em_commands > 0) s.mean_components = components_total[v] / em_commands;
+    if (v < kEmWithout && dgmm_commands > 0) {
+      s.mean_components = components_total[v] / dgmm_commands;
+    }
   }
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
@@ -309,7 +354,7 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
 std::string CvSummary::BriefReport() const {
   std::ostringstream out;
   out << repeats << " x " << folds << "-fold cross-validation, " << samples << " samples, "
-      << commands << " commands";
+      << commands << " commands, folds " << folds_by;
   auto row = [&](const char* name, const CvScore& s) {
     if (s.evaluated) out << "; " << name << " " << s.mean << " +- " << s.sd;
   };

@@ -1,5 +1,5 @@
 #pragma once
-// Repeated stratified K-fold cross-validation of motion models, as in Table I of Edgington et al.:
+// Repeated K-fold cross-validation (whole episodes per fold, else stratified by command) of motion models, as in Table I of Edgington et al.:
 // per repeat, the held-out log-likelihood summed over every validation fold,
 //   L_r = sum_f sum_{i in fold f} log p(x_i | c_i [, z_i]; model trained on the other folds),
 // for the DGMM without terrain (p(x | c)) and with it (p(x | c, z)), and for an EM baseline per
@@ -24,6 +24,12 @@ namespace dgmm {
 // some folds (never duplicated). folds >= 1 (asserted).
 std::vector<int> StratifiedFolds(const Eigen::VectorXi& command, int folds, std::mt19937_64& rng);
 
+// fold[i] in 0..folds-1 for each sample, grouped by episode: the distinct episode ids are
+// shuffled (rng) and each is given whole to the fold with the fewest samples so far (lowest
+// index on ties), so no episode is split across folds and fold sizes stay close. Needs at least
+// `folds` distinct episodes (asserted).
+std::vector<int> EpisodeFolds(const Eigen::VectorXi& episode, int folds, std::mt19937_64& rng);
+
 // A seed for one independent stream, mixed (splitmix64) from a base seed and up to three indices
 // (e.g. repeat, fold, purpose). The same inputs always give the same seed.
 std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b = 0,
@@ -41,6 +47,10 @@ struct CvOptions {
   // false (default): each training fold streams its samples in the set's recorded order, as the
   // robot produced them (ADDSAMPLE is order dependent). true: shuffled per (repeat, fold).
   bool shuffle_training = false;
+  // true (default): when the set has episode data with at least `folds` episodes, folds hold
+  // whole episodes (EpisodeFolds), so windows of one drive never fall on both sides; otherwise
+  // (or when false) stratified by command (StratifiedFolds).
+  bool group_by_episode = true;
   // Which rows of the table to compute. With terrain needs a set with terrain (else skipped).
   bool without_terrain = true;
   bool with_terrain = true;
@@ -71,7 +81,8 @@ struct CvScore {
   // they are averaged, not counted as independent).
   double standard_error = 0;
   double mean_per_sample = 0;  // mean / n_scored
-  // EM only: the mean over folds and commands of the number of components BIC chose.
+  // The mean over folds and commands of the number of components (EM: the K BIC chose; DGMM:
+  // the Gaussians the pass ended with).
   double mean_components = 0;
 };
 
@@ -85,6 +96,9 @@ struct CvSummary {
   int scored_per_repeat = 0;
   int unscored_per_repeat = 0;
   bool has_terrain = false;
+  // How the folds were made, stated in every report: "episodes (E whole episodes)" or
+  // "stratified by command" with the reason when episodes were not used.
+  std::string folds_by;
   CvScore dgmm_without_terrain, dgmm_with_terrain, em_without_terrain, em_with_terrain;
   double seconds = 0;  // wall time
   std::string BriefReport() const;

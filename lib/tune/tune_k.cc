@@ -6,7 +6,9 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <map>
 #include <sstream>
+#include <tuple>
 
 #include "util/error.h"
 
@@ -45,8 +47,21 @@ class NegatedQuadratic : public ceres::FirstOrderFunction {
   double b_, c_, u0_, lo_, hi_;
 };
 
-TuneKPoint ToPoint(double k, const CvScore& score, const char* role) {
-  return {k, score.mean, score.sd, score.standard_error, role};
+TuneKPoint ToPoint(const DgmmOptions& o, const CvScore& score, const char* role) {
+  return {o.k,
+          score.mean,
+          score.sd,
+          score.standard_error,
+          role,
+          score.mean_components,
+          o.initial_covariance_fraction,
+          o.prior_pseudo_count};
+}
+
+std::string Num(double v) {
+  std::ostringstream out;
+  out << v;
+  return out.str();
 }
 
 }  // namespace
@@ -63,8 +78,44 @@ bool TuneKOptions::IsValid(std::string* error) const {
     return fail("need 0 < k_min < k_max (finite)");
   }
   if (grid_points < 3) return fail("grid_points must be >= 3");
+  if (cycles < 1) return fail("cycles must be >= 1");
   if (refine_points < 0) return fail("refine_points must be >= 0");
+  if (!(plateau_tolerance >= 0) || !std::isfinite(plateau_tolerance)) {
+    return fail("plateau_tolerance must be finite and >= 0");
+  }
+  for (double f : init_scales) {
+    if (!(f > 0) || !std::isfinite(f)) return fail("init_scales must be finite and > 0");
+  }
+  for (double nu : prior_counts) {
+    if (!(nu > 0) || !std::isfinite(nu)) return fail("prior_counts must be finite and > 0");
+  }
   return true;
+}
+
+Plateau FindPlateau(const std::vector<TuneKPoint>& points, double tolerance) {
+  Plateau p;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    if (p.best < 0 || points[i].log_likelihood > points[p.best].log_likelihood) p.best = i;
+  }
+  if (p.best < 0) return p;
+  const double floor = points[p.best].log_likelihood - tolerance;
+  for (int i = 0; i < static_cast<int>(points.size()); ++i) {
+    if (points[i].log_likelihood < floor) continue;
+    p.members.push_back(i);
+    const TuneKPoint& q = points[i];
+    if (p.simplest < 0 || q.components < points[p.simplest].components ||
+        (q.components == points[p.simplest].components &&
+         q.log_likelihood > points[p.simplest].log_likelihood)) {
+      p.simplest = i;
+    }
+  }
+  p.flat = p.members.size() > 1;
+  p.k_lo = p.k_hi = points[p.best].k;
+  for (int i : p.members) {
+    p.k_lo = std::min(p.k_lo, points[i].k);
+    p.k_hi = std::max(p.k_hi, points[i].k);
+  }
+  return p;
 }
 
 double TuneKSummary::Smoothed(double k) const {
@@ -134,6 +185,125 @@ void FitAndMaximise(const std::vector<TuneKPoint>& points, double bracket_lo, do
   summary->maximise_report = max_summary.BriefReport();
 }
 
+namespace {
+
+// One evaluation per (k, f, nu0): CrossValidate with the same folds and random numbers.
+class Evaluator {
+ public:
+  Evaluator(const SampleSet& set, CvOptions cv, const TuneKOptions& options, TuneKSummary* summary)
+      : set_(set), cv_(std::move(cv)), options_(options), summary_(summary) {}
+  DgmmOptions& dgmm() { return cv_.dgmm; }
+  TuneKPoint operator()(double k, const char* role) {
+    cv_.dgmm.k = k;
+    const auto key =
+        std::make_tuple(k, cv_.dgmm.initial_covariance_fraction, cv_.dgmm.prior_pseudo_count);
+    if (auto it = cache_.find(key); it != cache_.end()) return it->second;
+    if (options_.progress) options_.progress(static_cast<int>(cache_.size()), -1);
+    const CvSummary result = CrossValidate(set_, cv_);
+    summary_->folds = result.folds;
+    summary_->repeats = result.repeats;
+    summary_->samples = result.samples;
+    summary_->folds_by = result.folds_by;
+    summary_->evaluations = static_cast<int>(cache_.size()) + 1;
+    return cache_[key] = ToPoint(
+               cv_.dgmm,
+               summary_->with_terrain ? result.dgmm_with_terrain : result.dgmm_without_terrain,
+               role);
+  }
+  double Tolerance(const std::vector<TuneKPoint>& pts) const {
+    if (options_.plateau_tolerance > 0) return options_.plateau_tolerance;
+    return std::max(pts[FindPlateau(pts, 0.0).best].standard_error, 1e-9);
+  }
+
+ private:
+  const SampleSet& set_;
+  CvOptions cv_;
+  const TuneKOptions& options_;
+  TuneKSummary* summary_;
+  std::map<std::tuple<double, double, double>, TuneKPoint> cache_;
+};
+
+// The k step at the evaluator's f and nu0: grid, bracket, refinement, Ceres fit, plateau rule.
+// Fills the k fields of *summary and returns the chosen point.
+TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummary* summary) {
+  const double u_min = std::log(options.k_min), u_max = std::log(options.k_max);
+  const double step = (u_max - u_min) / (options.grid_points - 1);
+  std::vector<TuneKPoint> points;
+  for (int i = 0; i < options.grid_points; ++i) {
+    points.push_back(evaluate(std::exp(u_min + i * step), "grid"));
+  }
+  int best = 0;
+  for (int i = 1; i < options.grid_points; ++i) {
+    if (points[i].log_likelihood > points[best].log_likelihood) best = i;
+  }
+  summary->at_grid_edge = best == 0 || best == options.grid_points - 1;
+  const double lo = u_min + std::max(best - 1, 0) * step;
+  const double hi = u_min + std::min(best + 1, options.grid_points - 1) * step;
+  summary->bracket_lo = std::exp(lo);
+  summary->bracket_hi = std::exp(hi);
+  const double scale = std::max(points[best].standard_error, 1e-6);
+  for (int j = 1; j <= options.refine_points; ++j) {
+    points.push_back(
+        evaluate(std::exp(lo + (hi - lo) * j / (options.refine_points + 1.0)), "refine"));
+  }
+  FitAndMaximise(points, summary->bracket_lo, summary->bracket_hi, scale, summary);
+  // Plateau rule: several evaluations equivalent to the best -> the simplest of them.
+  summary->plateau_tolerance = evaluate.Tolerance(points);
+  const Plateau plateau = FindPlateau(points, summary->plateau_tolerance);
+  summary->plateau = plateau.flat;
+  summary->plateau_k_lo = plateau.k_lo;
+  summary->plateau_k_hi = plateau.k_hi;
+  summary->plateau_points = static_cast<int>(plateau.members.size());
+  TuneKPoint chosen;
+  if (plateau.flat) {
+    chosen = points[plateau.simplest];
+    summary->k = chosen.k;
+    summary->k_rule = "plateau: " + std::to_string(plateau.members.size()) +
+                      " evaluations within " + Num(summary->plateau_tolerance) +
+                      " of the best, k in [" + Num(plateau.k_lo) + ", " + Num(plateau.k_hi) +
+                      "]; chose the simplest (fewest Gaussians, " + Num(chosen.components) +
+                      " per command)";
+  } else {
+    summary->k_rule = "maximum of the Ceres quadratic fit (no other evaluation within " +
+                      Num(summary->plateau_tolerance) + " of the best)";
+    chosen = evaluate(summary->k, "chosen");
+    points.push_back(chosen);
+  }
+  std::sort(points.begin(), points.end(), [](const auto& p, const auto& q) { return p.k < q.k; });
+  summary->curve = points;
+  const auto top = std::max_element(points.begin(), points.end(), [](const auto& p, const auto& q) {
+    return p.log_likelihood < q.log_likelihood;
+  });
+  summary->best_evaluated_k = top->k;
+  summary->best_evaluated_log_likelihood = top->log_likelihood;
+  return chosen;
+}
+
+// A coordinate step at the chosen k over `grid` for one option; same plateau rule.
+TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions::*field,
+                            const char* role, const TuneKPoint& start, double k,
+                            Evaluator& evaluate, std::vector<TuneKPoint>* curve, bool* flat) {
+  std::vector<TuneKPoint> pts = {start};
+  const double kept = evaluate.dgmm().*field;
+  for (double value : grid) {
+    if (value == kept) continue;  // the start point already has it
+    evaluate.dgmm().*field = value;
+    pts.push_back(evaluate(k, role));
+  }
+  const Plateau p = FindPlateau(pts, evaluate.Tolerance(pts));
+  *flat = p.flat;
+  const TuneKPoint pick = pts[p.flat ? p.simplest : p.best];
+  evaluate.dgmm().initial_covariance_fraction = pick.init_scale;
+  evaluate.dgmm().prior_pseudo_count = pick.prior_count;
+  std::sort(pts.begin(), pts.end(), [](const auto& a, const auto& b) {
+    return std::tie(a.init_scale, a.prior_count) < std::tie(b.init_scale, b.prior_count);
+  });
+  *curve = pts;
+  return pick;
+}
+
+}  // namespace
+
 TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "tune-k", error);
@@ -145,57 +315,46 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
   cv.em_baseline = false;
   cv.with_terrain = summary.with_terrain;
   cv.without_terrain = !summary.with_terrain;
-  const int planned = options.grid_points + options.refine_points + 1;
-  int evaluations = 0;
-  auto evaluate = [&](double k, const char* role) {
-    if (options.progress) options.progress(evaluations, planned);
-    ++evaluations;
-    cv.dgmm.k = k;
-    const CvSummary result = CrossValidate(set, cv);
-    summary.folds = result.folds;
-    summary.repeats = result.repeats;
-    summary.samples = result.samples;
-    return ToPoint(k, summary.with_terrain ? result.dgmm_with_terrain : result.dgmm_without_terrain,
-                   role);
-  };
+  const bool tune_scale =
+      !options.init_scales.empty() &&
+      cv.dgmm.initial_covariance_rule == DgmmOptions::InitialCovarianceRule::kData;
+  const bool tune_prior = !options.prior_counts.empty() &&
+                          cv.dgmm.covariance_rule == DgmmOptions::CovarianceRule::kPrior;
+  Evaluator evaluate(set, cv, options, &summary);
 
-  // (1) coarse grid in log k; (2) bracket around its best point.
-  const double u_min = std::log(options.k_min), u_max = std::log(options.k_max);
-  const double step = (u_max - u_min) / (options.grid_points - 1);
-  std::vector<TuneKPoint> points;
-  for (int i = 0; i < options.grid_points; ++i) {
-    points.push_back(evaluate(std::exp(u_min + i * step), "grid"));
+  // Cyclic coordinate ascent: k (Ceres + plateau rule), then f, then nu0, repeated until a
+  // cycle changes nothing (at most options.cycles).
+  TuneKPoint chosen;
+  for (int cycle = 0; cycle < options.cycles; ++cycle) {
+    summary.cycles = cycle + 1;
+    const TuneKPoint before = chosen;
+    chosen = ChooseK(options, evaluate, &summary);
+    if (tune_scale) {
+      chosen = ChooseCoordinate(options.init_scales, &DgmmOptions::initial_covariance_fraction,
+                                "scale", chosen, summary.k, evaluate, &summary.scale_curve,
+                                &summary.init_scale_plateau);
+      summary.init_scale_tuned = true;
+    }
+    if (tune_prior) {
+      chosen =
+          ChooseCoordinate(options.prior_counts, &DgmmOptions::prior_pseudo_count, "prior", chosen,
+                           summary.k, evaluate, &summary.prior_curve, &summary.prior_count_plateau);
+      summary.prior_count_tuned = true;
+    }
+    if (!tune_scale && !tune_prior) break;  // nothing else moves: one k step is final
+    if (cycle > 0 && chosen.k == before.k && chosen.init_scale == before.init_scale &&
+        chosen.prior_count == before.prior_count) {
+      break;
+    }
   }
-  int best = 0;
-  for (int i = 1; i < options.grid_points; ++i) {
-    if (points[i].log_likelihood > points[best].log_likelihood) best = i;
-  }
-  summary.at_grid_edge = best == 0 || best == options.grid_points - 1;
-  const double lo = u_min + std::max(best - 1, 0) * step;
-  const double hi = u_min + std::min(best + 1, options.grid_points - 1) * step;
-  summary.bracket_lo = std::exp(lo);
-  summary.bracket_hi = std::exp(hi);
-  const double scale = std::max(points[best].standard_error, 1e-6);
-  // (3) a few more evaluations inside the bracket, (4) smooth fit and its maximum.
-  for (int j = 1; j <= options.refine_points; ++j) {
-    points.push_back(
-        evaluate(std::exp(lo + (hi - lo) * j / (options.refine_points + 1.0)), "refine"));
-  }
-  FitAndMaximise(points, summary.bracket_lo, summary.bracket_hi, scale, &summary);
-  // (5) the chosen k, cross-validated with the same folds and random numbers.
-  const TuneKPoint chosen = evaluate(summary.k, "chosen");
-  points.push_back(chosen);
+  summary.k = chosen.k;
+  summary.init_scale = chosen.init_scale;
+  summary.prior_count = chosen.prior_count;
   summary.log_likelihood = chosen.log_likelihood;
   summary.standard_error = chosen.standard_error;
   summary.sd = chosen.sd;
-  std::sort(points.begin(), points.end(), [](const auto& p, const auto& q) { return p.k < q.k; });
-  summary.curve = points;
-  const auto top = std::max_element(points.begin(), points.end(), [](const auto& p, const auto& q) {
-    return p.log_likelihood < q.log_likelihood;
-  });
-  summary.best_evaluated_k = top->k;
-  summary.best_evaluated_log_likelihood = top->log_likelihood;
-  if (options.progress) options.progress(planned, planned);
+  summary.components = chosen.components;
+  if (options.progress) options.progress(summary.evaluations, summary.evaluations);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }
@@ -205,7 +364,15 @@ std::string TuneKSummary::BriefReport() const {
   out << "k = " << k << ": held-out log-likelihood " << log_likelihood << " +- " << standard_error
       << " (" << repeats << " x " << folds << "-fold, " << (with_terrain ? "with" : "without")
       << " terrain); bracket [" << bracket_lo << ", " << bracket_hi << "]"
-      << (at_grid_edge ? " at the edge of the grid" : "") << "; " << curve.size() << " evaluations";
+      << (at_grid_edge ? " at the edge of the grid" : "") << "; " << curve.size()
+      << " evaluations of k; k chosen by " << k_rule << "; " << evaluations
+      << " cross-validations in " << cycles << " cycle(s)";
+  if (init_scale_tuned) {
+    out << "; S0 scale " << init_scale << (init_scale_plateau ? " (simplest of a plateau)" : "");
+  }
+  if (prior_count_tuned) {
+    out << "; nu0 " << prior_count << (prior_count_plateau ? " (simplest of a plateau)" : "");
+  }
   return out.str();
 }
 

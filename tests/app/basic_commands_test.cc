@@ -2,6 +2,8 @@
 // log with commands, terrain and episodes.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -116,6 +118,27 @@ TEST_F(OldFaithful, FitOptionsReachTheModel) {
   EXPECT_EQ(m.seed, 3u);
   Ok({"fit", P("set.h5"), "-o", P("m1.h5"), "--init-cov", "2"}, false);
   EXPECT_EQ(ReadModel(P("m1.h5")).dgmm_options.initial_covariance_diagonal, Eigen::Vector2d(2, 2));
+}
+
+TEST_F(OldFaithful, FitWarnsWhenTheInitialCovarianceIsFarFromTheDataScale) {
+  RunResult far = RunDgmm({"fit", P("set.h5"), "-o", P("far.h5"), "--init-cov", "1e6"});
+  EXPECT_EQ(far.exit_code, 0) << far.err;
+  EXPECT_NE(far.err.find("warning: "), std::string::npos) << far.err;
+  EXPECT_NE(far.err.find("pooled within-command variance"), std::string::npos) << far.err;
+  EXPECT_EQ(std::count(far.err.begin(), far.err.end(), '\n'), 1) << "one line: " << far.err;
+  RunResult data = RunDgmm({"fit", P("set.h5"), "-o", P("data.h5")});
+  EXPECT_EQ(data.exit_code, 0) << data.err;
+  EXPECT_EQ(data.err.find("warning"), std::string::npos) << data.err;
+  const MotionModel m = ReadModel(P("data.h5"));
+  EXPECT_EQ(m.dgmm_options.initial_covariance_rule, DgmmOptions::InitialCovarianceRule::kData);
+  EXPECT_EQ(m.dgmm_options.covariance_rule, DgmmOptions::CovarianceRule::kPrior);
+  EXPECT_EQ(m.dgmm_options.initial_covariance_diagonal.size(), 2);
+  RunResult identity = RunDgmm({"fit", P("set.h5"), "-o", P("id.h5"), "--init-cov", "identity",
+                                "--covariance", "literal"});
+  EXPECT_EQ(identity.exit_code, 0) << identity.err;
+  const MotionModel id = ReadModel(P("id.h5"));
+  EXPECT_EQ(id.dgmm_options.initial_covariance_diagonal, Eigen::Vector2d(1, 1));
+  EXPECT_EQ(id.dgmm_options.covariance_rule, DgmmOptions::CovarianceRule::kLiteral);
 }
 
 TEST(BasicCommands, HelpOnEverySubcommand) {

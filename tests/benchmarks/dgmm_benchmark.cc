@@ -36,6 +36,7 @@ void BM_AddSample(benchmark::State& state) {
   const Eigen::MatrixXd& stream = Stream(d);
   DgmmOptions options;
   options.k = 0.7;
+  options.initial_covariance_rule = DgmmOptions::InitialCovarianceRule::kIdentity;  // N(0, I)-scale
   int components = 0;
   for (auto _ : state) {
     Dgmm model(d, options);

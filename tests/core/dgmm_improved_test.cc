@@ -8,10 +8,17 @@
 namespace dgmm {
 namespace {
 
+// Identity S0 (these tests use standardised-scale data) and each variant's version-1 covariance:
+// the blend for the paper's, one S0 pseudo-sample (the prior rule, nu0 = 1) for the improved.
 DgmmOptions Options(DgmmOptions::Variant variant, double k) {
   DgmmOptions o;
   o.variant = variant;
   o.k = k;
+  o.initial_covariance_rule = DgmmOptions::InitialCovarianceRule::kIdentity;
+  o.covariance_rule = variant == DgmmOptions::Variant::kImproved
+                          ? DgmmOptions::CovarianceRule::kPrior
+                          : DgmmOptions::CovarianceRule::kBlend;
+  o.prior_pseudo_count = 1.0;
   return o;
 }
 DgmmOptions Improved(double k) { return Options(DgmmOptions::Variant::kImproved, k); }
@@ -54,8 +61,9 @@ TEST(DgmmImprovedTest, OneComponentHoldsRecencyWeightedStatistics) {
   Eigen::Matrix2d m2 = Eigen::Matrix2d::Zero();
   for (int i = 0; i < count; ++i) m2 += (i + 1) * (xs.col(i) - mean) * (xs.col(i) - mean).transpose();
   const Eigen::Matrix2d weighted_cov = m2 / (w - s2 / w);
+  // The prior rule (nu0 = 1, S0 = I) on the weighted scatter (n - 1) C_w.
   const Eigen::Matrix2d expected =
-      ((count - 1) * weighted_cov + Eigen::Matrix2d::Identity()) / count +
+      ((count - 1) * weighted_cov + Eigen::Matrix2d::Identity()) / (count + 1.0) +
       model.options().covariance_floor * Eigen::Matrix2d::Identity();
   const double kRel = 1e-10;  // round-off of 40 incremental updates
   EXPECT_LT((model.stats()[0].mean - mean).norm(), kRel * (1 + mean.norm()));

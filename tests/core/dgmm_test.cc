@@ -24,8 +24,16 @@ Eigen::MatrixXd Stream(int d, int n, std::mt19937_64& rng) {
   return source.Sample(n, rng);
 }
 
-DgmmOptions Options(double k) {
+// Version-1 behaviour (identity S0, blend covariance), which these tests were written for.
+DgmmOptions PaperOptions() {
   DgmmOptions o;
+  o.initial_covariance_rule = DgmmOptions::InitialCovarianceRule::kIdentity;
+  o.covariance_rule = DgmmOptions::CovarianceRule::kBlend;
+  return o;
+}
+
+DgmmOptions Options(double k) {
+  DgmmOptions o = PaperOptions();
   o.k = k;
   return o;
 }
@@ -33,14 +41,18 @@ DgmmOptions Options(double k) {
 TEST(DgmmOptionsTest, IsValid) {
   std::string error;
   EXPECT_TRUE(DgmmOptions{}.IsValid(&error));
+  // The default S0 follows the data: unresolved, it is not valid for a model.
+  EXPECT_FALSE(DgmmOptions{}.IsValid(2, &error));
+  EXPECT_NE(error.find("resolved"), std::string::npos);
+  EXPECT_TRUE(PaperOptions().IsValid(2, &error));
   for (double k : {0.0, -1.0, std::nan(""), double{INFINITY}}) {
     EXPECT_FALSE(Options(k).IsValid(&error)) << k;
     EXPECT_NE(error.find("k must be"), std::string::npos);
   }
-  DgmmOptions o;
+  DgmmOptions o = PaperOptions();
   o.covariance_floor = -1;
   EXPECT_FALSE(o.IsValid(&error));
-  o = DgmmOptions{};
+  o = PaperOptions();
   o.initial_covariance_diagonal = Eigen::Vector2d(1, 0);
   EXPECT_FALSE(o.IsValid(&error));
   o.initial_covariance_diagonal = Eigen::Vector2d(1, 2);
@@ -51,7 +63,7 @@ TEST(DgmmOptionsTest, IsValid) {
 }
 
 TEST(DgmmTest, FirstSampleStartsAComponentWithInitialCovariance) {
-  DgmmOptions o;
+  DgmmOptions o = PaperOptions();
   o.initial_covariance_diagonal = Eigen::Vector2d(0.5, 2.0);
   o.covariance_floor = 0;
   Dgmm model(2, o);
@@ -198,7 +210,7 @@ TEST(DgmmTest, InvariantsHoldOverManySeededStreams) {
 TEST(DgmmTest, DegenerateSamplesStayPositiveDefinite) {
   // Repeated identical samples and samples on a line give singular sample covariances.
   for (double floor : {1e-6, 0.0}) {
-    DgmmOptions o;
+    DgmmOptions o = PaperOptions();
     o.covariance_floor = floor;
     Dgmm model(3, o);
     std::mt19937_64 rng(1);
@@ -209,7 +221,7 @@ TEST(DgmmTest, DegenerateSamplesStayPositiveDefinite) {
 }
 
 TEST(DgmmTest, FlooredCovarianceBlendsTowardInitialUntilFullRank) {
-  DgmmOptions o;
+  DgmmOptions o = PaperOptions();
   o.covariance_floor = 1e-3;
   o.initial_covariance_diagonal = Eigen::Vector2d(4, 9);
   const Dgmm model(2, o);
@@ -262,7 +274,7 @@ TEST(DgmmTest, LargeKGivesOneComponentTinyKGivesMany) {
 }
 
 TEST(DgmmTest, ImprovedVariantKeepsInvariants) {
-  DgmmOptions o;
+  DgmmOptions o = PaperOptions();
   o.variant = DgmmOptions::Variant::kImproved;
   Dgmm model(2, o);
   std::mt19937_64 rng(6);

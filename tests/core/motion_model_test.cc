@@ -198,6 +198,8 @@ TEST(MotionModelTest, LearnerRejectsBadInput) {
   options.dgmm.initial_covariance_diagonal = Eigen::Vector3d(1, 1, 1);
   EXPECT_THROW(MotionModelLearner(header, options), InputError);
   options.dgmm.initial_covariance_diagonal.resize(0);
+  EXPECT_THROW(MotionModelLearner(header, options), InputError);  // data rule, unresolved
+  options.dgmm.initial_covariance_rule = DgmmOptions::InitialCovarianceRule::kIdentity;
   MotionModelLearner learner(header, options);
   EXPECT_THROW(learner.Add(0, Eigen::Vector2d(std::nan(""), 0)), InputError);
   EXPECT_THROW(learner.Add(0, Eigen::Vector3d(0, 0, 0)), InputError);

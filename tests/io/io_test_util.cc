@@ -119,6 +119,11 @@ MotionModel RandomModel(int pose_dim, int terrain_dim, int commands, std::uint64
   m.dgmm_options.variant = DgmmOptions::Variant::kImproved;
   m.dgmm_options.covariance_floor = 1e-7 / 3.0;
   m.dgmm_options.initial_covariance_diagonal = Eigen::VectorXd::Constant(d, 0.25);
+  m.dgmm_options.initial_covariance_rule = DgmmOptions::InitialCovarianceRule::kData;
+  m.dgmm_options.initial_covariance_fraction = 0.7;
+  m.dgmm_options.covariance_rule = DgmmOptions::CovarianceRule::kPrior;
+  m.dgmm_options.prior_pseudo_count = 2.5;
+  m.dgmm_options.covariance_floor_relative = 3e-6;
   m.seed = 0xFEDCBA9876543210ULL;
   if (transform) {
     m.transform.offset = Eigen::VectorXd::NullaryExpr(d, [&] { return normal(rng); });
@@ -183,6 +188,12 @@ void ExpectSameModel(const MotionModel& a, const MotionModel& b) {
   EXPECT_EQ(a.dgmm_options.variant, b.dgmm_options.variant);
   EXPECT_EQ(a.dgmm_options.k, b.dgmm_options.k);
   EXPECT_EQ(a.dgmm_options.covariance_floor, b.dgmm_options.covariance_floor);
+  EXPECT_EQ(a.dgmm_options.covariance_floor_relative, b.dgmm_options.covariance_floor_relative);
+  EXPECT_EQ(a.dgmm_options.covariance_rule, b.dgmm_options.covariance_rule);
+  EXPECT_EQ(a.dgmm_options.prior_pseudo_count, b.dgmm_options.prior_pseudo_count);
+  EXPECT_EQ(a.dgmm_options.initial_covariance_rule, b.dgmm_options.initial_covariance_rule);
+  EXPECT_EQ(a.dgmm_options.initial_covariance_fraction,
+            b.dgmm_options.initial_covariance_fraction);
   EXPECT_TRUE(SameBits(a.dgmm_options.initial_covariance_diagonal,
                        b.dgmm_options.initial_covariance_diagonal));
   EXPECT_EQ(a.seed, b.seed);

@@ -34,6 +34,12 @@ TEST(ModelJson, HoldsDimsNamesOptionsAndEveryComponent) {
   EXPECT_EQ(j["seed"].get<std::uint64_t>(), model.seed);
   EXPECT_EQ(j["dgmm_options"]["variant"], "improved");
   EXPECT_EQ(j["dgmm_options"]["k"].get<double>(), model.dgmm_options.k);
+  EXPECT_EQ(j["dgmm_options"]["covariance_rule"], "prior");
+  EXPECT_EQ(j["dgmm_options"]["prior_pseudo_count"].get<double>(),
+            model.dgmm_options.prior_pseudo_count);
+  EXPECT_EQ(j["dgmm_options"]["initial_covariance_rule"], "data");
+  EXPECT_EQ(j["dgmm_options"]["covariance_floor_relative"].get<double>(),
+            model.dgmm_options.covariance_floor_relative);
   EXPECT_TRUE(j["transform"].is_null());
   ASSERT_EQ(j["commands"].size(), model.command_values.size());
   for (const json& c : j["commands"]) {

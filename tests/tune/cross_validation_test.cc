@@ -23,6 +23,53 @@ CvOptions SmallOptions() {
   return options;
 }
 
+TEST(EpisodeFolds, NeverSplitAnEpisodeAndBalanceSizes) {
+  for (std::uint64_t seed = 0; seed < 20; ++seed) {
+    std::mt19937_64 make(seed);
+    const int folds = 2 + static_cast<int>(make() % 9);
+    const int episodes = folds + static_cast<int>(make() % 30);
+    std::vector<int> ids;
+    for (int e = 0; e < episodes; ++e) {
+      const int length = 1 + static_cast<int>(make() % 12);  // episodes of unequal length
+      for (int i = 0; i < length; ++i) ids.push_back(100 + 3 * e);
+    }
+    std::shuffle(ids.begin(), ids.end(), make);  // interleaved, as windows of several drives
+    const Eigen::VectorXi episode = Eigen::Map<Eigen::VectorXi>(ids.data(), ids.size());
+    std::mt19937_64 rng(seed);
+    const std::vector<int> fold_of = EpisodeFolds(episode, folds, rng);
+    ASSERT_EQ(fold_of.size(), ids.size());
+    std::map<int, std::set<int>> folds_of_episode;
+    std::vector<int> size(folds, 0);
+    for (size_t i = 0; i < ids.size(); ++i) {
+      ASSERT_GE(fold_of[i], 0);
+      ASSERT_LT(fold_of[i], folds);
+      folds_of_episode[ids[i]].insert(fold_of[i]);
+      ++size[fold_of[i]];
+    }
+    for (const auto& [e, f] : folds_of_episode) EXPECT_EQ(f.size(), 1u) << "episode " << e;
+    // Greedy smallest-fold deal: no fold empty, sizes within one episode length (<= 12).
+    EXPECT_GT(*std::min_element(size.begin(), size.end()), 0);
+    EXPECT_LE(
+        *std::max_element(size.begin(), size.end()) - *std::min_element(size.begin(), size.end()),
+        12);
+  }
+}
+
+TEST(EpisodeFolds, CrossValidationUsesThemWhenTheSetHasEpisodes) {
+  SampleSet set = test::MakeTerrainSet(3, 40, 1.0, 5);
+  CvOptions options = SmallOptions();
+  options.em_baseline = false;
+  options.repeats = 1;
+  EXPECT_NE(CrossValidate(set, options).folds_by.find("no episode data"), std::string::npos);
+  set.episode.resize(set.size());
+  set.step.resize(set.size());
+  for (int i = 0; i < set.size(); ++i) set.episode(i) = i / 6, set.step(i) = i % 6;
+  const CvSummary by_episode = CrossValidate(set, options);
+  EXPECT_EQ(by_episode.folds_by.rfind("episodes", 0), 0u) << by_episode.folds_by;
+  options.group_by_episode = false;
+  EXPECT_NE(CrossValidate(set, options).folds_by.find("stratified"), std::string::npos);
+}
+
 TEST(StratifiedFolds, PartitionAndStratifyEveryCommand) {
   for (std::uint64_t seed = 0; seed < 20; ++seed) {
     std::mt19937_64 make(seed);

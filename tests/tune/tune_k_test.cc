@@ -59,7 +59,11 @@ TEST(TuneK, ChosenKInBracketAndSmoothedMaximumBeatsGridNeighbours) {
   options.k_max = 10;
   options.grid_points = 6;
   options.refine_points = 2;
+  options.plateau_tolerance = 1e-9;  // the quadratic's maximum, not the plateau rule
+  options.init_scales.clear();
+  options.prior_counts.clear();
   const TuneKSummary summary = TuneK(set, options);
+  EXPECT_FALSE(summary.plateau) << summary.k_rule;
   EXPECT_GE(summary.k, summary.bracket_lo * (1 - kBoundSlack));
   EXPECT_LE(summary.k, summary.bracket_hi * (1 + kBoundSlack));
   EXPECT_LT(summary.c, 0);
@@ -77,6 +81,45 @@ TEST(TuneK, ChosenKInBracketAndSmoothedMaximumBeatsGridNeighbours) {
   const TuneKSummary again = TuneK(set, options);
   EXPECT_EQ(again.k, summary.k);
   EXPECT_EQ(again.log_likelihood, summary.log_likelihood);
+}
+
+TEST(FindPlateau, FlatObjectiveGivesTheRangeAndTheSimplestModel) {
+  // L(k) rises then stays flat from k = 1 to 30 (within 0.5 nats); fewer Gaussians for larger k.
+  std::vector<TuneKPoint> points;
+  const double ks[] = {0.01, 0.1, 1, 3, 10, 30};
+  const double ls[] = {-50, -20, -5.3, -5.0, -5.2, -5.4};
+  const double kk[] = {9, 5, 3, 2, 1.5, 1};
+  for (int i = 0; i < 6; ++i) points.push_back({ks[i], ls[i], 0, 1.0, "grid", kk[i]});
+  const Plateau p = FindPlateau(points, 0.5);
+  EXPECT_TRUE(p.flat);
+  EXPECT_EQ(p.best, 3);
+  EXPECT_EQ(p.members.size(), 4u);
+  EXPECT_EQ(p.k_lo, 1);
+  EXPECT_EQ(p.k_hi, 30);
+  EXPECT_EQ(p.simplest, 5);  // one Gaussian per command at k = 30
+  // A sharp optimum is not a plateau.
+  const Plateau sharp = FindPlateau(points, 0.1);
+  EXPECT_FALSE(sharp.flat);
+  EXPECT_EQ(sharp.simplest, 3);
+}
+
+TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
+  // Large k everywhere: one Gaussian per command at every grid point, the curve is flat.
+  const SampleSet set = test::MakeTerrainSet(2, 20, 1.0, 3);
+  TuneKOptions options;
+  options.cv.folds = 4;
+  options.cv.repeats = 1;
+  options.k_min = 50;
+  options.k_max = 500;
+  options.grid_points = 3;
+  options.refine_points = 1;
+  options.init_scales.clear();
+  options.prior_counts.clear();
+  const TuneKSummary s = TuneK(set, options);
+  EXPECT_TRUE(s.plateau);
+  EXPECT_EQ(s.plateau_points, 4);
+  EXPECT_NE(s.BriefReport().find("plateau"), std::string::npos) << s.BriefReport();
+  EXPECT_EQ(s.components, 1.0);
 }
 
 TEST(TuneK, RejectsBadOptions) {

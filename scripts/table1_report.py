@@ -1,0 +1,146 @@
+#!/usr/bin/env python3
+"""The table1 section of docs/reproduction.md from the JSON files scripts/table1.sh writes.
+
+Usage: table1_report.py WORK OUT REAL SIM FOLDS REPEATS SEED ROOT REPORT_SEED (prints Markdown,
+writes OUT/bars.csv)."""
+import json
+import os
+import sys
+
+work, out, real, sim, folds, repeats, seed, root, report_seed = sys.argv[1:10]
+shown = lambda p: os.path.relpath(p, root) if os.path.abspath(p).startswith(root + "/") else p
+paper = {"real": ((-371.9, 3.9), (-162.2, 4.0)), "sim": ((308.5, 7.5), (402.5, 7.9))}
+paper_n = {"real": 390, "sim": 830}
+role_name = {"real": "real (our 390-sample set)", "sim": "simulated (our 830-sample set)"}
+load = lambda name, r: json.load(open(os.path.join(work, f"{name}_{r}.json")))
+roles = ("real", "sim")
+cv = {r: load("cv", r) for r in roles}
+cv_without = {r: load("cv_without", r) for r in roles}
+default = {r: load("cv_default", r) for r in roles}
+v1 = {r: load("cv_v1", r) for r in roles}
+literal = {r: load("cv_literal", r) for r in roles}
+planar = {r: load("cv_planar", r) for r in roles}
+vertical = {r: load("cv_vertical", r) for r in roles}
+tune = {r: load("tune", r) for r in roles}
+tune_without = {r: load("tune_without", r) for r in roles}
+fmt = lambda m, s: f"{m:.1f} ± {s:.1f}"
+
+
+def settings(t):
+    s = f"k = {t['k']:.3g}"
+    if t.get("init_scale") is not None:
+        s += f", f = {t['init_scale']:g}"
+    if t.get("prior_count") is not None:
+        s += f", ν0 = {t['prior_count']:g}"
+    if t["plateau"]["flat"]:
+        lo, hi = t["plateau"]["k_range"]
+        s += f" (k from a plateau, {lo:.3g}–{hi:.3g}: simplest model)"
+    return s
+
+
+with open(os.path.join(out, "bars.csv"), "w") as f:
+    f.write("setting,ours_dgmm,ours_dgmm_sd,ours_em,ours_em_sd,paper,paper_sd\n")
+    for r in roles:
+        n = cv[r]["scored_per_repeat"]
+        for t, key in ((0, "without_terrain"), (1, "with_terrain")):
+            d = (cv_without[r] if t == 0 else cv[r])["rows"]["dgmm_" + key]
+            e = cv[r]["rows"]["em_bic_" + key]
+            pm, ps = paper[r][t]
+            label = f"{cv[r]['samples']} ({r}) {'with' if t else 'without'} terrain"
+            f.write(f"{label},{d['mean']/n:.6g},{d['sd']/n:.6g},{e['mean']/n:.6g},{e['sd']/n:.6g},"
+                    f"{pm/paper_n[r]:.6g},{ps/paper_n[r]:.6g}\n")
+
+print("Written by `scripts/table1.sh` (rerun it to regenerate; figures and JSON in "
+      "`docs/figures/table1/`).")
+print(f"Repeated {folds}-fold cross-validation, {repeats} repeats; folds: "
+      f"{cv['real']['folds_by']} (390 set), {cv['sim']['folds_by']} (830 set): no placement is "
+      "split between training and test. The held-out log-likelihood is summed over all "
+      "validation folds of a repeat (the paper's measure), mean ± sd over repeats, with the "
+      "standard error (s.e.) of a total. **Tuned** rows: `dgmm tune` chose k, the S0 scale f and "
+      f"the prior pseudo-count ν0 on folds and merges of seed {seed}, separately with and "
+      f"without terrain; every row is then scored on seed {report_seed} (other folds, other "
+      "random numbers), so the tuned settings are not scored on the folds that chose them. "
+      "EM-BIC: per command a full-covariance EM whose number of components minimises BIC on the "
+      "training fold (at most as many parameters as samples).")
+print()
+print("| role (file) | model | settings | without terrain | with terrain | terrain gain (s.e.) | Gaussians per command (w/o, with) |")
+print("|---|---|---|---|---|---|---|")
+for r in roles:
+    name = f"{role_name[r]}<br>`{shown(real if r == 'real' else sim)}`"
+    def row(label, sett, w_json, t_json, model="dgmm"):
+        w = w_json["rows"][model + "_without_terrain"]
+        t = t_json["rows"][model + "_with_terrain"]
+        gain = t["mean"] - w["mean"]
+        se = max(w["standard_error"], t["standard_error"])
+        print(f"| {name} | {label} | {sett} | {fmt(w['mean'], w['sd'])} | {fmt(t['mean'], t['sd'])} "
+              f"| {gain:+.0f} ({se:.0f}) | {w['mean_components']:.2f}, {t['mean_components']:.2f} |")
+    row("DGMM, tuned", f"without: {settings(tune_without[r])}<br>with: {settings(tune[r])}",
+        cv_without[r], cv[r])
+    row("DGMM, new defaults", "k = 0.7, S0 = 0.3 v, prior ν0 = 4", default[r], default[r])
+    row("DGMM, version 1", "k = 0.7, S0 = I, blend, floor 1e-6", v1[r], v1[r])
+    row("DGMM, literal eq. 13", "k = 0.7, S0 = I, literal, floor 1e-6", literal[r], literal[r])
+    row("EM-BIC", "—", cv[r], cv[r], model="em_bic")
+    row("DGMM, x = (dx, dy, dyaw) only", "tuned with terrain", planar[r], planar[r])
+    row("DGMM, x = (dz, droll, dpitch) only", "tuned with terrain", vertical[r], vertical[r])
+    (pw, pws), (pt, pts) = paper[r]
+    print(f"| {r} (paper, SCORPION, {paper_n[r]} samples) | DGMM (paper) | – | {fmt(pw, pws)} | "
+          f"{fmt(pt, pts)} | {pt - pw:+.0f} | – |")
+print()
+check = json.load(open(os.path.join(work, "check_real.json")))
+print(f"Check of `dgmm tune` (`scripts/check_tune_k.sh`, 390-sample set, with terrain, seed {seed}): "
+      f"tune's k = {check['tune_k']['k']:.3g} scores {check['tune_k']['log_likelihood']:.1f}; a dense "
+      f"grid of {check['grid_points']} `dgmm cv` runs over k (at tune's f and ν0, same folds and "
+      f"seeds) peaks at k = {check['grid_best']['k']:.3g} with "
+      f"{check['grid_best']['log_likelihood']:.1f} ± {check['grid_best']['standard_error']:.1f}: gap "
+      f"{check['gap']:.1f} nats, {'within' if check['pass'] else 'NOT within'} one standard error"
+      + (f"; tune reported a plateau over k = {check['plateau']['k_range'][0]:.3g}–"
+         f"{check['plateau']['k_range'][1]:.3g}." if check["plateau"]["flat"] else "."))
+print()
+print("![Table I as bars](figures/table1/table1_bars.png)")
+print()
+print("Last k step of `dgmm tune` with terrain (held-out log-likelihood ± s.e. against k at the "
+      "final f and ν0, the Ceres quadratic fit and the chosen k):")
+print()
+print("![tune, 390](figures/table1/tune_k_real.png) ![tune, 830](figures/table1/tune_k_sim.png)")
+print()
+print("Conditional densities p(dx, dy | c = ⟨+0.5, 0, 0⟩, z) of the 390-sample model (tuned, with "
+      "terrain) at two terrain values (pitch ±0.314 rad = ±18°, roll 0):")
+print()
+print("![pitch +18°](figures/table1/density_forward_pitch_down.png) "
+      "![pitch -18°](figures/table1/density_forward_pitch_up.png)")
+print()
+print("### Reading the table: the estimator's point of view")
+print()
+for r in roles:
+    w = cv_without[r]["rows"]["dgmm_without_terrain"]
+    t = cv[r]["rows"]["dgmm_with_terrain"]
+    gain = t["mean"] - w["mean"]
+    se = max(w["standard_error"], t["standard_error"])
+    em_k = cv[r]["rows"]["em_bic_with_terrain"]["mean_components"]
+    print(f"- {role_name[r]}: at tuned settings terrain {'raises' if gain > 0 else 'lowers'} the "
+          f"held-out log-likelihood by {abs(gain):.0f} nats, {'more' if abs(gain) > se else 'less'} "
+          f"than one s.e. of a total (≈ {se:.0f}). The DGMM uses {w['mean_components']:.2f} / "
+          f"{t['mean_components']:.2f} Gaussians per command (without / with terrain); EM-BIC "
+          f"chooses {em_k:.2f} components per command with terrain.")
+print()
+print("""Each command of the 390 set has 15 samples (3 placements × 5 executions); with whole placements
+held out a training fold keeps about 10 from two placements, in 8 dimensions for y = x‖z (44
+parameters for one full-covariance Gaussian). Whether terrain helps is then a question about the
+covariance estimator, not about the robot: the conditional p(x | c, z) is a regression of six pose
+dimensions on two terrain values whose residual covariance comes from ~10 points. Version 1 used
+the identity S0 (1 m², 3·10⁴ times dz's variance) and a blend that drops S0 once n > d, so each
+command was one plug-in Gaussian whose only regulariser was the absolute 10⁻⁶ floor — the literal
+eq. 13 row shows what remains without S0. The prior rule keeps S0 = f v as ν0 pseudo-samples
+(a Normal–inverse-Wishart posterior mean): a shrinkage estimator whose strength ν0 and target f v
+are chosen by cross-validation. With it the estimation cost of the two extra dimensions falls
+below what terrain explains, which is the sign the paper reports. The tuned models use one
+Gaussian per command: with 10–30 samples per command cross-validation prefers one well-regularised
+Gaussian to a mixture, and EM-BIC agrees (its mean number of components is given above).
+
+**Why the absolute values differ from the paper's.** A log-likelihood of continuous data is not
+unit-free: scaling one dimension by s shifts every sample's log-density by −log s. Our pose change
+is in metres and radians and three of its six dimensions (dz, droll, dpitch) move by millimetres
+and milliradians in the simulation, so totals are large and positive; the paper does not state its
+units or scaling, so its levels cannot be matched. Our "real" set is simulated too (we have no
+robot). The comparison that carries over is the sign and size of the terrain effect relative to
+the spread, not the level.""")
