@@ -31,7 +31,8 @@ struct RenderArgs {
   std::string size = "800x640";
   int grid = 200;
   std::string title;
-  std::vector<std::string> labels;
+  std::string labels;
+  std::string color_scale = "auto";
   bool json = false;
 };
 
@@ -82,24 +83,25 @@ nlohmann::json ModeJson(const Mixture& mixture, const PlotLayout& layout) {
           {"pixel", {px(0), px(1)}}};
 }
 
-// A window that shows every slice and the data (padded by 5% when data widen it).
-PlotRange CombinedRange(const std::vector<const ModelSlice*>& slices,
-                        const Eigen::MatrixX2d& points) {
-  PlotRange range = MixtureRange(slices.front()->mixture);
-  for (const ModelSlice* s : slices) {
-    PlotRange r = MixtureRange(s->mixture);
-    range.Include(r.x_min, r.y_min);
-    range.Include(r.x_max, r.y_max);
+// "A,B" -> {"A", "B"}; InputError naming --labels unless exactly two non-empty names.
+std::vector<std::string> ParseLabels(const std::string& text) {
+  const size_t comma = text.find(',');
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos ||
+      comma == 0 || comma + 1 == text.size()) {
+    throw MakeInputError("", "--labels",
+                         "expected two names separated by one comma, e.g. --labels \"EM,DGMM\" "
+                         "(got '" + text + "')");
   }
-  if (points.rows() > 0) {
-    for (Eigen::Index i = 0; i < points.rows(); ++i) range.Include(points(i, 0), points(i, 1));
-    const double px = 0.05 * (range.x_max - range.x_min), py = 0.05 * (range.y_max - range.y_min);
-    range = {range.x_min - px, range.x_max + px, range.y_min - py, range.y_max + py};
-  }
-  return range;
+  return {text.substr(0, comma), text.substr(comma + 1)};
 }
 
 void Run(const RenderArgs& args) {
+  if (args.models.size() > 2 && !args.labels.empty()) {
+    throw MakeInputError("", "--labels", "takes one value \"A,B\" (comma-separated), not two "
+                                         "space-separated names");
+  }
+  if (!args.labels.empty()) ParseLabels(args.labels);
+  ParseColorScale(args.color_scale);
   // Before any VTK call: a missing display is one clear line, never a crash.
   RequireDisplay();
   if (args.diff != (args.models.size() == 2)) {
@@ -130,9 +132,10 @@ void Run(const RenderArgs& args) {
     SampleSet set = ReadSampleSet(args.data);
     points = SlicePoints(set, slices[0].command, slices[0].x_index, slices[0].y_index);
   }
-  std::vector<const ModelSlice*> slice_ptrs;
-  for (const auto& s : slices) slice_ptrs.push_back(&s);
-  const PlotRange range = CombinedRange(slice_ptrs, points);
+  const HeatMapSpec::ColorScale color_scale = ParseColorScale(args.color_scale);
+  std::vector<const Mixture*> mixtures;
+  for (const auto& s : slices) mixtures.push_back(&s.mixture);
+  const PlotRange range = ExtentRange(mixtures, points);
   if (!range.IsValid()) throw MakeInputError(args.models[0], "", "cannot find a plot window");
 
   nlohmann::json report = {{"output", args.output}, {"width", width}, {"height", height}};
@@ -142,6 +145,7 @@ void Run(const RenderArgs& args) {
     map.background = MixtureDensityGrid(s.mixture, range, args.grid, args.grid);
     if (args.contours > 0) map.contours.push_back({map.background, args.contours, {200, 200, 200}});
     map.points = points;
+    map.color_scale = color_scale;
     map.title = args.title.empty() ? fmt::format("{} model {}: {}", models[0].kind,
                                                  Basename(args.models[0]), s.description)
                                    : args.title;
@@ -154,24 +158,29 @@ void Run(const RenderArgs& args) {
     report["panels"][0]["mode"] = ModeJson(s.mixture, layout);
     report["description"] = s.description;
   } else {
-    std::vector<std::string> labels = args.labels;
+    std::vector<std::string> labels;
+    if (!args.labels.empty()) labels = ParseLabels(args.labels);
     for (size_t i = labels.size(); i < 2; ++i) {
       labels.push_back(models[i].kind + " " + Basename(args.models[i]));
     }
     std::vector<DensityGrid> grids;
     for (const auto& s : slices) grids.push_back(MixtureDensityGrid(s.mixture, range, args.grid, args.grid));
     std::vector<HeatMapSpec> panels(3);
+    // A and B share one colour scale so equal colours mean equal densities.
+    const double shared_max = std::max(grids[0].values.maxCoeff(), grids[1].values.maxCoeff());
     const std::array<unsigned char, 3> kA{0, 0, 0}, kB{0, 150, 60}, kGrey{200, 200, 200};
     for (int i = 0; i < 2; ++i) {
       panels[i].background = grids[i];
       if (args.contours > 0) panels[i].contours.push_back({grids[i], args.contours, kGrey});
       panels[i].title = fmt::format("{}: {}", i == 0 ? "A" : "B", labels[i]);
+      panels[i].color_scale = color_scale;
+      panels[i].color_max = shared_max;
     }
     HeatMapSpec& d = panels[2];
     d.background = grids[0];
     d.background.values = grids[0].values - grids[1].values;
     d.palette = HeatMapSpec::Palette::kDiverging;
-    d.value_label = "density difference A - B";
+    d.value_label = "A - B (clamped at 99th pct of |A - B|)";
     if (args.contours > 0) {
       d.contours.push_back({grids[0], args.contours, kA, 1.5f, labels[0]});
       d.contours.push_back({grids[1], args.contours, kB, 1.5f, labels[1]});
@@ -206,7 +215,8 @@ void Setup(CLI::App& root) {
       "Density heat map of a model as PNG (or, with --diff, model A, model B and their "
       "difference side by side). Needs an X display: run under `xvfb-run -a`.");
   cmd->add_option("models", args->models, "model file (two with --diff)")
-      ->required()->expected(1, 2)->check(CLI::ExistingFile);
+      ->required()
+      ->expected(1, -1);
   cmd->add_option("-o,--output", args->output, "PNG to write")->required();
   cmd->add_flag("--diff", args->diff, "compare two models: A, B and A - B (like Figure 3)");
   cmd->add_option("--command", args->slice.command, "command id or label (default: the only one)");
@@ -224,7 +234,12 @@ void Setup(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--grid", args->grid, "grid points per axis")->capture_default_str();
   cmd->add_option("--title", args->title, "title (default: what is shown)");
-  cmd->add_option("--labels", args->labels, "names of models A and B for --diff")->expected(0, 2);
+  cmd->add_option("--labels", args->labels,
+                  "names of models A and B for --diff, comma-separated: \"A,B\"");
+  cmd->add_option("--color-scale", args->color_scale,
+                  "linear, log, quantile or auto (log when the bright part covers < 10% of the "
+                  "window, e.g. a peaked model)")
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "print output, plot windows, pixel layout and modes as JSON");
   cmd->callback([args] { Run(*args); });
 }
