@@ -71,7 +71,11 @@ std::string Basename(const std::string& path) {
 }
 
 nlohmann::json LayoutJson(const PlotLayout& l) {
+  const char* scales[] = {"linear", "log", "quantile", "auto"};
   return {{"range", {l.range.x_min, l.range.x_max, l.range.y_min, l.range.y_max}},
+          {"color_range", {l.color_min, l.color_max}},
+          {"color_scale", scales[static_cast<int>(l.color_scale)]},
+          {"axis_titles", {l.x_title, l.y_title}},
           {"plot_area_px", {{"left", l.left}, {"bottom", l.bottom}, {"right", l.right},
                             {"top", l.top}}}};
 }
@@ -166,16 +170,15 @@ void Run(const RenderArgs& args) {
     std::vector<DensityGrid> grids;
     for (const auto& s : slices) grids.push_back(MixtureDensityGrid(s.mixture, range, args.grid, args.grid));
     std::vector<HeatMapSpec> panels(3);
-    // A and B share one colour scale so equal colours mean equal densities.
-    const double shared_max = std::max(grids[0].values.maxCoeff(), grids[1].values.maxCoeff());
     const std::array<unsigned char, 3> kA{0, 0, 0}, kB{0, 150, 60}, kGrey{200, 200, 200};
     for (int i = 0; i < 2; ++i) {
       panels[i].background = grids[i];
       if (args.contours > 0) panels[i].contours.push_back({grids[i], args.contours, kGrey});
       panels[i].title = fmt::format("{}: {}", i == 0 ? "A" : "B", labels[i]);
       panels[i].color_scale = color_scale;
-      panels[i].color_max = shared_max;
     }
+    // A and B share one colour scale so equal colours mean equal densities.
+    ShareColorScale({&panels[0], &panels[1]});
     HeatMapSpec& d = panels[2];
     d.background = grids[0];
     d.background.values = grids[0].values - grids[1].values;

@@ -135,7 +135,11 @@ ColourRaster MakeColourRaster(const HeatMapSpec& spec, HeatMapSpec::ColorScale s
   }
   const double top = std::max(spec.color_max > 0 ? spec.color_max : v.maxCoeff(), 1e-300);
   if (scale == HeatMapSpec::ColorScale::kLog) {
-    const double floor = top * 1e-4;
+    // Floor: 4 decades below the top, or higher when the window's lowest values are (so the
+    // ramp is spent on what the window shows).
+    std::vector<double> sorted(v.data(), v.data() + v.size());
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 100, sorted.end());
+    const double floor = std::min(top * 0.5, std::max(top * 1e-4, sorted[sorted.size() / 100]));
     out.grid.values = v.cwiseMax(floor).array().log10().matrix();
     out.lo = std::log10(floor);
     out.hi = std::log10(top);
@@ -243,6 +247,15 @@ RenderedPanel RenderPanel(const HeatMapSpec& spec) {
   out.layout.x_title = x_axis->GetTitle();
   out.layout.y_title = y_axis->GetTitle();
   out.layout.title = chart->GetTitle();
+  auto ticks = [](vtkAxis* axis) {
+    std::vector<std::string> names;
+    if (vtkStringArray* labels = axis->GetTickLabels()) {
+      for (vtkIdType k = 0; k < labels->GetNumberOfValues(); ++k) names.push_back(labels->GetValue(k));
+    }
+    return names;
+  };
+  if (!spec.x_categories.empty()) out.layout.x_ticks = ticks(x_axis);
+  if (!spec.y_categories.empty()) out.layout.y_ticks = ticks(y_axis);
   out.layout.title_font_size = title_size;
   out.layout.color_min = raster.lo;
   out.layout.color_max = raster.hi;
@@ -285,6 +298,21 @@ HeatMapSpec::ColorScale ResolveColorScale(const HeatMapSpec& spec) {
   if (!(top > 0) || v.size() == 0) return HeatMapSpec::ColorScale::kLinear;
   const double bright = static_cast<double>((v.array() > 0.1 * top).count()) / static_cast<double>(v.size());
   return bright < 0.1 ? HeatMapSpec::ColorScale::kLog : HeatMapSpec::ColorScale::kLinear;
+}
+
+void ShareColorScale(const std::vector<HeatMapSpec*>& panels) {
+  double top = 0;
+  for (const HeatMapSpec* p : panels) top = std::max(top, p->background.values.maxCoeff());
+  bool all_log = true;
+  for (HeatMapSpec* p : panels) {
+    p->color_max = top;
+    all_log = all_log && ResolveColorScale(*p) == HeatMapSpec::ColorScale::kLog;
+  }
+  for (HeatMapSpec* p : panels) {
+    if (p->color_scale == HeatMapSpec::ColorScale::kAuto) {
+      p->color_scale = all_log ? HeatMapSpec::ColorScale::kLog : HeatMapSpec::ColorScale::kLinear;
+    }
+  }
 }
 
 double RobustAbsScale(const Eigen::MatrixXd& values, double quantile) {

@@ -26,7 +26,7 @@ struct HeatMapSpec {
   // symmetric about 0 (for differences p_A - p_B).
   enum class Palette { kSequential, kDiverging };
   // How a sequential raster maps to colour: linear in the value; log10 of the value (floored at
-  // 1e-4 of the top); quantile (the cell's rank among the grid's cells, so every colour covers
+  // the window's 1st percentile, at least 1e-4 of the top); quantile (the cell's rank among the grid's cells, so every colour covers
   // the same area); auto: log when the bright part (cells above 10% of the maximum) covers less
   // than 10% of the grid (a peaked model would be a black field with one spot), else linear.
   enum class ColorScale { kLinear, kLog, kQuantile, kAuto };
@@ -55,6 +55,9 @@ struct HeatMapSpec {
 HeatMapSpec::ColorScale ParseColorScale(const std::string& name);
 // The scale a spec's sequential raster is drawn with (kAuto resolved on its values).
 HeatMapSpec::ColorScale ResolveColorScale(const HeatMapSpec& spec);
+// Puts sequential panels on one colour scale: color_max = the largest maximum, and kAuto resolved
+// once for all (log only when every panel would be log), so equal colours mean equal values.
+void ShareColorScale(const std::vector<HeatMapSpec*>& panels);
 // Robust symmetric scale of a difference raster: the `quantile` of |value| over the cells
 // (default 99th percentile, so one spike does not wash out the rest); > 0.
 double RobustAbsScale(const Eigen::MatrixXd& values, double quantile = 0.99);
@@ -67,6 +70,7 @@ struct PlotLayout {
   int width = 0, height = 0;
   // What was drawn: axis titles, the title lines and the colour scale's range and kind.
   std::string x_title, y_title, title;
+  std::vector<std::string> x_ticks, y_ticks;  // tick labels when category axes were drawn
   int title_font_size = 0;
   double color_min = 0, color_max = 0;
   HeatMapSpec::ColorScale color_scale = HeatMapSpec::ColorScale::kLinear;
