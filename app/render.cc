@@ -31,13 +31,18 @@ struct RenderArgs {
   std::string size = "800x640";
   int grid = 200;
   std::string title;
-  std::vector<std::string> labels;
+  std::string labels;
   std::string window;
+  std::string color_scale = "auto";
   bool json = false;
 };
 
 nlohmann::json LayoutJson(const PlotLayout& l) {
+  const char* scales[] = {"linear", "log", "quantile", "auto"};
   return {{"range", {l.range.x_min, l.range.x_max, l.range.y_min, l.range.y_max}},
+          {"color_range", {l.color_min, l.color_max}},
+          {"color_scale", scales[static_cast<int>(l.color_scale)]},
+          {"axis_titles", {l.x_title, l.y_title}},
           {"plot_area_px", {{"left", l.left}, {"bottom", l.bottom}, {"right", l.right},
                             {"top", l.top}}}};
 }
@@ -49,7 +54,25 @@ nlohmann::json ModeJson(const Mixture& mixture, const PlotLayout& layout) {
           {"pixel", {px(0), px(1)}}};
 }
 
+// "A,B" -> {"A", "B"}; InputError naming --labels unless exactly two non-empty names.
+std::vector<std::string> ParseLabels(const std::string& text) {
+  const size_t comma = text.find(',');
+  if (comma == std::string::npos || text.find(',', comma + 1) != std::string::npos ||
+      comma == 0 || comma + 1 == text.size()) {
+    throw MakeInputError("", "--labels",
+                         "expected two names separated by one comma, e.g. --labels \"EM,DGMM\" "
+                         "(got '" + text + "')");
+  }
+  return {text.substr(0, comma), text.substr(comma + 1)};
+}
+
 void Run(const RenderArgs& args) {
+  if (args.models.size() > 2 && !args.labels.empty()) {
+    throw MakeInputError("", "--labels", "takes one value \"A,B\" (comma-separated), not two "
+                                         "space-separated names");
+  }
+  if (!args.labels.empty()) ParseLabels(args.labels);
+  ParseColorScale(args.color_scale);
   // Before any VTK call: a missing display is one clear line, never a crash.
   RefuseOutputThatIsAnInput(args.output, args.models);
   RequireDisplay();
@@ -99,7 +122,8 @@ void Run(const RenderArgs& args) {
   figure.width = width;
   figure.height = height;
   figure.title = args.title;
-  figure.labels = args.labels;
+  figure.labels = args.labels.empty() ? std::vector<std::string>{} : ParseLabels(args.labels);
+  figure.color_scale = ParseColorScale(args.color_scale);
   const std::vector<HeatMapSpec> panels = SliceHeatMaps(slice_ptrs, sources, points, range, figure);
   nlohmann::json report = {{"output", args.output}, {"width", width}, {"height", height}};
   if (!args.diff) {
@@ -130,7 +154,8 @@ void Setup(CLI::App& root) {
       "Density heat map of a model as PNG (or, with --diff, model A, model B and their "
       "difference side by side). Needs an X display: run under `xvfb-run -a`.");
   cmd->add_option("models", args->models, "model file (two with --diff)")
-      ->required()->expected(1, 2)->check(CLI::ExistingFile);
+      ->required()
+      ->expected(1, -1);
   cmd->add_option("-o,--output", args->output, "PNG to write")->required();
   cmd->add_flag("--diff", args->diff, "compare two models: A, B and A - B (like Figure 3)");
   cmd->add_option("--command", args->slice.command, "command id or label (default: the only one)");
@@ -150,7 +175,12 @@ void Setup(CLI::App& root) {
   cmd->add_option("--window", args->window,
                   "x_min,x_max,y_min,y_max: the plot window (default: the slices and the data)");
   cmd->add_option("--title", args->title, "title (default: what is shown)");
-  cmd->add_option("--labels", args->labels, "names of models A and B for --diff")->expected(0, 2);
+  cmd->add_option("--labels", args->labels,
+                  "names of models A and B for --diff, comma-separated: \"A,B\"");
+  cmd->add_option("--color-scale", args->color_scale,
+                  "linear, log, quantile or auto (log when the bright part covers < 10% of the "
+                  "window, e.g. a peaked model)")
+      ->capture_default_str();
   cmd->add_flag("--json", args->json, "print output, plot windows, pixel layout and modes as JSON");
   cmd->callback([args] { Run(*args); });
 }

@@ -27,7 +27,7 @@ echo "DGMM score: $("$dgmm" score "$out/old_faithful_dgmm.h5" "$out/old_faithful
 echo "EM score:   $("$dgmm" score "$out/old_faithful_em.h5" "$out/old_faithful.h5" --json | tr -d '\n' | cut -c1-160)"
 "$dgmm" export "$out/old_faithful_dgmm.h5" -o "$out/old_faithful_dgmm.json"
 "${render[@]}" "$dgmm" render --diff "$out/old_faithful_em.h5" "$out/old_faithful_dgmm.h5" \
-  --labels "EM, 2 components" "DGMM k=0.7" --data "$out/old_faithful.h5" \
+  --labels "EM 2 components,DGMM k=0.7" --data "$out/old_faithful.h5" \
   -o "$out/figure3_em_vs_dgmm.png"
 "${render[@]}" "$dgmm" render "$out/old_faithful_dgmm.h5" --data "$out/old_faithful.h5" \
   -o "$out/old_faithful_dgmm.png"

@@ -42,7 +42,7 @@ xvfb "$dgmm" plot --csv "$work/k_sweep.csv" --x k --y faithful-blend_mean,improv
   --x-label "k (log scale)" --y-label "number of Gaussians" -o "$fig/figure2_k_sweep.png" >/dev/null
 for variant in faithful-blend improved-prior; do
   xvfb "$dgmm" render --diff "$work/em.h5" "$work/${variant}_dgmm_median.h5" --data "$work/of.h5" \
-    --labels "EM, 2 components, 10 restarts" "DGMM k=0.7 ($variant), median-MISE run" \
+    --labels "EM 2 components (10 restarts),DGMM k=0.7 ($variant) median-MISE run" \
     --size 620x520 -o "$fig/figure3_em_vs_dgmm_${variant%%-*}.png" >/dev/null
 done
 xvfb "$dgmm" render "$work/em.h5" --data "$work/of.h5" --size 700x560 \

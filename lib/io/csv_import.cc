@@ -1,160 +1,27 @@
 #include "io/csv_import.h"
 
-#include <charconv>
-#include <deque>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <set>
 
+#include "io/csv_reader.h"
 #include "util/error.h"
 
 namespace dgmm {
 namespace {
 
-std::string Trim(const std::string& s) {
-  size_t b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
-  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
-
-std::string Line(long long n) { return "line " + std::to_string(n); }
-
-// A cell as echoed in a message: control characters shown as '?', at most 80 characters.
-std::string Echo(const std::string& text) {
-  constexpr size_t kMaxEcho = 80;
-  std::string s = text.substr(0, kMaxEcho);
-  for (char& c : s) {
-    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = '?';
-  }
-  if (text.size() > kMaxEcho) s += "... (" + std::to_string(text.size()) + " characters)";
-  return s;
-}
-
-// Lines ending in \n, \r\n or a lone \r (old Mac files are one line per record too).
-class LineReader {
- public:
-  explicit LineReader(std::istream& in) : in_(in) {}
-  bool Next(std::string* line) {
-    if (pending_.empty()) {
-      std::string raw;
-      if (!std::getline(in_, raw)) return false;
-      if (!raw.empty() && raw.back() == '\r') raw.pop_back();
-      size_t start = 0;
-      for (size_t cr = raw.find('\r'); cr != std::string::npos; cr = raw.find('\r', start)) {
-        pending_.push_back(raw.substr(start, cr - start));
-        start = cr + 1;
-      }
-      pending_.push_back(raw.substr(start));
-    }
-    *line = std::move(pending_.front());
-    pending_.pop_front();
-    return true;
-  }
-
- private:
-  std::istream& in_;
-  std::deque<std::string> pending_;
-};
-
-// Splits one CSV record at commas; fields may be "quoted" (with "" for a quote).
-std::vector<std::string> SplitRecord(const std::string& line, const std::string& path,
-                                     long long line_no) {
-  std::vector<std::string> fields;
-  std::string field;
-  bool quoted = false, was_quoted = false;
-  for (size_t i = 0; i < line.size(); ++i) {
-    char c = line[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < line.size() && line[i + 1] == '"') {
-        field += '"';
-        ++i;
-      } else if (c == '"') {
-        quoted = false;
-      } else {
-        field += c;
-      }
-    } else if (c == '"' && Trim(field).empty()) {
-      quoted = was_quoted = true;
-      field.clear();
-    } else if (c == ',') {
-      fields.push_back(was_quoted ? field : Trim(field));
-      field.clear();
-      was_quoted = false;
-    } else {
-      field += c;
-    }
-  }
-  if (quoted) throw MakeInputError(path, Line(line_no), "unterminated quoted field");
-  fields.push_back(was_quoted ? field : Trim(field));
-  return fields;
-}
-
-// The value of one cell; InputError naming the line and column unless finite and numeric.
-double ParseNumber(const std::string& cell, const std::string& path, long long line_no,
-                   const std::string& column) {
-  const std::string field = Line(line_no) + ", column '" + Echo(column) + "'";
-  std::string text = Trim(cell);
-  if (text.empty()) throw MakeInputError(path, field, "empty value, expected a number");
-  const char* begin = text.c_str();
-  if (*begin == '+') ++begin;
-  double value = 0;
-  auto [end, ec] = std::from_chars(begin, text.c_str() + text.size(), value);
-  if (ec == std::errc::result_out_of_range && end == text.c_str() + text.size()) {
-    // Underflow (1e-400, 0.000...1) reads as 0 or a subnormal; overflow is refused.
-    value = std::strtod(begin, nullptr);
-    if (std::isinf(value)) {
-      throw MakeInputError(path, field,
-                           "'" + Echo(text) +
-                               "' is infinite as a double (beyond +-1.8e308), expected a finite "
-                               "number");
-    }
-    ec = std::errc();
-  }
-  if (ec != std::errc() || end != text.c_str() + text.size()) {
-    throw MakeInputError(path, field, "'" + Echo(text) + "' is not a number");
-  }
-  if (std::isnan(value)) throw MakeInputError(path, field, "NaN value, expected a finite number");
-  if (std::isinf(value)) {
-    throw MakeInputError(path, field, "infinite value, expected a finite number");
-  }
-  return value;
-}
-
-// The names joined with commas, each echoed, cut after about 200 characters.
-std::string JoinNames(const std::vector<std::string>& names) {
-  std::string s;
-  for (const auto& n : names) {
-    if (s.size() > 200) return s + ", ... (" + std::to_string(names.size()) + " columns)";
-    s += (s.empty() ? "" : ", ") + Echo(n);
-  }
-  return s;
-}
-
-// Column index of each name; InputError listing the available columns for unknown names.
-std::vector<int> FindColumns(const std::vector<std::string>& wanted,
-                             const std::vector<std::string>& header, const std::string& path,
+// Column index of each name; InputError for unknown or twice-selected names.
+std::vector<int> FindColumns(const std::vector<std::string>& wanted, const CsvTable& table,
                              std::set<std::string>* used) {
   std::vector<int> indices;
   for (const std::string& name : wanted) {
-    int found = -1;
-    for (int i = 0; i < static_cast<int>(header.size()); ++i) {
-      if (header[i] != name) continue;
-      if (found >= 0) {
-        throw MakeInputError(path, "column '" + Echo(name) + "'", "appears twice in the header");
-      }
-      found = i;
-    }
-    if (found < 0) {
-      throw MakeInputError(path, "column '" + Echo(name) + "'",
-                           "not found (have: " + JoinNames(header) + ")");
-    }
+    indices.push_back(table.Column(name));
     if (!used->insert(name).second) {
-      throw MakeInputError(path, "column '" + name + "'", "selected twice");
+      throw MakeInputError(table.path, "column '" + name + "'", "selected twice");
     }
-    indices.push_back(found);
   }
   return indices;
 }
@@ -183,41 +50,32 @@ Standardization Standardize(Eigen::MatrixXd* x, Eigen::MatrixXd* z) {
 
 }  // namespace
 
-SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
+SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options,
+                    CsvImportSummary* summary) {
   if (options.pose_columns.empty()) {
     throw MakeInputError(path, "pose columns", "none chosen (expected at least one)");
   }
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) {
-    throw MakeInputError(path, "", "is a folder, expected a CSV file");
-  }
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw MakeInputError(path, "", "file not found");
-  }
-  std::ifstream in(path);
-  if (!in) throw MakeInputError(path, "", "cannot open for reading");
-
-  std::string line;
-  long long line_no = 0;
-  std::vector<std::string> header;
-  LineReader lines(in);
-  while (lines.Next(&line)) {
-    ++line_no;
-    if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
-    if (Trim(line).empty()) continue;
-    header = SplitRecord(line, path, line_no);
-    break;
-  }
-  if (header.empty()) throw MakeInputError(path, "", "empty file (expected a header row)");
-
+  const CsvTable table = ReadCsv(path, options.delimiter);
   std::set<std::string> used;
-  const auto command_idx = FindColumns(options.command_columns, header, path, &used);
-  const auto pose_idx = FindColumns(options.pose_columns, header, path, &used);
-  const auto terrain_idx = FindColumns(options.terrain_columns, header, path, &used);
+  const auto command_idx = FindColumns(options.command_columns, table, &used);
+  const auto pose_idx = FindColumns(options.pose_columns, table, &used);
+  const auto terrain_idx = FindColumns(options.terrain_columns, table, &used);
   std::vector<int> episode_idx;
   if (!options.episode_column.empty()) {
-    episode_idx = FindColumns({options.episode_column}, header, path, &used);
+    episode_idx = FindColumns({options.episode_column}, table, &used);
   }
+  for (const auto& [column, factor] : options.units) {
+    if (!used.count(column)) {
+      throw MakeInputError(path, "--units", "column '" + column + "' is not a selected column");
+    }
+  }
+  auto unit = [&](int col) {
+    auto it = options.units.find(table.header[col]);
+    return it == options.units.end() ? 1.0 : it->second;
+  };
+  std::vector<bool> label_column;
+  for (int col : command_idx) label_column.push_back(!table.IsNumericColumn(col));
+  std::vector<std::map<std::string, int>> label_codes(command_idx.size());
 
   const int dx = static_cast<int>(pose_idx.size()), dz = static_cast<int>(terrain_idx.size());
   std::vector<double> xs, zs;
@@ -226,21 +84,47 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
   std::vector<std::vector<double>> command_rows;
   std::vector<std::string> labels;
   std::map<int, int> steps_so_far;
-  while (lines.Next(&line)) {
-    ++line_no;
-    if (Trim(line).empty()) continue;
-    const auto fields = SplitRecord(line, path, line_no);
-    if (fields.size() != header.size()) {
-      throw MakeInputError(path, Line(line_no),
-                           std::to_string(fields.size()) + " fields, expected " +
-                               std::to_string(header.size()) + " as in the header (ragged row)");
-    }
-    auto number = [&](int col) { return ParseNumber(fields[col], path, line_no, header[col]); };
-    std::vector<double> key;
+  InvalidRows invalid(options.drop_invalid);
+  for (const CsvRecord& record : table.records) {
+    std::vector<double> key, x, z;
     std::string label;
-    for (int col : command_idx) {
-      key.push_back(number(col));
-      label += (label.empty() ? "" : ",") + Trim(fields[col]);
+    int episode = 0;
+    try {
+      table.CheckFieldCount(record);
+      auto number = [&](int col) { return table.Number(record, col); };
+      for (size_t c = 0; c < command_idx.size(); ++c) {
+        const int col = command_idx[c];
+        const std::string& cell = record.fields[col];
+        if (label_column[c]) {
+          if (cell.empty()) {
+            throw MakeInputError(path, "line " + std::to_string(record.line) + ", column '" +
+                                           table.header[col] + "'",
+                                 "empty command label");
+          }
+          auto [it, fresh] = label_codes[c].try_emplace(cell, static_cast<int>(label_codes[c].size()));
+          key.push_back(it->second);
+        } else {
+          key.push_back(number(col));
+        }
+        label += (label.empty() ? "" : ",") + cell;
+      }
+      for (int col : pose_idx) x.push_back(number(col) * unit(col));
+      for (int col : terrain_idx) z.push_back(number(col) * unit(col));
+      if (!episode_idx.empty()) {
+        const double e = number(episode_idx[0]);
+        if (e != std::floor(e) || std::abs(e) > 2e9) {
+          char shown[32];
+          std::snprintf(shown, sizeof shown, "%.6g", e);
+          throw MakeInputError(path, "line " + std::to_string(record.line) + ", column '" +
+                                         EchoCell(table.header[episode_idx[0]]) + "'",
+                               std::string("episode id ") + shown +
+                                   ", expected an integer between -2e9 and 2e9");
+        }
+        episode = static_cast<int>(e);
+      }
+    } catch (const InputError& e) {
+      invalid.Handle(path, e.what());
+      continue;
     }
     auto [it, inserted] = command_ids.try_emplace(key, static_cast<int>(command_rows.size()));
     if (inserted) {
@@ -248,23 +132,22 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options) {
       labels.push_back(command_idx.empty() ? "all" : label);
     }
     commands.push_back(it->second);
-    for (int col : pose_idx) xs.push_back(number(col));
-    for (int col : terrain_idx) zs.push_back(number(col));
+    xs.insert(xs.end(), x.begin(), x.end());
+    zs.insert(zs.end(), z.begin(), z.end());
     if (!episode_idx.empty()) {
-      const double e = number(episode_idx[0]);
-      if (e != std::floor(e) || std::abs(e) > 2e9) {
-        char shown[32];
-        std::snprintf(shown, sizeof shown, "%.6g", e);
-        throw MakeInputError(path, Line(line_no) + ", column '" + Echo(header[episode_idx[0]]) + "'",
-                             std::string("episode id ") + shown +
-                                 ", expected an integer between -2e9 and 2e9");
-      }
-      episodes.push_back(static_cast<int>(e));
-      steps.push_back(steps_so_far[static_cast<int>(e)]++);
+      episodes.push_back(episode);
+      steps.push_back(steps_so_far[episode]++);
     }
   }
+  if (summary) {
+    summary->dropped_rows = invalid.total();
+    summary->dropped_report = invalid.Report();
+  }
   const long long n = static_cast<long long>(commands.size());
-  if (n == 0) throw MakeInputError(path, "", "no data rows after the header");
+  if (n == 0) {
+    throw MakeInputError(path, "", invalid.total() > 0 ? "every data row was invalid and dropped"
+                                                     : "no data rows after the header");
+  }
 
   SampleSet set;
   set.command_dim_names = options.command_columns;

@@ -20,6 +20,7 @@
 #include <utility>
 #include <vector>
 
+#include "render/text_fit.h"
 #include "render/vtk_image.h"
 #include "util/error.h"
 
@@ -72,29 +73,6 @@ void AddErrorBars(vtkChartXY* chart, const std::vector<double>& x, const std::ve
   line->SetColor(rgb[0], rgb[1], rgb[2], 255);
   line->SetWidth(1.0);
   line->SetLegendVisibility(false);
-}
-
-// Title text and font size that fit `width` pixels: bold glyphs are about 0.6 x the font size
-// wide; a long title first gets a smaller font (down to 11 pt), then a line break at the space
-// nearest its middle.
-std::pair<std::string, int> FitTitle(const std::string& title, int width) {
-  const double room = std::max(100, width - 40);
-  auto fits = [&](size_t chars, int size) { return 0.6 * size * chars <= room; };
-  for (int size = 15; size >= 11; --size) {
-    if (fits(title.size(), size)) return {title, size};
-  }
-  size_t cut = std::string::npos;
-  for (size_t i = 0; i < title.size(); ++i) {
-    if (title[i] == ' ' && (cut == std::string::npos ||
-                            std::abs(2.0 * i - title.size()) < std::abs(2.0 * cut - title.size()))) {
-      cut = i;
-    }
-  }
-  if (cut == std::string::npos) return {title, 11};
-  const size_t longest = std::max(cut, title.size() - cut - 1);
-  int size = 15;
-  while (size > 9 && !fits(longest, size)) --size;
-  return {title.substr(0, cut) + "\n" + title.substr(cut + 1), size};
 }
 
 void StyleChart(vtkChartXY* chart, const std::string& title, const std::string& x_label,

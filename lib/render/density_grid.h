@@ -2,6 +2,7 @@
 // A 2-D function sampled on a regular grid: the raster behind heat maps and contour lines.
 #include <Eigen/Dense>
 #include <functional>
+#include <vector>
 
 #include "core/mixture.h"
 
@@ -38,5 +39,11 @@ DensityGrid MixtureDensityGrid(const Mixture& mixture2d, const PlotRange& range,
 // A window that shows the mixture: the union over components of mean +- `sigmas` standard
 // deviations per axis (components with < 1% of the weight ignored unless all are).
 PlotRange MixtureRange(const Mixture& mixture2d, double sigmas = 3.5);
+
+// The window a reader needs: per axis, the `tail` and 1 - tail quantiles of the mixtures'
+// marginals (where the mass is, not mean +- 3.5 sd of every broad component), grown to contain
+// every data point, then padded by `pad` of its size on each side. Points are always inside.
+PlotRange ExtentRange(const std::vector<const Mixture*>& mixtures2d, const Eigen::MatrixX2d& points,
+                      double tail = 0.005, double pad = 0.06);
 
 }  // namespace dgmm

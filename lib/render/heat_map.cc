@@ -13,12 +13,14 @@
 #include <vtkPlotPoints.h>
 #include <vtkPolyData.h>
 #include <vtkTable.h>
+#include <vtkStringArray.h>
 #include <vtkTextProperty.h>
 
 #include <algorithm>
 #include <cmath>
 
 #include "render/heat_map_chart.h"
+#include "render/text_fit.h"
 #include "render/vtk_image.h"
 #include "util/error.h"
 
@@ -53,13 +55,13 @@ vtkSmartPointer<vtkImageData> ToImage(const DensityGrid& grid, bool cell_centred
 
 // Inferno-like ramp (perceptually uniform, luminance increasing): the densest cell is the
 // brightest pixel of the plot area.
-vtkSmartPointer<vtkColorTransferFunction> SequentialColours(double max_value) {
+vtkSmartPointer<vtkColorTransferFunction> SequentialColours(double lo, double hi) {
   static const double kStops[][4] = {
       {0.00, 0, 0, 4},       {0.13, 31, 12, 72},   {0.25, 85, 15, 109},
       {0.38, 136, 34, 106},  {0.50, 186, 54, 85},  {0.63, 227, 89, 51},
       {0.75, 249, 140, 10},  {0.88, 249, 201, 50}, {1.00, 252, 255, 164}};
   auto tf = vtkSmartPointer<vtkColorTransferFunction>::New();
-  for (const auto& s : kStops) tf->AddRGBPoint(s[0] * max_value, s[1] / 255, s[2] / 255, s[3] / 255);
+  for (const auto& s : kStops) tf->AddRGBPoint(lo + s[0] * (hi - lo), s[1] / 255, s[2] / 255, s[3] / 255);
   return tf;
 }
 
@@ -123,6 +125,61 @@ vtkSmartPointer<vtkTable> CurveSegments(const CurveOverlay& curve) {
   return table;
 }
 
+// Ticks at the centres of equal blocks over [lo, hi], labelled with the names.
+void SetCategories(vtkAxis* axis, const std::vector<std::string>& names, double lo, double hi) {
+  auto positions = vtkSmartPointer<vtkDoubleArray>::New();
+  auto labels = vtkSmartPointer<vtkStringArray>::New();
+  const double step = (hi - lo) / static_cast<double>(names.size());
+  for (size_t i = 0; i < names.size(); ++i) {
+    positions->InsertNextValue(lo + (static_cast<double>(i) + 0.5) * step);
+    labels->InsertNextValue(names[i]);
+  }
+  axis->SetCustomTickPositions(positions, labels);
+}
+
+// The raster as drawn and its colour range: log10 or quantile ranks for those scales.
+struct ColourRaster {
+  DensityGrid grid;
+  double lo = 0, hi = 1;
+  std::string value_label;
+};
+
+ColourRaster MakeColourRaster(const HeatMapSpec& spec, HeatMapSpec::ColorScale scale) {
+  ColourRaster out{spec.background, 0, 1, spec.value_label};
+  const Eigen::MatrixXd& v = spec.background.values;
+  if (spec.palette == HeatMapSpec::Palette::kDiverging) {
+    out.hi = spec.color_max > 0 ? spec.color_max : RobustAbsScale(v);
+    out.lo = -out.hi;
+    return out;
+  }
+  const double top = std::max(spec.color_max > 0 ? spec.color_max : v.maxCoeff(), 1e-300);
+  if (scale == HeatMapSpec::ColorScale::kLog) {
+    // Floor: 4 decades below the top, or higher when the window's lowest values are (so the
+    // ramp is spent on what the window shows).
+    std::vector<double> sorted(v.data(), v.data() + v.size());
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 100, sorted.end());
+    const double floor = std::min(top * 0.5, std::max(top * 1e-4, sorted[sorted.size() / 100]));
+    out.grid.values = v.cwiseMax(floor).array().log10().matrix();
+    out.lo = std::log10(floor);
+    out.hi = std::log10(top);
+    out.value_label = "log10 " + spec.value_label;
+  } else if (scale == HeatMapSpec::ColorScale::kQuantile) {
+    std::vector<double> sorted(v.data(), v.data() + v.size());
+    std::sort(sorted.begin(), sorted.end());
+    for (Eigen::Index k = 0; k < v.size(); ++k) {
+      const auto rank = std::lower_bound(sorted.begin(), sorted.end(), v.data()[k]) - sorted.begin();
+      out.grid.values.data()[k] = static_cast<double>(rank) / static_cast<double>(sorted.size() - 1);
+    }
+    out.lo = 0;
+    out.hi = 1;
+    out.value_label = spec.value_label + " quantile";
+  } else {
+    out.lo = 0;
+    out.hi = top;
+  }
+  return out;
+}
+
 struct RenderedPanel {
   vtkSmartPointer<vtkImageData> image;
   PlotLayout layout;
@@ -150,20 +207,21 @@ namespace render_internal {
 vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
   auto chart = vtkSmartPointer<vtkChartHistogram2D>::New();
   const DensityGrid& bg = spec.background;
-  chart->SetInputData(ToImage(bg, true));
+  const ColourRaster raster = MakeColourRaster(spec, ResolveColorScale(spec));
+  chart->SetInputData(ToImage(raster.grid, true));
   if (spec.palette == HeatMapSpec::Palette::kSequential) {
-    double max_value = std::max(bg.values.maxCoeff(), 1e-300);
-    chart->SetTransferFunction(SequentialColours(max_value));
+    chart->SetTransferFunction(SequentialColours(raster.lo, raster.hi));
   } else {
-    double max_abs = std::max(bg.values.cwiseAbs().maxCoeff(), 1e-300);
-    chart->SetTransferFunction(DivergingColours(max_abs));
+    chart->SetTransferFunction(DivergingColours(raster.hi));
   }
   if (auto* legend = vtkColorLegend::SafeDownCast(chart->GetLegend())) {
-    legend->SetTitle(spec.value_label);
+    legend->SetTitle(raster.value_label);
   }
   chart->SetShowLegend(true);
-  chart->SetTitle(spec.title);
-  chart->GetTitleProperties()->SetFontSize(15);
+  // The legend takes about 110 px on the right; the title is centred on the whole image.
+  const auto [title_text, title_size] = FitTitle(spec.title, spec.width);
+  chart->SetTitle(title_text);
+  chart->GetTitleProperties()->SetFontSize(title_size);
   chart->GetTitleProperties()->SetBold(true);
 
   for (const ContourOverlay& overlay : spec.contours) {
@@ -196,8 +254,11 @@ vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
     auto* points = vtkPlotPoints::SafeDownCast(chart->AddPlot(vtkChart::POINTS));
     points->SetInputData(table, 0, 1);
     points->SetMarkerStyle(vtkPlotPoints::CIRCLE);
-    points->SetMarkerSize(4);
-    points->SetColor(80, 200, 255, 255);
+    points->SetMarkerSize(spec.point_size);
+    const std::array<unsigned char, 3> rgb = spec.point_rgb.value_or(
+        spec.palette == HeatMapSpec::Palette::kSequential ? std::array<unsigned char, 3>{0, 230, 255}
+                                                          : std::array<unsigned char, 3>{0, 0, 0});
+    points->SetColor(rgb[0], rgb[1], rgb[2], 255);
   }
 
   vtkAxis* x_axis = chart->GetAxis(vtkAxis::BOTTOM);
@@ -207,6 +268,9 @@ vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
   for (vtkAxis* axis : {x_axis, y_axis}) axis->SetBehavior(vtkAxis::FIXED);
   x_axis->SetRange(bg.range.x_min, bg.range.x_max);
   y_axis->SetRange(bg.range.y_min, bg.range.y_max);
+  if (!spec.x_categories.empty()) SetCategories(x_axis, spec.x_categories, bg.range.x_min, bg.range.x_max);
+  if (!spec.y_categories.empty()) SetCategories(y_axis, spec.y_categories, bg.range.y_min, bg.range.y_max);
+
   return chart;
 }
 
@@ -214,6 +278,8 @@ PlotLayout ChartLayout(vtkChartHistogram2D* chart, const HeatMapSpec& spec) {
   PlotLayout layout;
   const int* p1 = chart->GetPoint1();
   const int* p2 = chart->GetPoint2();
+  vtkAxis* x_axis = chart->GetAxis(vtkAxis::BOTTOM);
+  vtkAxis* y_axis = chart->GetAxis(vtkAxis::LEFT);
   layout.range = spec.background.range;
   layout.left = p1[0];
   layout.bottom = p1[1];
@@ -221,6 +287,24 @@ PlotLayout ChartLayout(vtkChartHistogram2D* chart, const HeatMapSpec& spec) {
   layout.top = p2[1];
   layout.width = spec.width;
   layout.height = spec.height;
+  layout.x_title = x_axis->GetTitle();
+  layout.y_title = y_axis->GetTitle();
+  layout.title = chart->GetTitle();
+  auto ticks = [](vtkAxis* axis) {
+    std::vector<std::string> names;
+    if (vtkStringArray* labels = axis->GetTickLabels()) {
+      for (vtkIdType k = 0; k < labels->GetNumberOfValues(); ++k) names.push_back(labels->GetValue(k));
+    }
+    return names;
+  };
+  if (!spec.x_categories.empty()) layout.x_ticks = ticks(x_axis);
+  if (!spec.y_categories.empty()) layout.y_ticks = ticks(y_axis);
+  layout.title_font_size = FitTitle(spec.title, spec.width).second;
+  const HeatMapSpec::ColorScale scale = ResolveColorScale(spec);
+  const ColourRaster raster = MakeColourRaster(spec, scale);
+  layout.color_min = raster.lo;
+  layout.color_max = raster.hi;
+  layout.color_scale = scale;
   return layout;
 }
 
@@ -243,6 +327,52 @@ std::string HeatMapSpec::Validate() const {
     if (c.points.size() > 0 && !c.points.allFinite()) return "a curve has NaN or infinite points";
   }
   return "";
+}
+
+HeatMapSpec::ColorScale ParseColorScale(const std::string& name) {
+  if (name == "linear") return HeatMapSpec::ColorScale::kLinear;
+  if (name == "log") return HeatMapSpec::ColorScale::kLog;
+  if (name == "quantile") return HeatMapSpec::ColorScale::kQuantile;
+  if (name == "auto") return HeatMapSpec::ColorScale::kAuto;
+  throw MakeInputError("", "--color-scale", "'" + name + "' (expected linear, log, quantile or auto)");
+}
+
+HeatMapSpec::ColorScale ResolveColorScale(const HeatMapSpec& spec) {
+  if (spec.color_scale != HeatMapSpec::ColorScale::kAuto) return spec.color_scale;
+  const Eigen::MatrixXd& v = spec.background.values;
+  const double top = spec.color_max > 0 ? spec.color_max : v.maxCoeff();
+  if (!(top > 0) || v.size() == 0) return HeatMapSpec::ColorScale::kLinear;
+  const double bright = static_cast<double>((v.array() > 0.1 * top).count()) / static_cast<double>(v.size());
+  return bright < 0.1 ? HeatMapSpec::ColorScale::kLog : HeatMapSpec::ColorScale::kLinear;
+}
+
+void ShareColorScale(const std::vector<HeatMapSpec*>& panels) {
+  double top = 0;
+  for (const HeatMapSpec* p : panels) top = std::max(top, p->background.values.maxCoeff());
+  bool all_log = true;
+  for (HeatMapSpec* p : panels) {
+    p->color_max = top;
+    all_log = all_log && ResolveColorScale(*p) == HeatMapSpec::ColorScale::kLog;
+  }
+  for (HeatMapSpec* p : panels) {
+    if (p->color_scale == HeatMapSpec::ColorScale::kAuto) {
+      p->color_scale = all_log ? HeatMapSpec::ColorScale::kLog : HeatMapSpec::ColorScale::kLinear;
+    }
+  }
+}
+
+double RobustAbsScale(const Eigen::MatrixXd& values, double quantile) {
+  std::vector<double> a;
+  a.reserve(values.size());
+  for (Eigen::Index k = 0; k < values.size(); ++k) {
+    if (std::isfinite(values.data()[k])) a.push_back(std::abs(values.data()[k]));
+  }
+  if (a.empty()) return 1e-300;
+  const size_t at = std::min(a.size() - 1, static_cast<size_t>(std::ceil(quantile * (a.size() - 1))));
+  std::nth_element(a.begin(), a.begin() + at, a.end());
+  double scale = a[at];
+  if (!(scale > 0)) scale = *std::max_element(a.begin(), a.end());
+  return std::max(scale, 1e-300);
 }
 
 Eigen::Vector2d PlotLayout::ToPixel(double x, double y) const {

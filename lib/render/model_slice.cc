@@ -25,7 +25,10 @@ std::string Label(const MotionModel& model, int index, const std::string& name) 
   if (index < model.pose_dim && index < static_cast<int>(model.pose_units.size())) {
     unit = model.pose_units[index];
   }
-  if (unit.empty()) return name;
+  // Terrain angles are radians by dgmm's convention (docs/file-format.md); other dimensions
+  // without a recorded unit say so rather than leave the reader guessing.
+  if (unit.empty() && index >= model.pose_dim && (name == "pitch" || name == "roll")) unit = "rad";
+  if (unit.empty()) return name + " (no unit recorded)";
   return name + " (" + unit + ")";
 }
 

@@ -15,18 +15,7 @@ std::string Basename(const std::string& path) {
 
 PlotRange SliceWindow(const std::vector<const Mixture*>& slices, const Eigen::MatrixX2d& points) {
   assert(!slices.empty());
-  PlotRange range = MixtureRange(*slices.front());
-  for (const Mixture* s : slices) {
-    PlotRange r = MixtureRange(*s);
-    range.Include(r.x_min, r.y_min);
-    range.Include(r.x_max, r.y_max);
-  }
-  if (points.rows() > 0) {
-    for (Eigen::Index i = 0; i < points.rows(); ++i) range.Include(points(i, 0), points(i, 1));
-    const double px = 0.05 * (range.x_max - range.x_min), py = 0.05 * (range.y_max - range.y_min);
-    range = {range.x_min - px, range.x_max + px, range.y_min - py, range.y_max + py};
-  }
-  return range;
+  return ExtentRange(slices, points);
 }
 
 std::vector<HeatMapSpec> SliceHeatMaps(const std::vector<const ModelSlice*>& slices,
@@ -43,6 +32,7 @@ std::vector<HeatMapSpec> SliceHeatMaps(const std::vector<const ModelSlice*>& sli
       map.contours.push_back({map.background, options.contours, {200, 200, 200}});
     }
     map.points = points;
+    map.color_scale = options.color_scale;
     map.title = options.title.empty() ? sources[0].kind + " model " + Basename(sources[0].file) +
                                             ": " + s.description
                                       : options.title;
@@ -66,12 +56,15 @@ std::vector<HeatMapSpec> SliceHeatMaps(const std::vector<const ModelSlice*>& sli
     panels[i].background = grids[i];
     if (options.contours > 0) panels[i].contours.push_back({grids[i], options.contours, kGrey});
     panels[i].title = (i == 0 ? "A: " : "B: ") + labels[i];
+    panels[i].color_scale = options.color_scale;
   }
+  // A and B share one colour scale so equal colours mean equal densities.
+  ShareColorScale({&panels[0], &panels[1]});
   HeatMapSpec& d = panels[2];
   d.background = grids[0];
   d.background.values = grids[0].values - grids[1].values;
   d.palette = HeatMapSpec::Palette::kDiverging;
-  d.value_label = "density difference A - B";
+  d.value_label = "A - B (clamped at 99th pct of |A - B|)";
   if (options.contours > 0) {
     d.contours.push_back({grids[0], options.contours, kA, 1.5f, labels[0]});
     d.contours.push_back({grids[1], options.contours, kB, 1.5f, labels[1]});

@@ -24,10 +24,11 @@ struct SliceFigureOptions {
   int width = 800, height = 640;    // pixels of each panel
   std::string title;                // replaces the default title (of A - B for two slices)
   std::vector<std::string> labels;  // names of A and B (default: kind and file name)
+  // Colour scale of the density panels; A and B always share one scale (ShareColorScale).
+  HeatMapSpec::ColorScale color_scale = HeatMapSpec::ColorScale::kAuto;
 };
 
-// A window that shows every 2-D slice mixture (MixtureRange) and the points, padded by 5% when
-// there are points.
+// A window that shows where the slice mixtures' mass is and every point (ExtentRange).
 PlotRange SliceWindow(const std::vector<const Mixture*>& slices, const Eigen::MatrixX2d& points);
 
 // The panels over `window`: [p] for one slice; [p_A, p_B, p_A - p_B] for two (sources and slices

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 
 #ifdef DGMM_SIM2REAL_HAVE_RENDER
@@ -13,6 +14,36 @@
 #endif
 
 namespace dgmm::sim2real {
+
+DeficitHeatMapContent DescribeDeficitHeatMap(const Sim2RealResult& r) {
+  DeficitHeatMapContent h;
+  h.before = r.heat_before;
+  h.after = r.heat_after;
+  for (Eigen::Index i = 0; i < r.heat_before.rows(); ++i) {
+    const int c = i < static_cast<Eigen::Index>(r.real_commands.size()) ? r.real_commands[i] : -1;
+    h.commands.push_back(c >= 0 && c < static_cast<int>(r.command_labels.size())
+                             ? r.command_labels[c]
+                             : "command " + std::to_string(i));
+  }
+  h.terrain = r.terrain_labels;
+  h.terrain.resize(r.heat_before.cols(), "all terrain");
+  std::vector<double> magnitudes;
+  for (const Eigen::MatrixXd* m : {&r.heat_before, &r.heat_after}) {
+    for (Eigen::Index k = 0; k < m->size(); ++k) {
+      if (std::isfinite(m->data()[k])) magnitudes.push_back(std::abs(m->data()[k]));
+    }
+  }
+  if (!magnitudes.empty()) {
+    const size_t at = static_cast<size_t>(std::ceil(0.99 * (magnitudes.size() - 1)));
+    std::nth_element(magnitudes.begin(), magnitudes.begin() + at, magnitudes.end());
+    h.color_max = magnitudes[at];
+  }
+  if (!(h.color_max > 0)) h.color_max = 1e-12;
+  h.x_label = "terrain region (k-means of the terrain z)";
+  h.y_label = "command";
+  h.value_label = "deficit (nats/sample)";
+  return h;
+}
 
 #ifndef DGMM_SIM2REAL_HAVE_RENDER
 std::vector<ReportFigure> RenderFigures(const Sim2RealResult&, const SampleSet&, const SampleSet&,
@@ -76,36 +107,51 @@ std::vector<ReportFigure> RenderFigures(const Sim2RealResult& r, const SampleSet
     // 2. Heat map: rows = commands (as in the table), columns = terrain regions; cell (c, t) is
     // the block [t, t + 1] x [c, c + 1] (nearest-neighbour upsampling, so cells are equal blocks),
     // before and after the correction side by side.
-    if (r.heat_before.rows() >= 2 && r.heat_before.cols() >= 2) {
-      auto blocks = [](const Eigen::MatrixXd& h, const std::string& title) {
+    if (r.heat_before.rows() >= 1 && r.heat_before.cols() >= 1) {
+      const DeficitHeatMapContent content = DescribeDeficitHeatMap(r);
+      // Cell (c, t) is an equal block; the first command row is drawn at the top, as in the
+      // table; both panels share one symmetric colour scale.
+      auto blocks = [&](const Eigen::MatrixXd& h, const std::string& title) {
         constexpr int kPerCell = 16;
+        const int rows = static_cast<int>(h.rows()), cols = static_cast<int>(h.cols());
         HeatMapSpec heat;
         heat.palette = HeatMapSpec::Palette::kDiverging;
-        heat.background.range = {0, double(h.cols()), 0, double(h.rows())};
-        const int nx = static_cast<int>(h.cols()) * kPerCell, ny = static_cast<int>(h.rows()) * kPerCell;
+        heat.color_max = content.color_max;
+        heat.background.range = {0, double(cols), 0, double(rows)};
+        const int nx = std::max(2, cols * kPerCell), ny = std::max(2, rows * kPerCell);
         heat.background.values.resize(ny, nx);
         for (int j = 0; j < ny; ++j) {
           for (int i = 0; i < nx; ++i) {
-            const int c = std::min<int>(h.rows() - 1, j * h.rows() / (ny - 1));
-            const int t = std::min<int>(h.cols() - 1, i * h.cols() / (nx - 1));
+            const int c = rows - 1 - std::min(rows - 1, j * rows / (ny - 1));
+            const int t = std::min(cols - 1, i * cols / (nx - 1));
             heat.background.values(j, i) = std::isfinite(h(c, t)) ? h(c, t) : 0.0;
           }
         }
+        // Tick labels: the region's name and its pitch/roll on a second line (the explanation in
+        // parentheses is in the report's table).
+        for (const std::string& label : content.terrain) {
+          const size_t open = label.find(" ("), close = label.find("): ");
+          heat.x_categories.push_back(open != std::string::npos && close != std::string::npos && close > open
+                                          ? label.substr(0, open) + "\n" + label.substr(close + 3)
+                                          : label);
+        }
+        heat.y_categories.assign(content.commands.rbegin(), content.commands.rend());
         heat.title = title;
-        heat.x_label = "terrain region k in [k, k+1] (see table)";
-        heat.y_label = "command row r in [r, r+1] (table order)";
-        heat.value_label = "nats/sample";
-        heat.width = 560;
-        heat.height = 640;
+        heat.x_label = content.x_label;
+        heat.y_label = content.y_label;
+        heat.value_label = content.value_label;
+        heat.width = 640;
+        heat.height = std::max(420, 140 + 34 * rows);
         return heat;
       };
       RenderHeatMapRow({blocks(r.heat_before, "Deficit before the correction"),
-                        blocks(r.heat_after, "Deficit after the correction")},
+                        blocks(r.heat_after, "Deficit after the correction (same colour scale)")},
                        (dir / "heat_map.png").string());
       figures.push_back({"heat_map.png", "Held-out deficit (nats per real sample, real-trained "
                                          "ceiling minus model) per command x terrain region, "
-                                         "before and after the correction (rows and columns in "
-                                         "the order of the report's table; white: no samples)."});
+                                         "before and after the correction, on one colour scale "
+                                         "(red: the model explains the real data worse than the "
+                                         "ceiling; white: no difference or no samples)."});
     }
     // 3. Density maps for the two worst cells: sim, corrected, corrected - sim; real points overlaid.
     if (r.layout.has_planar()) {
@@ -126,40 +172,65 @@ std::vector<ReportFigure> RenderFigures(const Sim2RealResult& r, const SampleSet
         Eigen::Matrix2d s0, s1;
         PlanarPrediction(r, g.command, z, false, r.first_execution_share, &m0, &s0);
         PlanarPrediction(r, g.command, z, true, r.first_execution_share, &m1, &s1);
-        PlotRange range;
-        range.x_min = range.x_max = m0(0);
-        range.y_min = range.y_max = m0(1);
-        for (const auto& [m, s] : {std::pair{m0, s0}, std::pair{m1, s1}}) {
-          range.Include(m(0) - 3.5 * std::sqrt(s(0, 0)), m(1) - 3.5 * std::sqrt(s(1, 1)));
-          range.Include(m(0) + 3.5 * std::sqrt(s(0, 0)), m(1) + 3.5 * std::sqrt(s(1, 1)));
-        }
-        for (const auto& p : pts) range.Include(p(0), p(1));
         Eigen::MatrixX2d points(pts.size(), 2);
         for (size_t k = 0; k < pts.size(); ++k) points.row(k) = pts[k].transpose();
+        // The window holds both models' mass and every real sample of the cell.
+        Mixture before(2), after(2);
+        before.Add(1, Gaussian(m0, s0));
+        after.Add(1, Gaussian(m1, s1));
+        const PlotRange range = ExtentRange({&before, &after}, points);
+        auto axis = [&](int dim) {
+          const std::string name = dim < static_cast<int>(real.x_names.size()) ? real.x_names[dim] : "x" + std::to_string(dim);
+          const std::string unit = dim < static_cast<int>(real.x_units.size()) && !real.x_units[dim].empty()
+                                       ? real.x_units[dim] : (dim < static_cast<int>(sim.x_units.size()) ? sim.x_units[dim] : "");
+          return name + " (" + (unit.empty() ? "no unit recorded" : unit) + ")";
+        };
+        const std::string per_area = axis(r.layout.dx).find("(m)") != std::string::npos &&
+                                             axis(r.layout.dy).find("(m)") != std::string::npos
+                                         ? " (1/m^2)" : "";
+        std::string condition;
+        for (int d = 0; d < static_cast<int>(z.size()); ++d) {
+          const std::string name = d < static_cast<int>(real.z_names.size()) ? real.z_names[d] : "z" + std::to_string(d);
+          char buf[64];
+          std::snprintf(buf, sizeof buf, "%s%s=%.2f", condition.empty() ? "" : ", ", name.c_str(), z(d));
+          condition += buf;
+        }
+        const std::string command_label =
+            g.command >= 0 && g.command < static_cast<int>(r.command_labels.size()) ? r.command_labels[g.command] : "?";
+        std::string terrain_name = g.terrain >= 0 && g.terrain < static_cast<int>(r.terrain_labels.size())
+                                       ? r.terrain_labels[g.terrain] : "all terrain";
+        terrain_name = terrain_name.substr(0, terrain_name.find(" ("));
+        const std::string context = "command " + command_label + " on " + terrain_name +
+                                    (condition.empty() ? "" : " (" + condition + ")") + ", " +
+                                    std::to_string(pts.size()) + " real samples";
         auto panel = [&](const std::string& title, auto f, HeatMapSpec::Palette pal, const std::string& value) {
           HeatMapSpec h;
           h.background = SampleGrid(f, range, 80, 80);
           h.palette = pal;
+          h.color_scale = HeatMapSpec::ColorScale::kAuto;
           h.points = points;
-          h.title = title;
-          h.x_label = "dx";
-          h.y_label = "dy";
+          h.title = title + ": " + context;
+          h.x_label = axis(r.layout.dx);
+          h.y_label = axis(r.layout.dy);
           h.value_label = value;
-          h.width = 520;
-          h.height = 460;
+          h.width = 560;
+          h.height = 500;
           return h;
         };
         std::vector<HeatMapSpec> row = {
             panel("sim-trained", [&](double x, double y) { return Planar(m0, s0, x, y); },
-                  HeatMapSpec::Palette::kSequential, "density"),
+                  HeatMapSpec::Palette::kSequential, "density" + per_area),
             panel("corrected", [&](double x, double y) { return Planar(m1, s1, x, y); },
-                  HeatMapSpec::Palette::kSequential, "density"),
+                  HeatMapSpec::Palette::kSequential, "density" + per_area),
             panel("corrected - sim", [&](double x, double y) { return Planar(m1, s1, x, y) - Planar(m0, s0, x, y); },
-                  HeatMapSpec::Palette::kDiverging, "difference")};
+                  HeatMapSpec::Palette::kDiverging, "difference" + per_area)};
+        // Sim-trained and corrected on one scale: equal colours mean equal densities.
+        ShareColorScale({&row[0], &row[1]});
         const std::string file = "density_" + std::to_string(drawn + 1) + ".png";
         RenderHeatMapRow(row, (dir / file).string());
-        figures.push_back({file, "p(dx, dy | c, z) in " + g.label +
-                                     ": sim-trained, corrected and their difference; dots: the real samples."});
+        figures.push_back({file, "p(dx, dy | c, z) for " + context +
+                                     ": sim-trained and corrected (one colour scale) and their "
+                                     "difference; cyan/black dots: the real samples of the cell."});
         ++drawn;
       }
     }

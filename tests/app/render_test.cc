@@ -10,6 +10,7 @@
 
 #include "core/mixture.h"
 #include "io/model_io.h"
+#include "io/sample_set_io.h"
 #include "render/model_slice.h"
 #include "tests/app/run_dgmm.h"
 
@@ -79,6 +80,35 @@ TEST_F(RenderCommandTest, DiffWritesThreePanels) {
   EXPECT_GE(j["ise_of_slices"].get<double>(), 0.0);
 }
 
+TEST_F(RenderCommandTest, DiffSharesOneScaleKeepsDataInsideAndLabelsAxes) {
+  const fs::path png = Path("diff_data.png");
+  RunResult r = RunUnderXvfb({"render", "--diff", Path("m1.h5").string(), Path("m2.h5").string(),
+                              "--data", set_, "--labels", "seed 1,seed 2", "-o", png.string(),
+                              "--size", "500x400", "--json"}, *dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  nlohmann::json j = nlohmann::json::parse(r.out);
+  // A and B on one colour scale; the difference symmetric about 0.
+  EXPECT_EQ(j["panels"][0]["color_range"], j["panels"][1]["color_range"]);
+  EXPECT_DOUBLE_EQ(j["panels"][2]["color_range"][0].get<double>(),
+                   -j["panels"][2]["color_range"][1].get<double>());
+  // Every sample (raw units) inside the window.
+  const SampleSet set = ReadSampleSet(set_);
+  const auto range = j["panels"][0]["range"];
+  for (int i = 0; i < set.size(); ++i) {
+    const double x = set.transform.offset(0) + set.transform.scale(0) * set.x(i, 0);
+    const double y = set.transform.offset(1) + set.transform.scale(1) * set.x(i, 1);
+    EXPECT_GE(x, range[0].get<double>());
+    EXPECT_LE(x, range[1].get<double>());
+    EXPECT_GE(y, range[2].get<double>());
+    EXPECT_LE(y, range[3].get<double>());
+  }
+  // Axis titles name the dimension and say what is known of its unit.
+  for (const auto& panel : j["panels"]) {
+    EXPECT_NE(panel["axis_titles"][0].get<std::string>().find("eruptions ("), std::string::npos);
+    EXPECT_NE(panel["axis_titles"][1].get<std::string>().find("waiting ("), std::string::npos);
+  }
+}
+
 TEST_F(RenderCommandTest, BadArgumentsFailWithOneLineAndNoFile) {
   const fs::path png = Path("bad.png");
   for (const auto& args : std::vector<std::vector<std::string>>{
@@ -86,7 +116,8 @@ TEST_F(RenderCommandTest, BadArgumentsFailWithOneLineAndNoFile) {
            {"render", "--diff", Path("m1.h5").string(), "-o", png.string()},
            {"render", Path("m1.h5").string(), "-o", png.string(), "--size", "12"},
            {"render", Path("m1.h5").string(), "-o", png.string(), "--condition", "waiting"},
-           {"render", set_, "-o", png.string()}}) {
+           {"render", set_, "-o", png.string()},
+           {"render", Path("m1.h5").string(), "-o", png.string(), "--color-scale", "loud"}}) {
     RunResult r = RunUnderXvfb(args, *dir_);
     EXPECT_NE(r.exit_code, 0) << args[2];
     EXPECT_NE(r.err.find("dgmm: error:"), std::string::npos) << r.err;

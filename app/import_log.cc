@@ -1,0 +1,139 @@
+// `dgmm import-log`: time-stamped CSV streams (commands, pose, attitude) -> an HDF5 sample set
+// (io/log_import.h, docs/log-import.md).
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <nlohmann/json.hpp>
+
+#include "app/command.h"
+#include "io/csv_reader.h"
+#include "io/log_import.h"
+#include "io/sample_set_io.h"
+#include "util/atomic_file.h"
+
+namespace dgmm::app {
+namespace {
+
+struct ImportLogArgs {
+  LogImportOptions log;
+  std::string output, delimiter = ",", time_column;
+  std::vector<std::string> units;
+  bool json = false, quiet = false;
+};
+
+void Run(ImportLogArgs args) {
+  LogImportOptions& o = args.log;
+  o.delimiter = ParseDelimiter(args.delimiter);
+  o.units = ParseUnits(args.units);
+  if (!args.time_column.empty()) {
+    for (LogStream* s : {&o.commands, &o.pose, &o.attitude}) {
+      if (s->time_column == "t") s->time_column = args.time_column;
+    }
+  }
+  { AtomicFile probe(args.output); }  // fail before reading when the output is unwritable
+  LogImportSummary summary;
+  const SampleSet set = ImportLog(o, &summary);
+  WriteSampleSet(set, args.output);
+  if (!args.quiet) {
+    for (const auto& w : summary.warnings) std::fprintf(stderr, "dgmm: warning: %s\n", w.c_str());
+    for (const auto& line : summary.dropped_report) std::fprintf(stderr, "dgmm: %s\n", line.c_str());
+    if (!summary.unmatched_commands.empty()) {
+      std::string list;
+      for (const auto& c : summary.unmatched_commands) list += (list.empty() ? "" : "; ") + c;
+      std::fprintf(stderr,
+                   "dgmm: warning: %zu command(s) in %s gave no sample (segments too short or "
+                   "outside the pose/attitude coverage): %s\n",
+                   summary.unmatched_commands.size(), o.commands.path.c_str(), list.c_str());
+    }
+    if (summary.short_segments > 0) {
+      std::fprintf(stderr, "dgmm: warning: %d of %d command segments were shorter than %.3g s and skipped\n",
+                   summary.short_segments, summary.segments, summary.min_duration_s);
+    }
+  }
+  if (args.json) {
+    nlohmann::json out = {{"output", args.output},
+                          {"samples", set.size()},
+                          {"pose_dim", set.pose_dim()},
+                          {"terrain_dim", set.terrain_dim()},
+                          {"commands", set.command_labels},
+                          {"episodes", summary.episodes},
+                          {"segments", summary.segments},
+                          {"short_segments", summary.short_segments},
+                          {"gap_s", summary.gap_s},
+                          {"min_duration_s", summary.min_duration_s},
+                          {"dropped_rows", summary.dropped_rows},
+                          {"unmatched_commands", summary.unmatched_commands}};
+    std::cout << out.dump(2) << "\n";
+    return;
+  }
+  std::printf("imported %s\n", summary.BriefReport().c_str());
+  std::printf("%d commands:", set.num_commands());
+  for (const auto& label : set.command_labels) std::printf(" [%s]", label.c_str());
+  std::printf("\nwrote %s\n", args.output.c_str());
+}
+
+void Setup(CLI::App& root) {
+  auto args = std::make_shared<ImportLogArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "import-log",
+      "Turn time-stamped CSV logs (a command stream, a pose stream and optionally an IMU "
+      "attitude stream, each with its own time column and rate) into an HDF5 sample set: "
+      "streams are joined by time (commands held, pose and attitude interpolated), episodes "
+      "split at logging gaps, samples cut at command changes (or into --window seconds) and the "
+      "pose change expressed in the robot frame at the sample start (docs/log-import.md). "
+      "Lists are comma-separated.");
+  LogImportOptions& o = args->log;
+  cmd->add_option("--commands", o.commands.path, "command stream CSV")->required();
+  cmd->add_option("--command-cols", o.commands.columns,
+                  "command columns (comma-separated; numbers, or text taken as labels)")
+      ->delimiter(',');
+  cmd->add_option("--pose", o.pose.path, "pose stream CSV (fixed frame, e.g. map/odom)")->required();
+  cmd->add_option("--pose-cols", o.pose.columns,
+                  "x,y,yaw (planar) or x,y,z,roll,pitch,yaw (6-DoF) columns, in that order")
+      ->delimiter(',')
+      ->required();
+  cmd->add_option("--attitude", o.attitude.path, "attitude (IMU) stream CSV (optional)");
+  cmd->add_option("--terrain-cols", o.attitude.columns,
+                  "attitude angle columns stored as the terrain z (e.g. pitch,roll)")
+      ->delimiter(',');
+  cmd->add_option("--time-col", args->time_column, "time column name of every stream (default t)");
+  cmd->add_option("--commands-time", o.commands.time_column, "time column of the command stream");
+  cmd->add_option("--pose-time", o.pose.time_column, "time column of the pose stream");
+  cmd->add_option("--attitude-time", o.attitude.time_column, "time column of the attitude stream");
+  cmd->add_option("--units", args->units,
+                  "units converted to s, m and rad, COLUMN=UNIT comma-separated (e.g. "
+                  "t_ms=ms,x=mm,yaw=deg; units s ms us ns m cm mm rad deg); default SI")
+      ->delimiter(',');
+  cmd->add_option("--episode-col", o.episode_column,
+                  "integer episode column of the command stream (default: episodes from gaps)");
+  cmd->add_option("--gap", o.gap_s,
+                  "a pause longer than this (s) in the pose or attitude stream ends an episode "
+                  "(0: 10 x the slower stream's median interval)")
+      ->capture_default_str();
+  cmd->add_option("--window", o.window_s,
+                  "cut each command segment into windows of this many seconds (0: one sample "
+                  "per command segment)")
+      ->capture_default_str();
+  cmd->add_option("--min-duration", o.min_duration_s,
+                  "skip command segments shorter than this (s; 0: two pose intervals)")
+      ->capture_default_str();
+  cmd->add_option("--bins", o.bins,
+                  "bin numeric command columns into this many equal-width bins (0: every "
+                  "distinct value is a command)")
+      ->capture_default_str();
+  cmd->add_option("--delimiter", args->delimiter, "field separator: , ; tab | space")
+      ->capture_default_str();
+  cmd->add_flag("--drop-invalid", o.drop_invalid,
+                "skip rows with empty, NaN or non-numeric cells, ragged rows or times that do "
+                "not increase, and report how many per file; default: refuse naming file, "
+                "line and column");
+  cmd->add_option("--source", o.source, "where the data came from")->capture_default_str();
+  cmd->add_option("-o,--output", args->output, "sample set to write (.h5)")->required();
+  cmd->add_flag("--json", args->json, "print the summary as JSON");
+  cmd->add_flag("--quiet", args->quiet, "no warnings on stderr");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace
+DGMM_REGISTER_COMMAND("import-log", Setup);
+}  // namespace dgmm::app

@@ -1,0 +1,166 @@
+#include "sim/log_recorder.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <numbers>
+#include <random>
+
+#include "sim/simulator.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+constexpr double kRadToDeg = 180.0 / std::numbers::pi;
+
+struct Mode {
+  const char* name;
+  double long_, lat, turn;
+};
+constexpr Mode kModes[] = {{"forward", 0.5, 0, 0},  {"back", -0.5, 0, 0},
+                           {"left", 0, 0.5, 0},     {"right", 0, -0.5, 0},
+                           {"turn_left", 0, 0, 0.5}, {"turn_right", 0, 0, -0.5}};
+constexpr Mode kStop = {"stop", 0, 0, 0};
+
+// An open CSV file written through a temporary (std::FILE owned here).
+class CsvOut {
+ public:
+  CsvOut(const std::filesystem::path& path, const char* header) : file_(path) {
+    f_ = std::fopen(file_.temp_path().c_str(), "w");
+    if (!f_) throw MakeInputError(path.string(), "", "cannot open for writing");
+    std::fprintf(f_, "%s\n", header);
+  }
+  ~CsvOut() {
+    if (f_) std::fclose(f_);
+  }
+  std::FILE* get() { return f_; }
+  void Commit() {
+    const bool ok = std::fclose(f_) == 0;
+    f_ = nullptr;
+    if (!ok) throw MakeInputError(file_.target().string(), "", "write failed");
+    file_.Commit();
+  }
+
+ private:
+  AtomicFile file_;
+  std::FILE* f_ = nullptr;
+};
+
+}  // namespace
+
+bool LogRecordOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) { *error = m; return false; };
+  if (sessions < 1) return fail("sessions: expected >= 1");
+  if (commands_per_session < 1) return fail("commands per session: expected >= 1");
+  if (!(command_hz > 0 && pose_hz > 0 && imu_hz > 0)) return fail("rates: expected > 0 Hz");
+  if (!(gap_min_s > 0 && gap_max_s >= gap_min_s)) return fail("gaps: expected 0 < min <= max");
+  if (!(command_jitter >= 0) || !(dropout_probability >= 0 && dropout_probability < 1)) {
+    return fail("noise: expected jitter >= 0 and dropout probability in [0, 1)");
+  }
+  return true;
+}
+
+LogRecordSummary RecordLog(const SimConfig& config, const LogRecordOptions& options,
+                           const std::string& folder,
+                           const std::function<void(long long, long long)>& progress) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "log options", error);
+  const std::filesystem::path dir(folder);
+  CsvOut commands(dir / "commands.csv", "t,mode,v_long,v_lat,v_turn");
+  CsvOut pose(dir / "pose.csv", "t,x_mm,y_mm,z_mm,roll_deg,pitch_deg,yaw_deg");
+  CsvOut imu(dir / "imu.csv", "t_ms,roll_deg,pitch_deg");
+
+  std::mt19937_64 rng(options.seed);
+  std::normal_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  Simulator sim(config);
+  const NoiseConfig& noise = config.noise;
+  LogRecordSummary summary;
+  double clock_offset = options.start_time_s;  // log time = sim time + offset
+  for (int session = 0; session < options.sessions; ++session) {
+    if (session > 0) {
+      clock_offset += options.gap_min_s + (options.gap_max_s - options.gap_min_s) * uniform(rng);
+    }
+    const double x = 2 * uniform(rng) - 1, y = 2 * uniform(rng) - 1;
+    const double heading = std::numbers::pi * (2 * uniform(rng) - 1);
+    if (sim.Place(x, y, heading) != RunOutcome::kCompleted) {
+      ++summary.falls;
+      continue;
+    }
+    const double session_start = sim.time_s();
+    // Next logging time of each stream (sim clock), each with its own phase.
+    double next_pose = session_start + uniform(rng) / options.pose_hz;
+    double next_imu = session_start + uniform(rng) / options.imu_hz;
+    auto log_sensors = [&](const Simulator& s) {
+      const double t = s.time_s();
+      while (t >= next_imu) {
+        const Eigen::Vector2d pr = s.TruePitchRoll();
+        std::fprintf(imu.get(), "%.0f,%.3f,%.3f\n", (t + clock_offset) * 1000.0,
+                     (pr[1] + noise.imu_roll_sd_rad * unit(rng)) * kRadToDeg,
+                     (pr[0] + noise.imu_pitch_sd_rad * unit(rng)) * kRadToDeg);
+        ++summary.imu_rows;
+        next_imu += 1.0 / options.imu_hz;
+      }
+      while (t >= next_pose) {
+        const Pose p = s.TorsoPose();
+        const Eigen::Vector3d rpy = RollPitchYaw(p.rotation);
+        const double stamp = t + clock_offset + 0.002 * (uniform(rng) - 0.5);  // stamp jitter
+        if (uniform(rng) < options.dropout_probability) {
+          std::fprintf(pose.get(), "%.4f,nan,nan,nan,nan,nan,nan\n", stamp);
+          ++summary.dropouts;
+        } else {
+          double yaw = rpy[2] + noise.tracker_yaw_sd_rad * unit(rng);
+          yaw = std::remainder(yaw, 2 * std::numbers::pi);
+          std::fprintf(pose.get(), "%.4f,%.1f,%.1f,%.1f,%.3f,%.3f,%.3f\n", stamp,
+                       (p.position_m[0] + noise.tracker_position_sd_m * unit(rng)) * 1000,
+                       (p.position_m[1] + noise.tracker_position_sd_m * unit(rng)) * 1000,
+                       (p.position_m[2] + noise.tracker_position_sd_m * unit(rng)) * 1000,
+                       (rpy[0] + noise.tracker_roll_sd_rad * unit(rng)) * kRadToDeg,
+                       (rpy[1] + noise.tracker_pitch_sd_rad * unit(rng)) * kRadToDeg, yaw * kRadToDeg);
+        }
+        ++summary.pose_rows;
+        next_pose += 1.0 / options.pose_hz;
+      }
+    };
+    log_sensors(sim);
+    // Sensors run for one idle cycle before the first command is published (no command rows),
+    // and the controller publishes "stop" for two cycles after the last command.
+    bool fell = sim.RunCommand(Eigen::Vector3d::Zero(), log_sensors, 1) != RunOutcome::kCompleted;
+    auto run = [&](const Mode& mode) {
+      const Eigen::Vector3d command(mode.long_, mode.lat, mode.turn);
+      double next_command = sim.time_s();
+      const double command_end = next_command + config.command_duration_s;
+      auto log_command = [&](const Simulator& s) {
+        // The controller publishes the command when issued, then at command_hz until the next.
+        while (s.time_s() + 1e-9 >= next_command && next_command < command_end - 1e-6) {
+          std::fprintf(commands.get(), "%.4f,%s,%.3f,%.3f,%.3f\n", next_command + clock_offset,
+                       mode.name, mode.long_ + options.command_jitter * unit(rng),
+                       mode.lat + options.command_jitter * unit(rng),
+                       mode.turn + options.command_jitter * unit(rng));
+          ++summary.command_rows;
+          next_command += 1.0 / options.command_hz;
+        }
+      };
+      log_command(sim);
+      const RunOutcome outcome = sim.RunCommand(
+          command, [&](const Simulator& s) { log_command(s); log_sensors(s); }, 1);
+      fell = outcome != RunOutcome::kCompleted;
+    };
+    for (int c = 0; c < options.commands_per_session && !fell; ++c) {
+      run(kModes[static_cast<int>(uniform(rng) * std::size(kModes)) % std::size(kModes)]);
+    }
+    for (int k = 0; k < 2 && !fell; ++k) run(kStop);
+    if (fell) ++summary.falls;
+    summary.simulated_seconds += sim.time_s() - session_start;
+    ++summary.sessions;
+    if (progress) progress(session + 1, options.sessions);
+  }
+  commands.Commit();
+  pose.Commit();
+  imu.Commit();
+  return summary;
+}
+
+}  // namespace dgmm::sim
