@@ -377,7 +377,7 @@ std::vector<CurveOverlay> ComponentEllipses(const Mixture& mixture2d, int segmen
                                                                                std::sin(angle));
       curve.points.row(k) = p.transpose();
     }
-    curve.rgb = {120, 220, 255};
+    curve.rgb = {140, 255, 140};  // green: apart from the grey contours and blue samples
     curve.width = 1.5f;
     curves.push_back(std::move(curve));
   }

@@ -8,6 +8,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <random>
 
 #include "render/heat_map.h"
@@ -185,6 +187,38 @@ TEST(ViewerTest, KeysPickCommandsAxesEllipsesAndHoverReadsTheDensity) {
   // Outside every plot area (the control strip above the panels): no read-out.
   viewer.Replay(kHeader + Event("MouseMoveEvent", 3, viewer.window_size()[1] - 3));
   EXPECT_TRUE(viewer.readout().empty());
+}
+
+TEST(ViewerTest, ARecordedSessionReplaysToTheSameState) {
+  const fs::path dir = TempDir();
+  ExplorerInputs inputs;
+  inputs.model = TerrainModel(15);
+  inputs.model_file = "terrain.h5";
+  const fs::path recording = dir / "session.events";
+  std::string first_png;
+  double pitch = 0;
+  {
+    ViewerOptions options;
+    options.save_prefix = (dir / "recorded").string();
+    options.record_file = recording.string();
+    Viewer viewer(SliceExplorer(inputs, SmallFigure()), options);
+    viewer.Replay(kHeader + Key("n") + DragSlider(viewer, 0, 0.3) + Key("Tab") + Key("period") +
+                  Key("s"));
+    pitch = viewer.explorer().terrain()[0].value;
+    ASSERT_EQ(viewer.saved_files().size(), 1u);
+    first_png = viewer.saved_files()[0];
+  }
+  std::ifstream in(recording);
+  const std::string events((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(events.find("LeftButtonPressEvent"), std::string::npos);
+  ViewerOptions options;
+  options.save_prefix = (dir / "replayed").string();
+  Viewer viewer(SliceExplorer(inputs, SmallFigure()), options);
+  viewer.Replay(events);
+  EXPECT_EQ(viewer.explorer().command_index(), 1);
+  EXPECT_DOUBLE_EQ(viewer.explorer().terrain()[0].value, pitch);
+  ASSERT_EQ(viewer.saved_files().size(), 1u);
+  EXPECT_EQ(DifferentPixels(test::ReadPng(first_png), test::ReadPng(viewer.saved_files()[0])), 0);
 }
 
 TEST(ViewerTest, CompareShowsThreeLinkedPanelsEqualToTheRenderersRow) {
