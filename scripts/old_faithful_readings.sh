@@ -59,8 +59,10 @@ PY
 experiment known_identity "$work/known.h5" "$work/em_known.h5" identity 1
 
 python3 "$root/scripts/old_faithful_report.py" readings "$work" "$fig" > "$work/section.md"
+# A virtual display that fails to come up (several helpers start Xvfb at once) is retried.
+plot() { for _ in 1 2 3; do "${x[@]}" "$dgmm" plot "$@" && return 0; sleep 2; done; return 1; }
 for panel in known_identity std_identity; do
-  "${x[@]}" "$dgmm" plot --csv "$work/$panel/figure2.csv" --x k \
+  plot --csv "$work/$panel/figure2.csv" --x k \
     --y faithful-literal_mean,faithful-blend_mean,faithful-prior_mean,improved-prior_mean \
     --names "literal eq. 13,blend (v1),prior nu0=1,improved + prior" --log-x \
     --title "$( [ $panel = known_identity ] && echo "Known 2-Gaussian distribution" || echo "Old Faithful (standardised)"): Gaussians after one pass, S0 = I" \

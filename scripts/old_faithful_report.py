@@ -242,8 +242,9 @@ def readings(work, fig):
             w(f"| {data} | {s0} | {nu0 if v.endswith('prior') else '–'} | {v} | {mise_text} | "
               f"{g(m['fraction_with_target'], 3)} | {g(m['mean_components_all_attempts'], 3)} | "
               f"{g(cv, 4) if cv is not None else '–'} |")
-            if m["runs"] and run != "known_identity":
-                gap = abs(m["mean"] - PAPER_MISE)
+            # Closest to the paper: its own algorithm (faithful variant), distance in mean and sd.
+            if m["runs"] and run != "known_identity" and v.startswith("faithful"):
+                gap = abs(m["mean"] - PAPER_MISE) + abs(m["sd"] - PAPER_SD)
                 if best is None or gap < best[0]:
                     best = (gap, data, s0, v, m)
         em = s["cv"].get("em", {}).get("mean")
@@ -252,13 +253,16 @@ def readings(work, fig):
     w("")
     if best:
         gap, data, s0, v, m = best
-        w(f"**Closest to the paper's {PAPER_MISE} ± {PAPER_SD}:** {v} on {data} with S0 = {s0}: "
-          f"{g(m['mean'], 3)} ± {g(m['sd'], 3)}. MISE is not unit-free (an integral of a squared "
+        w(f"**Closest to the paper's {PAPER_MISE} ± {PAPER_SD}** among readings of the paper's own "
+          "algorithm (faithful variant; distance |mean - 0.0358| + |sd - 0.0317|): "
+          f"{v} on {data} with S0 = {s0}: {g(m['mean'], 3)} ± {g(m['sd'], 3)}. MISE is not unit-free (an integral of a squared "
           "density: it scales with 1/(area unit)), so agreement in one unit system and not in "
           "another says as much about the paper's unstated units as about the algorithm; and the "
           "literal eq. 13 makes components that received 2 or 3 samples singular (needles held up "
-          "only by the floor), which no unit choice repairs. Read the table rather than this "
-          "one line.")
+          "only by the floor), which no unit choice repairs. In standardised units the literal "
+          "reading is far off and only the prior rule comes near; in raw units (minutes, minutes: "
+          "S0 = I is then small against the waiting time's spread) every reading of Algorithm 2 "
+          "lands below the paper's figure. Read the table rather than this one line.")
         w("")
     w("**Figure 2 (as in the paper: a known generating distribution).** Number of Gaussians after "
       "one pass against k (mean over shuffles), S0 = I, left: samples from a known mixture of two "

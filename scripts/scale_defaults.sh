@@ -44,3 +44,21 @@ row "identity, blend (version 1)" --init-cov identity --covariance blend --floor
 for f in 0.1 0.3 1 3; do
   for nu in 1 4; do row "$f, $nu" --init-scale "$f" --prior-count "$nu"; done
 done
+
+# Raw-unit Old Faithful (minutes, minutes) at k = 0.7, S0 = I, streamed in file order, 40 seeds:
+# how many runs end with 1, 2, 3, ... Gaussians under each covariance reading.
+"$dgmm" import "$root/datasets/old_faithful.csv" -o "$work/of_raw.h5" \
+  --pose-cols eruptions,waiting > /dev/null
+echo
+echo "| raw-unit Old Faithful, k = 0.7, S0 = I, 40 seeds | runs ending with 1 / 2 / 3 / 4+ Gaussians |"
+echo "|---|---|"
+for rule in literal blend prior; do
+  counts=(0 0 0 0 0)
+  for seed in $(seq 1 40); do
+    c=$("$dgmm" fit "$work/of_raw.h5" -o "$work/m.h5" --seed "$seed" --init-cov identity \
+      --covariance "$rule" --prior-count 1 --floor-relative 1e-6 --json 2> /dev/null | components)
+    [ "$c" -gt 4 ] && c=4
+    counts[$c]=$((counts[c] + 1))
+  done
+  echo "| $rule | ${counts[1]} / ${counts[2]} / ${counts[3]} / ${counts[4]} |"
+done

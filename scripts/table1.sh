@@ -26,15 +26,17 @@ done
 x=()
 [ -z "${DISPLAY:-}" ] && x=(xvfb-run -a -s "-screen 0 1280x1024x24")
 mkdir -p "$out"
-# Runs a command that renders (under xvfb-run when there is no display); a run killed by a signal
-# (rare crashes seen inside VTK/Xvfb on this shared machine) is retried up to twice.
+# Runs a command that renders (under xvfb-run when there is no display); a failed run (a crash
+# inside VTK/Xvfb, or a virtual display that did not come up while other jobs start theirs on this
+# shared machine) is retried up to twice.
 render() {
   local attempt status
   for attempt in 1 2 3; do
     status=0
     "${x[@]}" "$@" || status=$?
-    [ "$status" -lt 128 ] && return "$status"
-    echo "table1: '$1 $2' killed by signal $((status - 128)), retrying" >&2
+    [ "$status" -eq 0 ] && return 0
+    echo "table1: '$1 $2' failed (status $status), retrying" >&2
+    sleep 2
   done
   return "$status"
 }
@@ -53,14 +55,17 @@ if t.get("prior_count") is not None: flags += ["--prior-count", repr(t["prior_co
 print(" ".join(flags))' "$1"
 }
 report=(--folds "$folds" --repeats "$repeats" --seed "$report_seed")
+# Grids of the S0 scale f and the prior pseudo-count nu0 (the library defaults).
+grids=(--init-scales 0.03,0.1,0.3,1,3,10 --prior-counts 1,4,16,64)
 for role in real sim; do
   set_path=$real
   [ "$role" = sim ] && set_path=$sim
   echo "table1: $role role: $set_path"
   # k, S0 scale and nu0 by cross-validation (seed $seed), with and without terrain.
-  render "$dgmm" tune "$set_path" "${common[@]}" --with-terrain --json \
+  render "$dgmm" tune "$set_path" "${common[@]}" "${grids[@]}" --with-terrain --json \
     --plot "$out/tune_k_$role.png" --curve-csv "$out/tune_k_$role.csv" > "$work/tune_$role.json"
-  "$dgmm" tune "$set_path" "${common[@]}" --without-terrain --json > "$work/tune_without_$role.json"
+  "$dgmm" tune "$set_path" "${common[@]}" "${grids[@]}" --without-terrain --json \
+    > "$work/tune_without_$role.json"
   read -r -a with_flags < <(tuned_flags "$work/tune_$role.json")
   read -r -a without_flags < <(tuned_flags "$work/tune_without_$role.json")
   echo "table1: $role: with terrain ${with_flags[*]}; without ${without_flags[*]}"

@@ -132,10 +132,14 @@ the identity S0 (1 m², 3·10⁴ times dz's variance) and a blend that drops S0 
 command was one plug-in Gaussian whose only regulariser was the absolute 10⁻⁶ floor — the literal
 eq. 13 row shows what remains without S0. The prior rule keeps S0 = f v as ν0 pseudo-samples
 (a Normal–inverse-Wishart posterior mean): a shrinkage estimator whose strength ν0 and target f v
-are chosen by cross-validation. With it the estimation cost of the two extra dimensions falls
-below what terrain explains, which is the sign the paper reports. The tuned models use one
-Gaussian per command: with 10–30 samples per command cross-validation prefers one well-regularised
-Gaussian to a mixture, and EM-BIC agrees (its mean number of components is given above).
+are chosen by cross-validation. The table shows whether, with it, the estimation cost of the two
+extra dimensions falls below what terrain explains (the sign the paper reports). The tuned models
+use one Gaussian per command when `dgmm tune` reports a plateau over k: with 10–30 samples per
+command cross-validation finds no mixture better than one well-regularised Gaussian, so it keeps
+the simplest. Whether any command is truly multimodal cannot be told from these sets: EM-BIC may
+only try as many parameters as samples (one 6-D Gaussian has 27, a second one needs 28 more), so
+it can only return one component, and its unregularised plug-in covariance is what collapses in
+its rows when whole placements are held out.
 
 **Why the absolute values differ from the paper's.** A log-likelihood of continuous data is not
 unit-free: scaling one dimension by s shifts every sample's log-density by −log s. Our pose change

@@ -44,8 +44,8 @@ struct TuneKOptions {
   double plateau_tolerance = 0;
   // Grids for the coordinate steps after k; an empty grid (or a rule it does not apply to)
   // skips the step and keeps cv.dgmm's value.
-  std::vector<double> init_scales = {0.01, 0.03, 0.1, 0.3, 1.0};
-  std::vector<double> prior_counts = {0.25, 1.0, 4.0, 16.0};
+  std::vector<double> init_scales = {0.03, 0.1, 0.3, 1.0, 3.0, 10.0};
+  std::vector<double> prior_counts = {1.0, 4.0, 16.0, 64.0};
   int cycles = 3;  // at most this many (k, f, nu0) cycles
   // Called before each cross-validation with (index, -1) (the total is not known in advance),
   // and once at the end with (total, total).

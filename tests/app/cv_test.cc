@@ -86,9 +86,18 @@ TEST(TuneKCommand, ChoosesKInsideTheBracketAndWritesTheCurve) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const double k = j["k"];
-  EXPECT_GE(k, j["bracket"][0].get<double>() * (1 - 1e-9));
-  EXPECT_LE(k, j["bracket"][1].get<double>() * (1 + 1e-9));
-  EXPECT_EQ(j["curve"].size(), 4u + 1u + 1u);
+  const bool plateau = j["plateau"]["flat"];
+  if (plateau) {  // k is the simplest member of the plateau, which is stated with its range
+    EXPECT_GE(k, j["plateau"]["k_range"][0].get<double>());
+    EXPECT_LE(k, j["plateau"]["k_range"][1].get<double>());
+    EXPECT_NE(j["k_rule"].get<std::string>().find("plateau"), std::string::npos);
+  } else {
+    EXPECT_GE(k, j["bracket"][0].get<double>() * (1 - 1e-9));
+    EXPECT_LE(k, j["bracket"][1].get<double>() * (1 + 1e-9));
+  }
+  // Grid and refinement, plus the chosen k's own evaluation unless it came from the plateau.
+  EXPECT_EQ(j["curve"].size(), 4u + 1u + (plateau ? 0u : 1u));
+  EXPECT_FALSE(j["folds_by"].get<std::string>().empty());
   std::ifstream in(csv);
   std::string header;
   std::getline(in, header);
