@@ -50,6 +50,7 @@ void RunCv(const CvArgs& args) {
   if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
+  WarnIfUnderdetermined(set, true, "cv");
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
   CvOptions options;
   options.dgmm.k = args.k;

@@ -40,6 +40,7 @@ void Run(const EmArgs& args) {
   if (!args.em.IsValid(&error)) throw MakeInputError(args.set, "options", error);
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const SampleSet set = ReadSampleSet(args.set);
+  WarnIfUnderdetermined(set, !args.without_terrain, "em");
   MotionModel model = ModelHeaderFor(set, !args.without_terrain);
   model.kind = "em";
   model.seed = args.em.seed;
