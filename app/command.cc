@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 
 namespace dgmm::app {
@@ -15,12 +16,75 @@ CommandRegistrar::CommandRegistrar(std::string name, CommandSetup setup) {
   CommandRegistry().push_back({std::move(name), std::move(setup)});
 }
 
-bool ShowProgress() { return ::isatty(STDERR_FILENO) == 1; }
+namespace {
+bool g_quiet = false;
+struct Stage {
+  std::string label;
+  long long last_done = -1;
+  std::chrono::steady_clock::time_point start;
+};
+Stage g_stage;
+}  // namespace
+
+void SetQuiet(bool quiet) { g_quiet = quiet; }
+bool Quiet() { return g_quiet; }
+
+bool ShowProgress() { return !g_quiet && ::isatty(STDERR_FILENO) == 1; }
 
 void ReportProgress(const std::string& label, long long done, long long total) {
-  if (!ShowProgress()) return;
-  std::fprintf(stderr, "\r%s %lld/%lld", label.c_str(), done, total);
-  if (done >= total) std::fprintf(stderr, "\n");
+  if (g_quiet) return;
+  const auto now = std::chrono::steady_clock::now();
+  if (label != g_stage.label || done < g_stage.last_done) {
+    g_stage.label = label;
+    g_stage.start = now;
+  }
+  g_stage.last_done = done;
+  const double elapsed = std::chrono::duration<double>(now - g_stage.start).count();
+  if (ShowProgress()) {
+    std::fprintf(stderr, "\r%s %lld/%lld (%.0f%%), %.0f s", label.c_str(), done, total,
+                 total > 0 ? 100.0 * static_cast<double>(done) / static_cast<double>(total) : 100.0,
+                 elapsed);
+    if (done > 0 && done < total) {
+      std::fprintf(stderr, ", about %.0f s left   ",
+                   elapsed * static_cast<double>(total - done) / static_cast<double>(done));
+    } else {
+      std::fprintf(stderr, "                    ");
+    }
+    if (done >= total) std::fprintf(stderr, "\n");
+  } else if (done >= total) {
+    std::fprintf(stderr, "dgmm: %s: %lld/%lld done in %.1f s\n", label.c_str(), done, total, elapsed);
+  }
+  std::fflush(stderr);
+}
+
+void ReportStage(const std::string& text) {
+  if (g_quiet) return;
+  std::fprintf(stderr, "dgmm: %s\n", text.c_str());
+  std::fflush(stderr);
+}
+
+void WarnIfUnderdetermined(const SampleSet& set, bool with_terrain, const std::string& what) {
+  const int d = set.pose_dim() + (with_terrain ? set.terrain_dim() : 0);
+  const int parameters = d + d * (d + 1) / 2;
+  std::vector<int> count(set.num_commands(), 0);
+  for (int i = 0; i < set.size(); ++i) ++count[set.command[i]];
+  std::string list;
+  for (int c = 0; c < set.num_commands(); ++c) {
+    if (count[c] >= parameters) continue;
+    const std::string name = c < static_cast<int>(set.command_labels.size()) ? set.command_labels[c]
+                                                                               : std::to_string(c);
+    list += (list.empty() ? "" : ", ") + ("'" + name + "' (" + std::to_string(count[c]) + ")");
+  }
+  if (list.empty()) return;
+  Warn(what + ": fewer samples than the " + std::to_string(parameters) +
+       " parameters of one Gaussian in d = " + std::to_string(d) + " for command(s) " + list +
+       "; their components rest on the covariance floor and prior more than on data (record more "
+       "samples, or use --pose-dims/--terrain-dims or --without-terrain)");
+}
+
+void Warn(const std::string& text) {
+  if (g_quiet) return;
+  std::fprintf(stderr, "dgmm: warning: %s\n", text.c_str());
   std::fflush(stderr);
 }
 

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "core/sample_set.h"
+
 namespace dgmm::app {
 
 // Adds a subcommand (with its options and callback) to the top-level app.
@@ -22,11 +24,30 @@ struct CommandRegistrar {
   CommandRegistrar(std::string name, CommandSetup setup);
 };
 
-// True when stderr is a terminal: long work shows progress only then.
+// `dgmm --quiet ...` (or `dgmm <command> ... --quiet`): no progress, stage lines or warnings.
+void SetQuiet(bool quiet);
+bool Quiet();
+
+// True when stderr is a terminal and not quiet: live progress lines are shown only then.
 bool ShowProgress();
 
-// Prints "\r<label> <done>/<total>" to stderr when ShowProgress(); a final newline when done == total.
+// Progress of one stage (a new label or a smaller `done` starts a new stage). On a terminal:
+// "\r<label> <done>/<total> (p%), <elapsed> s, about <eta> s left" (the estimate assumes the
+// remaining steps take as long as the finished ones), a newline when done == total. Otherwise
+// one line per stage when it completes: "<label>: <total>/<total> done in <s> s". Nothing when
+// quiet.
 void ReportProgress(const std::string& label, long long done, long long total);
+
+// "dgmm: <text>" on stderr unless quiet: one line per stage of a long command.
+void ReportStage(const std::string& text);
+
+// "dgmm: warning: <text>" on stderr unless quiet.
+void Warn(const std::string& text);
+
+// Warns for each command with fewer samples than the d + d(d+1)/2 parameters of one full-
+// covariance Gaussian over d = pose (+ terrain) dimensions: its EM or DGMM components are then
+// fixed by the covariance floor and initial covariance more than by the data.
+void WarnIfUnderdetermined(const SampleSet& set, bool with_terrain, const std::string& what);
 
 }  // namespace dgmm::app
 

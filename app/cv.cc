@@ -54,6 +54,7 @@ void RunCv(const CvArgs& args) {
   if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
+  WarnIfUnderdetermined(set, true, "cv");
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
   // Stratified folds: every command's samples are spread over the folds, so no fold may be
   // empty for any command (and a huge --folds must not run for minutes on empty folds).

@@ -42,6 +42,7 @@ void Run(const EmArgs& args) {
   RefuseOutputThatIsAnInput(args.output, {args.set});
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const SampleSet set = ReadSampleSet(args.set);
+  WarnIfUnderdetermined(set, !args.without_terrain, "em");
   MotionModel model = ModelHeaderFor(set, !args.without_terrain);
   model.kind = "em";
   model.seed = args.em.seed;

@@ -30,7 +30,9 @@ void Run(const ImportArgs& args) {
   { AtomicFile probe(args.output); }  // fail before reading when the output is unwritable
   CsvImportSummary summary;
   const SampleSet set = ImportCsv(args.input, csv, &summary);
-  for (const std::string& line : summary.dropped_report) std::fprintf(stderr, "dgmm: %s\n", line.c_str());
+  if (!Quiet()) {
+    for (const std::string& line : summary.dropped_report) std::fprintf(stderr, "dgmm: %s\n", line.c_str());
+  }
   WriteSampleSet(set, args.output);
   if (args.json) {
     nlohmann::json out = {{"input", args.input},

@@ -34,7 +34,7 @@ void Run(ImportLogArgs args) {
   LogImportSummary summary;
   const SampleSet set = ImportLog(o, &summary);
   WriteSampleSet(set, args.output);
-  if (!args.quiet) {
+  if (!Quiet()) {
     for (const auto& w : summary.warnings) std::fprintf(stderr, "dgmm: warning: %s\n", w.c_str());
     for (const auto& line : summary.dropped_report) std::fprintf(stderr, "dgmm: %s\n", line.c_str());
     if (!summary.unmatched_commands.empty()) {
@@ -130,7 +130,6 @@ void Setup(CLI::App& root) {
   cmd->add_option("--source", o.source, "where the data came from")->capture_default_str();
   cmd->add_option("-o,--output", args->output, "sample set to write (.h5)")->required();
   cmd->add_flag("--json", args->json, "print the summary as JSON");
-  cmd->add_flag("--quiet", args->quiet, "no warnings on stderr");
   cmd->callback([args] { Run(*args); });
 }
 

@@ -14,6 +14,12 @@ int main(int argc, char** argv) {
   std::signal(SIGXFSZ, SIG_IGN);
   CLI::App root{"dgmm: Dynamic Gaussian Mixture motion models for legged robots"};
   root.require_subcommand(1);
+  // Options of the top level are also accepted after the subcommand (`dgmm cv set.h5 --quiet`).
+  root.fallthrough();
+  bool quiet = false;
+  root.add_flag("--quiet", quiet,
+                "no progress, stage lines or warnings on stderr (errors are still printed)");
+  root.parse_complete_callback([&quiet] { dgmm::app::SetQuiet(quiet); });
   auto& registry = dgmm::app::CommandRegistry();
   std::sort(registry.begin(), registry.end(),
             [](const auto& a, const auto& b) { return a.name < b.name; });

@@ -83,7 +83,8 @@ void Run(const Sim2RealArgs& args) {
   options.seed = args.seed;
   options.selection.bootstrap_selection = args.bootstrap;
   options.locate.mmd.permutations = args.permutations;
-  if (ShowProgress()) std::cerr << "sim2real: analysing " << real.size() << " real vs " << sim.size() << " sim samples\n";
+  ReportStage("sim2real: analysing " + std::to_string(real.size()) + " real vs " +
+              std::to_string(sim.size()) + " sim samples");
   const sim2real::Sim2RealResult result = sim2real::RunSim2Real(sim, real, options);
 
   sim2real::ReportContext ctx;
@@ -109,7 +110,7 @@ void Run(const Sim2RealArgs& args) {
   ctx.verdict_json = sim2real::VerdictJson(verdict);
   ctx.verdict_sentence = verdict.sentence;
   if (!args.sim_config.empty()) {
-    if (ShowProgress()) std::cerr << "sim2real: re-simulating with fitted physical parameters\n";
+    ReportStage("sim2real: re-simulating with fitted physical parameters");
     sim2real::RecalibrationOptions recal;
     recal.sim_config_path = args.sim_config;
     recal.seed = args.seed;

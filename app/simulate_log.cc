@@ -26,7 +26,7 @@ void Run(const SimulateLogArgs& args) {
   }
   const sim::LogRecordSummary s = sim::RecordLog(
       config, args.log, args.folder, [&](long long done, long long total) {
-        if (!args.quiet) ReportProgress("simulate-log: session", done, total);
+        ReportProgress("simulate-log: session", done, total);
       });
   std::printf(
       "wrote %s/{commands,pose,imu}.csv: %d sessions (%d falls), %.1f s simulated; rows: %lld "
@@ -51,7 +51,6 @@ void Setup(CLI::App& root) {
   cmd->add_option("--commands-per-session", args->log.commands_per_session,
                   "commands run back to back in each session")
       ->capture_default_str();
-  cmd->add_flag("--quiet", args->quiet, "no progress on stderr");
   cmd->callback([args] { Run(*args); });
 }
 

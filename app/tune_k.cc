@@ -100,6 +100,7 @@ void RunTuneK(const TuneKArgs& args) {
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
+  WarnIfUnderdetermined(set, !args.without_terrain, "tune-k");
   if (args.with_terrain && set.terrain_dim() == 0) {
     throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
   }

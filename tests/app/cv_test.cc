@@ -25,7 +25,7 @@ TEST(CvCommand, JsonTableWithTerrainHelping) {
   const fs::path dir = MakeTempDir("cv_json");
   const std::string set = WriteTerrainSet(dir);
   const RunResult r =
-      RunDgmm({"cv", set, "--k", "0.5", "--folds", "4", "--repeats", "2", "--json"});
+      RunDgmm({"cv", set, "--k", "0.5", "--folds", "4", "--repeats", "2", "--json", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["samples"], 60);
@@ -39,7 +39,13 @@ TEST(CvCommand, JsonTableWithTerrainHelping) {
             j["rows"]["dgmm_without_terrain"]["mean"].get<double>());
   EXPECT_GT(j["rows"]["em_bic_with_terrain"]["mean"].get<double>(),
             j["rows"]["em_bic_without_terrain"]["mean"].get<double>());
-  EXPECT_TRUE(r.err.empty()) << "no progress output when stderr is not a terminal: " << r.err;
+  EXPECT_TRUE(r.err.empty()) << "--quiet silences progress: " << r.err;
+  // Without --quiet and without a terminal: one line for the stage, no carriage returns.
+  const RunResult loud = RunDgmm({"cv", set, "--k", "0.5", "--folds", "4", "--repeats", "2", "--json"});
+  ASSERT_EQ(loud.exit_code, 0) << loud.err;
+  EXPECT_EQ(CountLines(loud.err), 1) << loud.err;
+  EXPECT_NE(loud.err.find("cv folds: 8/8 done in"), std::string::npos) << loud.err;
+  EXPECT_EQ(loud.err.find('\r'), std::string::npos);
 }
 
 TEST(CvCommand, TextTableAndThreadIndependence) {
