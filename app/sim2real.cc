@@ -81,10 +81,15 @@ void Run(const Sim2RealArgs& args) {
     ko.selection = options.selection;
     ko.signatures.cache_dir = args.cache;
     ko.signatures.placements = args.signature_placements;
-    const sim2real::KnobAnalysis knobs =
-        sim2real::AnalyseKnobs(sim, real, sim::LoadSimConfig(args.sim_config), result, ko);
-    verdict = knobs.verdict;
-    ctx.knob_analysis_json = sim2real::KnobAnalysisJson(knobs);
+    const sim::SimConfig config = sim::LoadSimConfig(args.sim_config);  // a bad config is the user's error
+    try {
+      const sim2real::KnobAnalysis knobs = sim2real::AnalyseKnobs(sim, real, config, result, ko);
+      verdict = knobs.verdict;
+      ctx.knob_analysis_json = sim2real::KnobAnalysisJson(knobs);
+    } catch (const InputError& e) {
+      // E.g. a sim set without episodes: the data-level verdict stands, and the report says why.
+      ctx.notes.push_back(std::string("simulator-knob analysis skipped: ") + e.what());
+    }
   }
   ctx.verdict_json = sim2real::VerdictJson(verdict);
   ctx.verdict_sentence = verdict.sentence;
