@@ -100,7 +100,7 @@ void Run(const Sim2RealArgs& args) {
   WriteModel(sim2real::BuildSimModel(result, sim), (out_dir / ctx.sim_model_file).string());
   sim2real::Verdict verdict = sim2real::VerdictFromEffects(result);
   if (!args.sim_config.empty() && !args.no_knobs) {
-    if (ShowProgress()) std::cerr << "sim2real: simulator knobs (signatures, selection, refinement)\n";
+    ReportStage("sim2real: simulator knobs (signatures, selection, refinement)");
     sim2real::KnobAnalysisOptions ko;
     ko.seed = args.seed;
     ko.selection = options.selection;
