@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -35,11 +36,15 @@ struct FitArgs {
 };
 
 // Default cap on components per mixture (docs/reliability.md, "Bounded work"): the square-root
-// rule ceil(sqrt(N)), at most N / (d + 1) (a component's covariance needs d + 1 samples), and
-// never below 50 so that small sets are never capped by default.
+// rule ceil(sqrt(N)); at most N / (d + 1) (a component's covariance needs d + 1 samples); at most
+// kWorkBudget / (N d^2), since each sample costs about K d^2 once the cap is reached (choosing
+// the component); never below 50 so that small sets are not capped by default.
 long long DefaultMaxComponents(long long n, int dim) {
-  const long long root = static_cast<long long>(std::ceil(std::sqrt(static_cast<double>(n))));
-  return std::max<long long>(50, std::min(root, n / (dim + 1)));
+  constexpr double kWorkBudget = 2e9;  // N K d^2 multiply-adds: a few seconds of one core
+  const double nd = static_cast<double>(n), d = dim;
+  const double cap = std::min({std::ceil(std::sqrt(nd)), std::floor(nd / (d + 1)),
+                               std::floor(kWorkBudget / (std::max(nd, 1.0) * d * d))});
+  return std::max<long long>(50, static_cast<long long>(cap));
 }
 
 // DGMM options from the flags, checked against the set's dimension.
@@ -162,7 +167,8 @@ void Setup(CLI::App& root) {
       ->check(CLI::Range(1, 100000000));
   cmd->add_option("--max-components", args->max_components,
                   "cap on components per mixture; at the cap every sample merges (default: "
-                  "max(50, min(ceil(sqrt(N)), N / (d + 1))) for N samples of dimension d)");
+                  "max(50, min(ceil(sqrt(N)), N / (d + 1), 2e9 / (N d^2))) for N samples of "
+                  "dimension d)");
   cmd->add_flag("--json", args->json, "print the summary as JSON");
   cmd->callback([args] { Run(*args); });
 }

@@ -24,6 +24,11 @@ def check(condition, what):
         print(f"MISMATCH: {what}")
 
 
+def text(value):
+    """One string attribute: format 2 stores fixed-length strings, which h5py reads as bytes."""
+    return value.decode() if isinstance(value, (bytes, np.bytes_)) else str(value)
+
+
 def strings(values):
     return [v.decode() if isinstance(v, bytes) else str(v) for v in np.atleast_1d(values)]
 
@@ -48,9 +53,9 @@ def write_csv(path, rng):
 def check_set(path, data, standardized):
     raw = np.array([d[1:5] for d in data])
     with h5py.File(path, "r") as f:
-        check(f.attrs["dgmm_format"] == "sample_set", "set: dgmm_format")
+        check(text(f.attrs["dgmm_format"]) == "sample_set", "set: dgmm_format")
         check(int(f.attrs["dgmm_format_version"]) == 2, "set: dgmm_format_version")
-        check(f.attrs["source"] == "real", "set: source")
+        check(text(f.attrs["source"]) == "real", "set: source")
         n = len(data)
         check(f["x"].shape == (n, 2) and f["x"].dtype == np.float64, "set: x shape/dtype")
         check(f["z"].shape == (n, 2) and f["z"].dtype == np.float64, "set: z shape/dtype")
@@ -79,14 +84,14 @@ def check_set(path, data, standardized):
         else:
             check("transform" not in f, "set: no transform")
             check(np.array_equal(y, raw), "set: x||z equal the CSV exactly")
-        check(f["metadata"].attrs["imported_from"] == "walk.csv", "set: metadata")
+        check(text(f["metadata"].attrs["imported_from"]) == "walk.csv", "set: metadata")
 
 
 def check_model(path):
     with h5py.File(path, "r") as f:
-        check(f.attrs["dgmm_format"] == "model", "model: dgmm_format")
+        check(text(f.attrs["dgmm_format"]) == "model", "model: dgmm_format")
         check(int(f.attrs["dgmm_format_version"]) == 2, "model: version")
-        check(f.attrs["kind"] == "dgmm", "model: kind")
+        check(text(f.attrs["kind"]) == "dgmm", "model: kind")
         d = int(f.attrs["pose_dim"]) + int(f.attrs["terrain_dim"])
         check((int(f.attrs["pose_dim"]), int(f.attrs["terrain_dim"])) == (2, 2), "model: dims")
         check(int(f.attrs["seed"]) == 7, "model: seed")
@@ -95,7 +100,7 @@ def check_model(path):
         check(np.array_equal(f["commands/ids"][()], [0, 1, 2]), "model: command ids")
         check(f["commands/values"].shape == (3, 2), "model: command values")
         opts = f["dgmm_options"].attrs
-        check(opts["variant"] == "faithful" and float(opts["k"]) == 0.5, "model: options")
+        check(text(opts["variant"]) == "faithful" and float(opts["k"]) == 0.5, "model: options")
         check(np.array_equal(f["dgmm_options/initial_covariance_diagonal"][()],
                              [0.1, 0.1, 0.1, 0.1]), "model: initial covariance")
         check(f["transform/offset"].shape == (4,), "model: transform")

@@ -17,7 +17,7 @@ if ! command -v clang++-14 > /dev/null; then
 fi
 build=${DGMM_FUZZ_BUILD_DIR:-$root/build-fuzz}
 mkdir -p "$build"
-cmake -S "$root/tests/fuzz/harnesses" -B "$build" -DCMAKE_CXX_COMPILER=clang++-14 \
+cmake -S "$root/tests/fuzz/harnesses" -B "$build" -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_C_COMPILER=clang-14 \
   > "$build/configure.log" 2>&1 || { cat "$build/configure.log"; exit 1; }
 nice -n 5 cmake --build "$build" -j "${DGMM_JOBS:-2}" > "$build/build.log" 2>&1 \
   || { tail -40 "$build/build.log"; exit 1; }

@@ -9,10 +9,6 @@ namespace dgmm::h5 {
 
 namespace {
 
-[[noreturn]] void WriteFailed(const std::string& path, const std::string& field) {
-  throw MakeInputError(path, field, "cannot write (HDF5 error; disk full or not writable?)");
-}
-
 PropertyList NoTimesDatasetPlist() {
   PropertyList p(H5Pcreate(H5P_DATASET_CREATE));
   H5Pset_obj_track_times(p.get(), false);  // same content, same bytes

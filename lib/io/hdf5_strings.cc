@@ -15,10 +15,6 @@ thread_local int legacy_depth = 0;
 
 std::string Str(unsigned long long v) { return std::to_string(v); }
 
-[[noreturn]] void WriteFailed(const std::string& path, const std::string& field) {
-  throw MakeInputError(path, field, "cannot write (HDF5 error; disk full or not writable?)");
-}
-
 // Fixed-length string type of `size` bytes (>= 1), NULLPAD, in character set `cset`.
 Datatype FixedStringType(size_t size, H5T_cset_t cset = H5T_CSET_UTF8) {
   Datatype t(H5Tcopy(H5T_C_S1));
@@ -57,14 +53,6 @@ void CheckEntries(hsize_t n, long long expected, const std::string& path,
     throw MakeInputError(path, field,
                          Str(n) + " entries, expected " + Str(static_cast<hsize_t>(expected)));
   }
-}
-
-Attribute OpenAttribute(hid_t obj, const std::string& name, const std::string& path,
-                        const std::string& field) {
-  if (!HasAttribute(obj, name)) throw MakeInputError(path, field, "missing");
-  Attribute a(H5Aopen(obj, name.c_str(), H5P_DEFAULT));
-  if (!a.valid()) throw MakeInputError(path, field, "cannot open (corrupt file?)");
-  return a;
 }
 
 // Reads n strings from an attribute or dataset of type `file_type` after checking the type and

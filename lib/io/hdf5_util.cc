@@ -16,18 +16,6 @@ PropertyList NoTimesGroupPlist() {
   return p;
 }
 
-[[noreturn]] void WriteFailed(const std::string& path, const std::string& field) {
-  throw MakeInputError(path, field, "cannot write (HDF5 error; disk full or not writable?)");
-}
-
-Attribute OpenAttribute(hid_t obj, const std::string& name, const std::string& path,
-                        const std::string& field) {
-  if (!HasAttribute(obj, name)) throw MakeInputError(path, field, "missing");
-  Attribute a(H5Aopen(obj, name.c_str(), H5P_DEFAULT));
-  if (!a.valid()) throw MakeInputError(path, field, "cannot open (corrupt file?)");
-  return a;
-}
-
 template <typename T>
 void WriteScalarAttribute(hid_t obj, const std::string& name, hid_t file_type, hid_t mem_type,
                           const T& value, const std::string& path) {
@@ -53,6 +41,18 @@ T ReadScalarAttribute(hid_t obj, const std::string& name, hid_t file_type, hid_t
 }
 
 }  // namespace
+
+void WriteFailed(const std::string& path, const std::string& field) {
+  throw MakeInputError(path, field, "cannot write (HDF5 error; disk full or not writable?)");
+}
+
+Attribute OpenAttribute(hid_t obj, const std::string& name, const std::string& path,
+                        const std::string& field) {
+  if (!HasAttribute(obj, name)) throw MakeInputError(path, field, "missing");
+  Attribute a(H5Aopen(obj, name.c_str(), H5P_DEFAULT));
+  if (!a.valid()) throw MakeInputError(path, field, "cannot open (corrupt file?)");
+  return a;
+}
 
 herr_t CloseFile(hid_t file) {
   // After a failed flush (disk full) H5Fclose fails too and leaves the file half closed: closing

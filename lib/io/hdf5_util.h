@@ -96,6 +96,12 @@ std::int64_t ReadFormatVersion(hid_t file, const std::string& path);
 void WriteFormat(hid_t file, const std::string& format, const std::string& path);
 inline constexpr int kFormatVersion = 2;
 
+// InputError "<path>: <field>: cannot write (HDF5 error; disk full or not writable?)".
+[[noreturn]] void WriteFailed(const std::string& path, const std::string& field);
+// The attribute `name` of obj; InputError "<path>: <field>: missing" when absent.
+Attribute OpenAttribute(hid_t obj, const std::string& name, const std::string& path,
+                        const std::string& field);
+
 // --- Groups and existence -----------------------------------------------------------------
 Group CreateGroup(hid_t loc, const std::string& name, const std::string& path);
 Group OpenGroup(hid_t loc, const std::string& name, const std::string& path);

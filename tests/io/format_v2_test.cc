@@ -121,19 +121,30 @@ TEST(FormatV2, VersionOneIsRefusedWithTheWayToUpgrade) {
   EXPECT_NE(ErrorOf([&] { ReadSampleSet(set); }).find("unsupported version 3"), std::string::npos);
 }
 
-// A version-1 file as dgmm 1 wrote it: variable-length strings, version 1, no checksums.
+// A version-1 file as dgmm 1 wrote it: variable-length root strings, version 1, no checksums
+// (earliest format bounds). Objects are copied, root attributes copied byte for byte.
 void MakeVersionOne(const std::string& from, const std::string& to) {
-  // Copy object by object into a file with the earliest format bounds, then rewrite the root
-  // strings as variable-length ones.
   hid_t src = H5Fopen(from.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   hid_t dst = H5Fcreate(to.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  hid_t ocpypl = H5Pcreate(H5P_OBJECT_COPY);
   auto copy = [](hid_t g, const char* name, const H5L_info_t*, void* data) -> herr_t {
-    auto* ids = static_cast<std::pair<hid_t, hid_t>*>(data);
-    return H5Ocopy(g, name, ids->first, name, H5P_DEFAULT, H5P_DEFAULT);
+    return H5Ocopy(g, name, *static_cast<hid_t*>(data), name, H5P_DEFAULT, H5P_DEFAULT);
   };
-  std::pair<hid_t, hid_t> ids{dst, ocpypl};
-  H5Literate(src, H5_INDEX_NAME, H5_ITER_INC, nullptr, copy, &ids);
+  H5Literate(src, H5_INDEX_NAME, H5_ITER_INC, nullptr, copy, &dst);
+  auto copy_attr = [](hid_t loc, const char* name, const H5A_info_t*, void* data) -> herr_t {
+    hid_t a = H5Aopen(loc, name, H5P_DEFAULT);
+    hid_t t = H5Aget_type(a), space = H5Aget_space(a);
+    std::vector<char> buf(H5Tget_size(t) * H5Sget_simple_extent_npoints(space));
+    H5Aread(a, t, buf.data());
+    hid_t b = H5Acreate2(*static_cast<hid_t*>(data), name, t, space, H5P_DEFAULT, H5P_DEFAULT);
+    H5Awrite(b, t, buf.data());
+    H5Aclose(b);
+    H5Sclose(space);
+    H5Tclose(t);
+    H5Aclose(a);
+    return 0;
+  };
+  H5Aiterate2(src, H5_INDEX_NAME, H5_ITER_INC, nullptr, copy_attr, &dst);
+  H5Fclose(dst);
   for (const char* attr : {"dgmm_format", "source", "kind"}) {
     if (H5Aexists(src, attr) <= 0) continue;
     hid_t a = H5Aopen(src, attr, H5P_DEFAULT);
@@ -142,37 +153,10 @@ void MakeVersionOne(const std::string& from, const std::string& to) {
     H5Aread(a, t, buf.data());
     H5Tclose(t);
     H5Aclose(a);
-    H5Fclose(dst);
     InjectVlenString(to, "/", attr, std::string(buf.data()));
-    dst = H5Fopen(to.c_str(), H5F_ACC_RDWR, H5P_DEFAULT);
   }
-  for (const char* attr : {"dgmm_format_version", "pose_dim", "terrain_dim"}) {
-    if (H5Aexists(src, attr) <= 0) continue;
-    std::int64_t v = 0;
-    hid_t a = H5Aopen(src, attr, H5P_DEFAULT);
-    H5Aread(a, H5T_NATIVE_INT64, &v);
-    H5Aclose(a);
-    if (std::strcmp(attr, "dgmm_format_version") == 0) v = 1;
-    hid_t space = H5Screate(H5S_SCALAR);
-    a = H5Acreate2(dst, attr, H5T_STD_I64LE, space, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_INT64, &v);
-    H5Aclose(a);
-    H5Sclose(space);
-  }
-  if (H5Aexists(src, "seed") > 0) {
-    std::uint64_t v = 0;
-    hid_t a = H5Aopen(src, "seed", H5P_DEFAULT);
-    H5Aread(a, H5T_NATIVE_UINT64, &v);
-    H5Aclose(a);
-    hid_t space = H5Screate(H5S_SCALAR);
-    a = H5Acreate2(dst, "seed", H5T_STD_U64LE, space, H5P_DEFAULT, H5P_DEFAULT);
-    H5Awrite(a, H5T_NATIVE_UINT64, &v);
-    H5Aclose(a);
-    H5Sclose(space);
-  }
-  H5Pclose(ocpypl);
-  H5Fclose(dst);
   H5Fclose(src);
+  SetVersion(to, 1);
 }
 
 TEST(FormatV2, UpgradeConvertsATrustedVersionOneFile) {
@@ -190,6 +174,18 @@ TEST(FormatV2, UpgradeConvertsATrustedVersionOneFile) {
   // Idempotent: a version-2 input writes nothing.
   EXPECT_FALSE(UpgradeFile(dir / "up.h5", dir / "again.h5").written);
   EXPECT_FALSE(fs::exists(dir / "again.h5"));
+}
+
+TEST(FormatV2, UpgradeConvertsATrustedVersionOneModel) {
+  const fs::path dir = test::TestDir();
+  const MotionModel original = test::RandomModel(2, 1, 3, 8, true);
+  WriteModel(original, dir / "v2.h5");
+  MakeVersionOne((dir / "v2.h5").string(), (dir / "v1.h5").string());
+  EXPECT_NE(ErrorOf([&] { ReadModel(dir / "v1.h5"); }).find("dgmm upgrade"), std::string::npos);
+  const UpgradeSummary s = UpgradeFile(dir / "v1.h5", dir / "up.h5");
+  EXPECT_TRUE(s.written);
+  EXPECT_EQ(s.kind, "model");
+  test::ExpectSameModel(original, ReadModel(dir / "up.h5"));
 }
 
 TEST(FormatV2, HugeDeclaredShapeIsRefusedBeforeAnyAllocation) {
