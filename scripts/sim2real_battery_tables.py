@@ -72,13 +72,13 @@ def confusion_matrix(results):
 
 
 def pair_table(results):
-    lines = ["| seed | robot | kind | planted | detectability (mean z / spread z) | status | "
+    lines = ["| seed | robot | kind | planted | detectability (mean / consistent / spread z) | status | "
              "named (inclusion) | ties | score | value error | gap closed | wall |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
         planted = "; ".join(e["what"] for e in r["effects"]) or "nothing (another seed)"
         d = r["detectability"]
-        det = f"{_fmt(d['mean_shift_z'], 2)} / {_fmt(d['spread_z'], 2)}"
+        det = f"{_fmt(d['mean_shift_z'], 2)} / {_fmt(d['consistent_z'], 2)} / {_fmt(d['spread_z'], 2)}"
         if "score" not in r:
             lines.append(f"| {r['seed']} | {r['robot']} | {r['kind']} | {planted} | {det} | "
                          f"error: {r.get('error', '')[:80]} | | | | | | {r['analysis_wall_s']:.0f} s |")
