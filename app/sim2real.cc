@@ -10,10 +10,13 @@
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "sim2real/corrected_model.h"
+#include "sim/sim_config.h"
 #include "sim2real/figures.h"
+#include "sim2real/knob_analysis.h"
 #include "sim2real/pipeline.h"
 #include "sim2real/recalibrate.h"
 #include "sim2real/report.h"
+#include "sim2real/verdict.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
@@ -21,7 +24,8 @@ namespace dgmm::app {
 namespace {
 
 struct Sim2RealArgs {
-  std::string sim, real, out, sim_config;
+  std::string sim, real, out, sim_config, cache;
+  int signature_placements = 78;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
@@ -65,6 +69,21 @@ void Run(const Sim2RealArgs& args) {
   ctx.sim_model_file = "sim_model.h5";
   WriteModel(sim2real::BuildCorrectedModel(result, sim), (fs::path(args.out) / ctx.corrected_model_file).string());
   WriteModel(sim2real::BuildSimModel(result, sim), (fs::path(args.out) / ctx.sim_model_file).string());
+  sim2real::Verdict verdict = sim2real::VerdictFromEffects(result);
+  if (!args.sim_config.empty()) {
+    if (ShowProgress()) std::cerr << "sim2real: simulator knobs (signatures, selection, refinement)\n";
+    sim2real::KnobAnalysisOptions ko;
+    ko.seed = args.seed;
+    ko.selection = options.selection;
+    ko.signatures.cache_dir = args.cache;
+    ko.signatures.placements = args.signature_placements;
+    const sim2real::KnobAnalysis knobs =
+        sim2real::AnalyseKnobs(sim, real, sim::LoadSimConfig(args.sim_config), result, ko);
+    verdict = knobs.verdict;
+    ctx.knob_analysis_json = sim2real::KnobAnalysisJson(knobs);
+  }
+  ctx.verdict_json = sim2real::VerdictJson(verdict);
+  ctx.verdict_sentence = verdict.sentence;
   if (!args.sim_config.empty()) {
     if (ShowProgress()) std::cerr << "sim2real: re-simulating with fitted physical parameters\n";
     sim2real::RecalibrationOptions recal;
@@ -93,6 +112,7 @@ void Run(const Sim2RealArgs& args) {
     return;
   }
   std::cout << result.conclusion << "\n";
+  if (!verdict.sentence.empty()) std::cout << "verdict: " << verdict.sentence << "\n";
   for (const auto& n : ctx.notes) std::cout << "note: " << n << "\n";
   std::cout << "report: " << (fs::path(args.out) / "report.html").string() << "\n";
 }
@@ -111,6 +131,11 @@ void Setup(CLI::App& root) {
   cmd->add_option("-o,--output", args->out, "output folder")->required();
   cmd->add_option("--seed", args->seed, "seed of folds, bootstrap and permutations")->capture_default_str();
   cmd->add_option("--sim-config", args->sim_config, "simulation config of the sim set (JSON)");
+  cmd->add_option("--cache", args->cache,
+                  "folder of cached knob simulations (default $XDG_CACHE_HOME/dgmm or ~/.cache/dgmm; - for none)");
+  cmd->add_option("--signature-placements", args->signature_placements,
+                  "placements per knob simulation (paper protocol: >= 78 covers every command 3 times)")
+      ->capture_default_str()->check(CLI::Range(3, 10000));
   cmd->add_option("--bootstrap", args->bootstrap, "bootstrap resamples of the effect selection")
       ->capture_default_str()->check(CLI::Range(0, 1000));
   cmd->add_option("--permutations", args->permutations, "permutations per two-sample test")

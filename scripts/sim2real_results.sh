@@ -56,7 +56,7 @@ print("| pair | pooled test flags | conditional regions flagged | effects, ranke
 print("|---|---|---|---|---|---|---|---|---|---|")
 for pair, key in planted.items():
     d, o = load(f"{pair}-real"), load(f"{pair}-oracle")
-    effects = ", ".join(f"{e['effect']} ({100 * e['inclusion_probability']:.0f}%)"
+    effects = ", ".join(f"{e['effect']} ({'not computed' if e['inclusion_probability'] is None else format(100 * e['inclusion_probability'], '.0f') + '%'})"
                         + (f" [cannot be told apart from {', '.join(e['cannot_be_told_apart_from'])}]"
                            if e["cannot_be_told_apart_from"] else "")
                         for e in d["effects"]) or "none"

@@ -4,6 +4,9 @@
 # `dgmm simulate --protocol paper` (390 samples), and tabulates what the analysis names.
 # Writes the table into docs/sim2real.md (section sim2real-unseen).
 # Usage: scripts/sim2real_unseen.sh [build-dir] [seed]   (about 3 min on one idle core)
+# With DGMM_S2R_KNOBS=1 every analysis also runs the simulator-knob analysis (--sim-config
+# datasets/sim2real/configs/nominal.json, --bootstrap 0, --cache $DGMM_S2R_CACHE if set): the
+# verdict column then names simulator knobs (docs/sim2real.md, "Knobs").
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-${DGMM_BUILD_DIR:-$root/build}}
@@ -26,21 +29,38 @@ scenarios=(
   "tracker-noise-x2|tracker noise doubled|{\"noise\": {\"tracker_position_sd_m\": 0.006, \"tracker_roll_sd_rad\": 0.01, \"tracker_pitch_sd_rad\": 0.01, \"tracker_yaw_sd_rad\": 0.02}}"
   "short-stride|strides 10% shorter (0.108 m)|{\"gait\": {\"stride_m\": 0.108}}"
 )
-table="| pair | what the \"real\" robot had | pooled test flags | conditional regions | effects named (inclusion) | gap closed | unexplained |
-|---|---|---|---|---|---|---|"
+knob_args=()
+if [ "${DGMM_S2R_KNOBS:-0}" = 1 ]; then
+  knob_args=(--sim-config "$root/datasets/sim2real/configs/nominal.json" --bootstrap 0)
+  [ -n "${DGMM_S2R_CACHE:-}" ] && knob_args+=(--cache "$DGMM_S2R_CACHE")
+fi
+table="| pair | what the \"real\" robot had | pooled test flags | conditional regions | effects named (inclusion) | gap closed | unexplained | verdict |
+|---|---|---|---|---|---|---|---|"
 i=0
 for s in "${scenarios[@]}"; do
   IFS='|' read -r name what cfg <<< "$s"
   echo "$cfg" > "$work/$name.json"
   "$dgmm" simulate --config "$work/$name.json" --protocol paper --seed $((seed + i)) -o "$work/$name.h5" > /dev/null
-  "$dgmm" sim2real --sim "$root/datasets/sim2real/sim.h5" --real "$work/$name.h5" -o "$work/$name" --no-figures > /dev/null
+  "$dgmm" sim2real --sim "$root/datasets/sim2real/sim.h5" --real "$work/$name.h5" -o "$work/$name" --no-figures "${knob_args[@]}" > /dev/null
   row=$(/usr/bin/python3 - "$work/$name/report.json" "$name" "$what" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
-eff = ", ".join(f"{e['effect']} ({100 * e['inclusion_probability']:.0f}%)" for e in d["effects"]) or "none"
+incl = lambda p: "not computed" if p is None else f"{100 * p:.0f}%"
+eff = ", ".join(f"{e['effect']} ({incl(e['inclusion_probability'])})" for e in d["effects"]) or "none"
+v = d.get("verdict", {})
+named = v.get("named", [])
+ties = v.get("ties", [])
+verdict = v.get("status", "?")
+if named:
+    first = named[0]
+    group = first.get("tie_group")
+    verdict += ": " + first["family"] + (f" (tie: {'/'.join(ties[group]['families'])})" if group is not None else "")
+    verdict += "".join(f", {n['family']}" for n in named[1:])
+if v.get("unexplained", {}).get("present"):
+    verdict += " [structured in " + ", ".join(v["unexplained"]["structured_in"]) + "]"
 gap = d["gap_closed"]
 gap = "no gap" if gap is None else f"{100 * gap:.0f}%"
-print(f"| {sys.argv[2]} | {sys.argv[3]} | {d['pooled_x_flagged_commands']} | {d['conditional_flagged_regions']} | {eff} | {gap} | {len(d['unexplained'])} |")
+print(f"| {sys.argv[2]} | {sys.argv[3]} | {d['pooled_x_flagged_commands']} | {d['conditional_flagged_regions']} | {eff} | {gap} | {len(d['unexplained'])} | {verdict} |")
 PY
 )
   echo "$row"

@@ -144,13 +144,13 @@ std::string SimSummary::BriefReport() const {
 }
 
 SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
-                           const ProgressFn& progress, SimSummary* summary) {
+                           const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit) {
   std::string error;
   if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
   if (!options.IsValid(&error)) throw MakeInputError("protocol options", "", error);
   const auto wall_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
-  Simulator sim(config);
+  Simulator sim(config, edit);
   std::mt19937_64 rng(options.seed);
 
   SampleSet set;

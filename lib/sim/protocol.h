@@ -8,6 +8,7 @@
 
 #include "core/sample_set.h"
 #include "sim/sim_config.h"
+#include "sim/simulator.h"
 
 namespace dgmm::sim {
 
@@ -57,7 +58,10 @@ using ProgressFn = std::function<void(long long done, long long total)>;
 // command table (long, lat, turn), x (dx, dy, dz [m]; droll, dpitch, dyaw [rad]), z (pitch, roll
 // [rad]), episode = placement, step = execution index, source "sim", metadata (config JSON,
 // protocol, seed, falls). Throws InputError for an invalid config/options or unloadable MJCF.
+// `edit` changes the compiled model after the config (lib/sim/knobs.h); the same seed draws the
+// same placements and sensor noise, so two runs differing only in physics are paired.
 SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
-                           const ProgressFn& progress = {}, SimSummary* summary = nullptr);
+                           const ProgressFn& progress = {}, SimSummary* summary = nullptr,
+                           const ModelEdit& edit = {});
 
 }  // namespace dgmm::sim

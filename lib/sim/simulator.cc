@@ -104,7 +104,7 @@ namespace {
 void QuietWarning(const char*) {}
 }  // namespace
 
-Simulator::Simulator(const SimConfig& config) : impl_(std::make_unique<Impl>()) {
+Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std::make_unique<Impl>()) {
   if (mju_user_warning == nullptr) mju_user_warning = QuietWarning;
   std::string error;
   if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
@@ -113,6 +113,7 @@ Simulator::Simulator(const SimConfig& config) : impl_(std::make_unique<Impl>()) 
   impl_->model = LoadRobotModel(config);
   impl_->parts = FindRobotParts(impl_->model.get(), config, source);
   ApplyConfig(config, impl_->parts, impl_->model.get(), source);
+  if (edit) edit(impl_->model.get());
   impl_->data.reset(mj_makeData(impl_->model.get()));
   const int latency_steps =
       static_cast<int>(std::lround(config.actuators.latency_s / config.timestep_s));

@@ -14,7 +14,13 @@
 #include "sim/pose.h"
 #include "sim/sim_config.h"
 
+struct mjModel_;  // MuJoCo's compiled model (mujoco/mjmodel.h); only lib/sim dereferences it
+
 namespace dgmm::sim {
+
+// An edit of the compiled model after the config was applied (e.g. a knob of lib/sim/knobs.h
+// that the JSON config does not expose: contact solref, a mass scale). Empty: none.
+using ModelEdit = std::function<void(mjModel_*)>;
 
 // A drawable geometric primitive of the simulated scene, in the slope frame (for robot_view).
 struct GeomSnapshot {
@@ -33,7 +39,7 @@ class Simulator {
  public:
   // Loads the built-in robot (or config.mjcf_path) and applies the config. Throws InputError for
   // an invalid config, an unloadable MJCF or one that breaks the naming/kinematic conventions.
-  explicit Simulator(const SimConfig& config);
+  explicit Simulator(const SimConfig& config, const ModelEdit& edit = {});
   ~Simulator();
   Simulator(const Simulator&) = delete;
   Simulator& operator=(const Simulator&) = delete;

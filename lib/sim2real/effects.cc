@@ -208,6 +208,7 @@ Eigen::MatrixXd EffectDesign(const EffectSpec& effect, const PoseLayout& layout,
       for (int j = 0; j < dx; ++j) d(j, j) = 1.0;
       break;
     case EffectId::kNoise:
+    case EffectId::kExternal:  // designs filled in by their owner (knob_analysis.cc)
       break;
   }
   return d;
@@ -279,6 +280,8 @@ std::string DescribeEffect(const EffectSpec& e, const Eigen::VectorXd& t, double
              Format("|offset| = %.3g in x units.", t.norm());
     case EffectId::kNoise:
       return Format("The real motion is %.2f times as variable as simulated.", std::exp(t(0)));
+    case EffectId::kExternal:
+      return e.physics;
   }
   return "";
 }

@@ -23,6 +23,7 @@ enum class EffectId {
   kCompliance,        // sinking (dz) and damped attitude changes on soft ground
   kBias,              // constant offset of every pose dimension (tracker, calibration)
   kNoise,             // real spread larger than simulated: Sigma * tau^2
+  kExternal,          // a design supplied from outside the library (simulated knob signatures)
 };
 
 struct EffectParameter {

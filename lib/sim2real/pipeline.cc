@@ -110,13 +110,18 @@ std::string Conclude(const Sim2RealResult& r) {
   for (size_t k = 0; k < r.effects.size(); ++k) {
     const auto& e = r.effects[k];
     s += Fmt("(%.0f) ", k + 1.0) + e.spec.title + " - " + e.sentence +
-         Fmt(" [inclusion %.0f%%]", 100 * e.inclusion);
+         (r.bootstrap_resamples > 0 ? Fmt(" [inclusion %.0f%%]", 100 * e.inclusion)
+                                    : std::string(" [inclusion not computed: --bootstrap 0]"));
     if (!e.confusable_with.empty()) {
       s += " (cannot be told apart from:";
       for (const auto& c : e.confusable_with) s += " " + c;
       s += ")";
     }
     s += " ";
+  }
+  if (!r.dropped_commands.empty()) {
+    s += Fmt("%.0f real sample(s) of %.0f command(s) with no sim counterpart were dropped. ",
+             r.dropped_samples, r.dropped_commands.size());
   }
   if (std::isfinite(r.gap_closed)) {
     s += Fmt("The corrected model raises the held-out real log-likelihood from %.3f to %.3f nats "
@@ -139,15 +144,18 @@ bool Sim2RealOptions::IsValid(std::string* error) const {
   return model.IsValid(error) && selection.IsValid(error) && locate.IsValid(error);
 }
 
-Sim2RealResult RunSim2Real(const SampleSet& sim_set, const SampleSet& real_set,
+Sim2RealResult RunSim2Real(const SampleSet& sim_in, const SampleSet& real_in,
                            const Sim2RealOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "options", error);
-  for (const auto* set : {&sim_set, &real_set}) {
+  for (const auto* set : {&sim_in, &real_in}) {
     std::string problem = set->Validate();
-    if (!problem.empty()) throw MakeInputError(set == &sim_set ? "--sim" : "--real", "", problem);
+    if (!problem.empty()) throw MakeInputError(set == &sim_in ? "--sim" : "--real", "", problem);
   }
+  // The analysis works in raw units: undo each set's standardisation (refuses broken transforms).
+  const SampleSet sim_set = ToRawUnits(sim_in, "--sim");
+  const SampleSet real_set = ToRawUnits(real_in, "--real");
   std::vector<int> real_map = AlignCommands(sim_set, real_set);
   std::vector<int> identity(sim_set.num_commands());
   for (int c = 0; c < sim_set.num_commands(); ++c) identity[c] = c;
@@ -165,6 +173,21 @@ Sim2RealResult RunSim2Real(const SampleSet& sim_set, const SampleSet& real_set,
     real = SubsetSamples(real, keep);
   }
   Sim2RealResult r;
+  r.bootstrap_resamples = options.selection.bootstrap_selection;
+  {
+    std::set<int> dropped;
+    for (int i = 0; i < real_set.size(); ++i) {
+      const int c = real_set.command(i);
+      if (real_map[c] < 0 || !sim_commands.count(real_map[c])) {
+        dropped.insert(c);
+        ++r.dropped_samples;
+      }
+    }
+    for (int c : dropped) {
+      r.dropped_commands.push_back(c < static_cast<int>(real_set.command_labels.size())
+                                       ? real_set.command_labels[c] : std::to_string(c));
+    }
+  }
   std::mt19937_64 rng(options.seed);
   r.n_real = real.size();
   r.n_sim = sim.size();

@@ -69,6 +69,10 @@ struct Sim2RealResult {
   EffectFit fit;
   double first_execution_share = 0;          // of the real samples
   double seconds = 0;
+  int bootstrap_resamples = 0;               // 0: inclusion probabilities not computed
+  // Real commands (labels) with no sim counterpart, dropped from the analysis.
+  std::vector<std::string> dropped_commands;
+  int dropped_samples = 0;
 };
 
 // Throws InputError when the sets cannot be compared (dimensions, no shared commands, too few

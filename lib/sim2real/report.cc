@@ -175,7 +175,8 @@ std::string ReportJson(const Sim2RealResult& r, const ReportContext& ctx) {
     }
     effects.push_back({{"rank", k + 1}, {"effect", e.spec.key}, {"title", e.spec.title},
                        {"physics", e.spec.physics}, {"sentence", e.sentence},
-                       {"parameters", params}, {"inclusion_probability", e.inclusion},
+                       {"parameters", params},
+                       {"inclusion_probability", r.bootstrap_resamples > 0 ? json(e.inclusion) : json(nullptr)},
                        {"heldout_gain_nats_per_sample", e.gain}, {"gain_se", e.gain_se},
                        {"importance_nats_per_sample", e.importance}, {"selection_step", e.selection_step},
                        {"cannot_be_told_apart_from", e.confusable_with}});
@@ -190,7 +191,9 @@ std::string ReportJson(const Sim2RealResult& r, const ReportContext& ctx) {
                      {"threshold_z", s.threshold_z}, {"candidates", cands}});
   }
   json inclusion = json::object();
-  for (size_t k = 0; k < r.library.size(); ++k) inclusion[r.library[k].key] = r.inclusion[k];
+  for (size_t k = 0; k < r.library.size(); ++k) {
+    inclusion[r.library[k].key] = r.bootstrap_resamples > 0 ? json(r.inclusion[k]) : json(nullptr);
+  }
   json heat = json::array();
   for (int i = 0; i < r.heat_before.rows(); ++i) {
     json row = json::array();
@@ -219,6 +222,10 @@ std::string ReportJson(const Sim2RealResult& r, const ReportContext& ctx) {
       {"seconds", r.seconds}};
   for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});
   if (!ctx.recalibration_json.empty()) out["recalibration"] = json::parse(ctx.recalibration_json);
+  if (!ctx.verdict_json.empty()) out["verdict"] = json::parse(ctx.verdict_json);
+  if (!ctx.knob_analysis_json.empty()) out["knob_analysis"] = json::parse(ctx.knob_analysis_json);
+  out["dropped_real_commands"] = r.dropped_commands;
+  out["dropped_real_samples"] = r.dropped_samples;
   return out.dump(2) + "\n";
 }
 
@@ -231,6 +238,7 @@ std::string ReportHtml(const Sim2RealResult& r, const ReportContext& ctx, const 
        "img{max-width:100%}.note{color:#777}</style></head><body>\n";
   o << "<h1>Sim vs real: " << Escape(ctx.sim_path) << " vs " << Escape(ctx.real_path) << "</h1>\n";
   o << "<h2>Conclusion</h2><p>" << Escape(r.conclusion) << "</p>\n";
+  if (!ctx.verdict_sentence.empty()) o << "<p><b>Verdict:</b> " << Escape(ctx.verdict_sentence) << "</p>\n";
   for (const auto& n : ctx.notes) o << "<p class=note>" << Escape(n) << "</p>\n";
   o << "<h2>1. Where the simulation fails</h2><p>" << r.n_real << " real and " << r.n_sim
     << " simulated samples. Deficit = held-out real log-likelihood per sample of the best "
@@ -258,7 +266,7 @@ std::string ReportHtml(const Sim2RealResult& r, const ReportContext& ctx, const 
         << Escape(e.spec.parameters[q].unit) << "<br>";
     }
     o << "</td><td>" << F("%.3f", e.importance) << " (step " << e.selection_step << ": gain " << F("%.3f", e.gain) << " &plusmn; " << F("%.3f", e.gain_se) << ")</td><td>"
-      << F("%.0f%%", 100 * e.inclusion) << "</td><td>";
+      << (r.bootstrap_resamples > 0 ? F("%.0f%%", 100 * e.inclusion) : std::string("not computed")) << "</td><td>";
     for (const auto& c : e.confusable_with) o << Escape(c) << " ";
     o << "</td></tr>\n";
   }

@@ -21,6 +21,10 @@ struct ReportContext {
   std::vector<std::string> notes;          // e.g. "figures skipped: no X display"
   std::string corrected_model_file, sim_model_file;
   std::string recalibration_json;          // JSON object text or empty (--sim-config)
+  // The verdict object (verdict.h; always set by the app) and, with --sim-config, the knob
+  // analysis details (knob_analysis.h); JSON object texts or empty.
+  std::string verdict_json, knob_analysis_json;
+  std::string verdict_sentence;            // shown under the conclusion
 };
 
 // report.json content (pretty-printed JSON).

@@ -156,4 +156,24 @@ Samples SubsetSamples(const Samples& s, const std::vector<int>& rows) {
   return out;
 }
 
+SampleSet ToRawUnits(const SampleSet& set, const std::string& which) {
+  if (set.transform.empty()) return set;
+  const int dx = set.pose_dim(), dz = set.terrain_dim();
+  const auto& t = set.transform;
+  if (t.offset.size() != dx + dz || t.scale.size() != dx + dz) {
+    throw MakeInputError(which, "transform", "standardisation has " + std::to_string(t.offset.size()) +
+                                                 " offsets and " + std::to_string(t.scale.size()) +
+                                                 " scales, expected x + z = " + std::to_string(dx + dz) +
+                                                 ": cannot reconcile it with the other set");
+  }
+  if (!t.offset.allFinite() || !t.scale.allFinite() || (t.scale.array() <= 0).any()) {
+    throw MakeInputError(which, "transform", "standardisation scales must be finite and positive");
+  }
+  SampleSet out = set;
+  for (int j = 0; j < dx; ++j) out.x.col(j) = (set.x.col(j).array() * t.scale(j) + t.offset(j)).matrix();
+  for (int j = 0; j < dz; ++j) out.z.col(j) = (set.z.col(j).array() * t.scale(dx + j) + t.offset(dx + j)).matrix();
+  out.transform = Standardization{};
+  return out;
+}
+
 }  // namespace dgmm::sim2real

@@ -50,6 +50,11 @@ Samples MakeSamples(const SampleSet& set, const std::vector<int>& command_map);
 // Returns, per real row, the sim row or -1. Throws InputError when x or z dimensions differ.
 std::vector<int> AlignCommands(const SampleSet& sim, const SampleSet& real);
 
+// The set in raw units: x || z = offset + scale .* y_std when it carries a standardisation
+// transform (SampleSet::transform), else unchanged. Throws InputError "<which>: transform: ..."
+// when the transform does not match the dimensions or has non-finite or non-positive scales.
+SampleSet ToRawUnits(const SampleSet& set, const std::string& which);
+
 // Rows of `s` listed in `rows`, in that order.
 Samples SubsetSamples(const Samples& s, const std::vector<int>& rows);
 

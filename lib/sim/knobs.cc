@@ -1,0 +1,189 @@
+#include "sim/knobs.h"
+
+#include <mujoco/mujoco.h>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <memory>
+#include <sstream>
+
+#include "sim/mujoco_model.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+// The child of `torso` whose subtree holds `body` (-1 when it is not below the torso).
+int TorsoChildOf(const mjModel* m, int body, int torso) {
+  while (body > 0 && m->body_parentid[body] != torso) body = m->body_parentid[body];
+  return body > 0 ? body : -1;
+}
+
+Knob MakeKnob(KnobKind kind, int index, std::string name, std::string family, std::string unit,
+              double nominal, double lo, double hi, std::vector<double> probes) {
+  Knob k;
+  k.kind = kind;
+  k.index = index;
+  k.name = std::move(name);
+  k.family = std::move(family);
+  k.unit = std::move(unit);
+  k.nominal = nominal;
+  k.lo = lo;
+  k.hi = hi;
+  k.probes = std::move(probes);
+  return k;
+}
+
+}  // namespace
+
+std::string RobotMjcfText(const SimConfig& config) {
+  if (config.mjcf_path.empty()) return kBuiltinRobotMjcf;
+  std::ifstream in(config.mjcf_path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  if (!in) throw MakeInputError(config.mjcf_path, "mjcf_path", "cannot read the robot MJCF");
+  return text.str();
+}
+
+double PayloadProbeMass(const SimConfig& config) {
+  const auto& m = config.masses;
+  return 0.15 * (m.torso_kg + kNumLegs * (m.coxa_kg + m.femur_kg + m.tibia_kg));
+}
+
+std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
+  const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
+  MjModelPtr model = LoadRobotModel(config);
+  const RobotParts parts = FindRobotParts(model.get(), config, source);
+  ApplyConfig(config, parts, model.get(), source);
+  const mjModel* m = model.get();
+  std::vector<Knob> knobs;
+  const double mu = config.friction.sliding;
+  knobs.push_back(MakeKnob(KnobKind::kFrictionSliding, -1, "floor.friction.sliding", "friction", "",
+                           mu, 0.2 * mu, 2.0 * mu, {0.6 * mu, 1.5 * mu}));
+  const double tor = config.friction.torsional;
+  knobs.push_back(MakeKnob(KnobKind::kFrictionTorsional, -1, "floor.friction.torsional", "friction",
+                           "m", tor, 0.0, 20 * tor, {5 * tor}));
+  if (parts.floor_geom >= 0) {
+    const double tc = m->geom_solref[mjNREF * parts.floor_geom + 0];
+    const double dr = m->geom_solref[mjNREF * parts.floor_geom + 1];
+    if (tc > 0) {  // standard (time constant, damping ratio) form
+      knobs.push_back(MakeKnob(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s",
+                               tc, std::max(2.5 * m->opt.timestep, 0.25 * tc), 8 * tc, {3 * tc}));
+      knobs.push_back(MakeKnob(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "",
+                               dr, 0.1 * dr, 4 * dr, {0.3 * dr}));
+    }
+  }
+  knobs.push_back(MakeKnob(KnobKind::kMassScale, -1, "bodies.mass_scale", "mass", "", 1.0, 0.4, 2.5, {0.7, 1.4}));
+  if (mj_name2id(m, mjOBJ_BODY, "payload") >= 0) {
+    const double m0 = PayloadProbeMass(config);
+    knobs.push_back(MakeKnob(KnobKind::kPayloadMass, -1, "payload.mass_kg", "payload", "kg",
+                             config.payload.mass_kg, 0.0, 4 * m0, {config.payload.mass_kg + m0}));
+    knobs.push_back(MakeKnob(KnobKind::kPayloadX, -1, "payload.position_x_m", "payload", "m",
+                             config.payload.position_body_m.x(), -0.3, 0.3, {0.1}));
+    knobs.push_back(MakeKnob(KnobKind::kPayloadY, -1, "payload.position_y_m", "payload", "m",
+                             config.payload.position_body_m.y(), -0.3, 0.3, {0.1}));
+  }
+  // Legs: the torso's child subtrees that carry the leg actuators; the side from the root's y.
+  bool side_has[2] = {false, false};
+  for (int leg = 0; leg < kNumLegs; ++leg) {
+    const int act = parts.actuator[leg][0];
+    const int joint = m->actuator_trnid[2 * act];
+    const int root = TorsoChildOf(m, m->jnt_bodyid[joint], parts.torso_body);
+    if (root < 0) continue;
+    const double g = config.actuators.leg_gain[leg];
+    knobs.push_back(MakeKnob(KnobKind::kLegGain, leg, "actuators.leg" + std::to_string(leg) + ".gain",
+                             "actuator_gain", "", g, 0.05 * g, 1.5 * g, {0.5 * g}));
+    side_has[m->body_pos[3 * root + 1] > 0 ? 0 : 1] = true;
+  }
+  const char* side_name[2] = {"left", "right"};
+  for (int s = 0; s < 2; ++s) {
+    if (!side_has[s]) continue;
+    knobs.push_back(MakeKnob(KnobKind::kSideGain, s, std::string("actuators.") + side_name[s] + "_side.gain",
+                             "actuator_gain", "", 1.0, 0.05, 1.5, {0.6}));
+  }
+  knobs.push_back(MakeKnob(KnobKind::kKpScale, -1, "actuators.kp_scale", "actuator_gain", "", 1.0, 0.2, 2.5,
+                           {0.6, 1.5}));
+  knobs.push_back(MakeKnob(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0,
+                           0.05, 10.0, {0.25, 4.0}));
+  return knobs;
+}
+
+SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
+                     const std::vector<KnobValue>& values, ModelEdit* edit) {
+  SimConfig c = config;
+  double mass_scale = 1, damping_scale = 1;
+  double solref_time = NAN, solref_damp = NAN;
+  bool payload = false;
+  double payload_mass = NAN;
+  Eigen::Vector3d payload_pos = config.payload.position_body_m;
+  // Side membership of each leg, from the model (same rule as EnumerateKnobs).
+  std::array<int, kNumLegs> side{};
+  bool need_sides = false;
+  for (const auto& v : values) need_sides |= knobs.at(v.knob).kind == KnobKind::kSideGain;
+  if (need_sides) {
+    const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
+    MjModelPtr model = LoadRobotModel(config);
+    const RobotParts parts = FindRobotParts(model.get(), config, source);
+    for (int leg = 0; leg < kNumLegs; ++leg) {
+      const int joint = model->actuator_trnid[2 * parts.actuator[leg][0]];
+      const int root = TorsoChildOf(model.get(), model->jnt_bodyid[joint], parts.torso_body);
+      side[leg] = root >= 0 && model->body_pos[3 * root + 1] > 0 ? 0 : 1;
+    }
+  }
+  for (const auto& v : values) {
+    const Knob& k = knobs.at(v.knob);
+    switch (k.kind) {
+      case KnobKind::kFrictionSliding: c.friction.sliding = v.value; break;
+      case KnobKind::kFrictionTorsional: c.friction.torsional = v.value; break;
+      case KnobKind::kFloorSolrefTime: solref_time = v.value; break;
+      case KnobKind::kFloorSolrefDamping: solref_damp = v.value; break;
+      case KnobKind::kMassScale: mass_scale = v.value; break;
+      case KnobKind::kPayloadMass: payload = true; payload_mass = v.value; break;
+      case KnobKind::kPayloadX: payload = true; payload_pos.x() = v.value; break;
+      case KnobKind::kPayloadY: payload = true; payload_pos.y() = v.value; break;
+      case KnobKind::kLegGain: c.actuators.leg_gain[k.index] = v.value; break;
+      case KnobKind::kSideGain:
+        for (int leg = 0; leg < kNumLegs; ++leg) {
+          if (side[leg] == k.index) c.actuators.leg_gain[leg] = config.actuators.leg_gain[leg] * v.value;
+        }
+        break;
+      case KnobKind::kKpScale: c.actuators.kp_nm_per_rad = config.actuators.kp_nm_per_rad * v.value; break;
+      case KnobKind::kDampingScale: damping_scale = v.value; break;
+    }
+  }
+  if (payload) {
+    c.payload.mass_kg = std::isfinite(payload_mass) ? payload_mass
+                                                    : std::max(config.payload.mass_kg, PayloadProbeMass(config));
+    c.payload.position_body_m = payload_pos;
+  }
+  c.actuators.joint_damping_nms_per_rad = config.actuators.joint_damping_nms_per_rad * damping_scale;
+  const std::string floor = config.names.floor_geom;
+  const bool model_edit = mass_scale != 1 || std::isfinite(solref_time) || std::isfinite(solref_damp);
+  if (edit) {
+    *edit = {};
+    if (model_edit) {
+      *edit = [=](mjModel_* m) {
+        if (mass_scale != 1) {
+          for (int b = 1; b < m->nbody; ++b) {
+            m->body_mass[b] *= mass_scale;
+            for (int j = 0; j < 3; ++j) m->body_inertia[3 * b + j] *= mass_scale;
+          }
+        }
+        const int g = mj_name2id(m, mjOBJ_GEOM, floor.c_str());
+        if (g >= 0 && std::isfinite(solref_time)) m->geom_solref[mjNREF * g + 0] = solref_time;
+        if (g >= 0 && std::isfinite(solref_damp)) m->geom_solref[mjNREF * g + 1] = solref_damp;
+      };
+    }
+  }
+  return c;
+}
+
+SampleSet SimulateWithKnobs(const SimConfig& config, const ProtocolOptions& options,
+                            const std::vector<Knob>& knobs, const std::vector<KnobValue>& values) {
+  ModelEdit edit;
+  const SimConfig c = ApplyKnobs(config, knobs, values, &edit);
+  return SimulateProtocol(c, options, {}, nullptr, edit);
+}
+
+}  // namespace dgmm::sim

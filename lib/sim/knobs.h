@@ -1,0 +1,71 @@
+#pragma once
+// The physical parameters ("knobs") of a simulation a user can get wrong, enumerated from the
+// loaded robot model and its SimConfig (not from hard-coded body names): floor friction, floor
+// contact softness (solref), all-body mass scale, a payload on the torso, actuator gain per leg
+// (legs = the torso's child subtrees that carry actuators), per side (sign of the leg root's y),
+// of all legs (kp), joint damping. Each knob knows its nominal value, a physical range, the
+// probe values simulated for its signature (docs/sim2real.md, "Signatures from the simulator")
+// and how to apply a value (to the SimConfig, or to the compiled mjModel through a ModelEdit).
+#include <string>
+#include <vector>
+
+#include "core/sample_set.h"
+#include "sim/protocol.h"
+#include "sim/sim_config.h"
+#include "sim/simulator.h"
+
+namespace dgmm::sim {
+
+enum class KnobKind {
+  kFrictionSliding,    // every geom's sliding friction (MuJoCo takes the max per contact)
+  kFrictionTorsional,  // every geom's torsional friction [m]
+  kFloorSolrefTime,    // floor geom solref[0], contact time constant [s]
+  kFloorSolrefDamping, // floor geom solref[1], damping ratio
+  kMassScale,          // every body's mass and inertia scaled
+  kPayloadMass,        // payload mass [kg] at the payload's position
+  kPayloadX,           // payload x offset [m] (torso frame, forward)
+  kPayloadY,           // payload y offset [m] (torso frame, left)
+  kLegGain,            // kp scale of one leg (index = leg)
+  kSideGain,           // kp scale of the legs on one side (index 0: left, y > 0; 1: right)
+  kKpScale,            // kp scale of every leg actuator
+  kDampingScale,       // joint damping scale of every leg hinge
+};
+
+// Confusion-matrix family of a knob (docs/sim2real.md, "report.json verdict").
+struct Knob {
+  KnobKind kind;
+  int index = -1;            // leg or side for kLegGain / kSideGain
+  std::string name;          // e.g. "floor.friction.sliding", "actuators.leg3.gain"
+  std::string family;        // friction, contact, mass, payload, actuator_gain, joint_damping
+  std::string unit;          // "" for factors
+  double nominal = 0;        // value in the nominal config / model
+  double lo = 0, hi = 0;     // physical range searched
+  std::vector<double> probes;  // values simulated for the signature (one signature each)
+};
+
+struct KnobValue {
+  int knob = -1;  // index into the knob list
+  double value = 0;
+};
+
+// Knobs of the robot of `config` (loads its MJCF). Throws InputError when it cannot be loaded.
+std::vector<Knob> EnumerateKnobs(const SimConfig& config);
+
+// The config with the config-level knob values applied, and the model edit for the rest.
+// The payload knobs: a mass at the centre unless kPayloadX/Y give an offset (with no
+// kPayloadMass, the offsets carry `payload_probe_kg`).
+SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
+                     const std::vector<KnobValue>& values, ModelEdit* edit);
+
+// SimulateProtocol with the knobs set (same seed: paired with the nominal run).
+SampleSet SimulateWithKnobs(const SimConfig& config, const ProtocolOptions& options,
+                            const std::vector<Knob>& knobs, const std::vector<KnobValue>& values);
+
+// The MJCF text of the robot of `config` (the built-in one when mjcf_path is empty), e.g. to key
+// a cache of simulations. Throws InputError when the file cannot be read.
+std::string RobotMjcfText(const SimConfig& config);
+
+// Mass of the payload probes [kg]: 15% of the robot's mass.
+double PayloadProbeMass(const SimConfig& config);
+
+}  // namespace dgmm::sim

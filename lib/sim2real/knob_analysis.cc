@@ -1,0 +1,530 @@
+#include "sim2real/knob_analysis.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <set>
+
+#include "sim/knobs.h"
+#include "sim/protocol.h"
+#include "sim2real/effect_fit.h"
+#include "sim2real/locate.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+using sim::Knob;
+using sim::KnobKind;
+using sim::KnobValue;
+
+std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[300];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
+// One external candidate: how its design is made for a sample.
+struct External {
+  enum Kind { kShift, kPayload, kImuBias, kHeading } kind = kShift;
+  std::vector<int> shifts;  // indices into the PairedShift list (payload: centre, x, y)
+};
+
+// Design (dx x p) of an external candidate at command c, terrain z, flag f.
+Eigen::MatrixXd ExternalDesign(const External& e, const std::vector<PairedShift>& shifts,
+                               const LinearGaussianModel& model, const PoseLayout& layout, int dx, int c,
+                               const Eigen::VectorXd& z, double f) {
+  switch (e.kind) {
+    case External::kShift: return shifts[e.shifts[0]].Shift(c, z, f);
+    case External::kPayload: {
+      Eigen::MatrixXd d(dx, 3);
+      const Eigen::VectorXd centre = shifts[e.shifts[0]].Shift(c, z, f);
+      d.col(0) = centre;
+      d.col(1) = shifts[e.shifts[1]].Shift(c, z, f) - centre;
+      d.col(2) = shifts[e.shifts[2]].Shift(c, z, f) - centre;
+      return d;
+    }
+    case External::kImuBias: {
+      // Recorded z = true z + b: the mean at the true z is u(z - b) ~ u(z) - J b.
+      Eigen::MatrixXd d(dx, z.size());
+      const double h = 1e-3;
+      for (int j = 0; j < z.size(); ++j) {
+        Eigen::VectorXd zp = z, zm = z;
+        zp(j) += h;
+        zm(j) -= h;
+        d.col(j) = -(model.Predict(c, zp, f).mean - model.Predict(c, zm, f).mean) / (2 * h);
+      }
+      return d;
+    }
+    case External::kHeading: {
+      Eigen::MatrixXd d = Eigen::MatrixXd::Zero(dx, 1);
+      d(layout.dyaw, 0) = 1.0;
+      return d;
+    }
+  }
+  return Eigen::MatrixXd::Zero(dx, 1);
+}
+
+EffectSpec ExternalSpec(const std::string& key, const std::string& title, int params, const std::string& unit) {
+  EffectSpec s;
+  s.id = EffectId::kExternal;
+  s.key = key;
+  s.title = title;
+  s.physics = title;
+  for (int p = 0; p < params; ++p) s.parameters.push_back({"t" + std::to_string(p), unit});
+  return s;
+}
+
+double Cosine(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+  const double d = a.norm() * b.norm();
+  return d > 0 ? a.dot(b) / d : 0.0;
+}
+
+}  // namespace
+
+bool KnobAnalysisOptions::IsValid(std::string* error) const {
+  if (!(tie_correlation > 0 && tie_correlation <= 1) || refine_iterations < 0) {
+    if (error) *error = "0 < tie_correlation <= 1 and refine_iterations >= 0";
+    return false;
+  }
+  return signatures.IsValid(error) && selection.IsValid(error) && residual.IsValid(error);
+}
+
+std::vector<int> TiedCandidates(const FitProblem& fp, const SelectionStep& step, int chosen,
+                                const std::vector<std::string>& family, double tie_correlation,
+                                const EffectFitOptions& fit_options, std::vector<double>* correlation) {
+  std::vector<int> out;
+  if (step.candidates.empty()) return out;
+  const CandidateScore& best = step.candidates.front();
+  Eigen::VectorXd shift_a;
+  if (!fp.library[chosen].is_noise) shift_a = WhitenedShift(fp, FitEffects(fp, {chosen}, {}, fit_options), 0);
+  for (const auto& cand : step.candidates) {
+    const int o = cand.effect;
+    if (o == chosen || family[o] == family[chosen]) continue;
+    const bool flagged = std::find(step.confusable.begin(), step.confusable.end(), o) != step.confusable.end();
+    double r = 0;
+    if (!fp.library[o].is_noise && shift_a.size() > 0) {
+      r = std::abs(Cosine(shift_a, WhitenedShift(fp, FitEffects(fp, {o}, {}, fit_options), 0)));
+    }
+    const bool close = cand.gain > 0 && cand.gain >= best.gain - 2 * best.se;
+    if (flagged || (close && r >= tie_correlation)) {
+      out.push_back(o);
+      if (correlation) correlation->push_back(r);
+    }
+  }
+  return out;
+}
+
+KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, const sim::SimConfig& config,
+                          const Sim2RealResult& base, const KnobAnalysisOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "knob analysis options", error);
+  const SampleSet sim_set = ToRawUnits(sim_in, "--sim");
+  const SampleSet real_set = ToRawUnits(real_in, "--real");
+  if (!sim_set.has_sequence()) throw MakeInputError("--sim", "episode", "signatures need the sim set's episodes and steps");
+  KnobAnalysis out;
+  // The sim set's own protocol and seed (dgmm simulate writes them into the metadata).
+  sim::Protocol protocol = sim::Protocol::kPaper;
+  std::uint64_t seed = options.seed;
+  if (auto it = sim_set.metadata.find("protocol"); it != sim_set.metadata.end()) protocol = sim::ParseProtocol(it->second);
+  if (auto it = sim_set.metadata.find("seed"); it != sim_set.metadata.end()) seed = std::stoull(it->second);
+  else out.note = "the sim set carries no seed; signatures use --seed. ";
+
+  // 1. Knobs and their signatures.
+  const std::vector<Knob> knobs = sim::EnumerateKnobs(config);
+  std::vector<SimulationRequest> requests(1);  // nominal first
+  std::vector<std::pair<int, double>> probe_of;  // per request after the nominal: (knob, value)
+  for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
+    for (double v : knobs[k].probes) {
+      requests.push_back({{KnobValue{k, v}}});
+      probe_of.emplace_back(k, v);
+    }
+  }
+  SimulationBatch batch = SimulateBatch(config, protocol, seed, knobs, requests, options.signatures);
+  out.simulations = batch.simulated;
+  out.from_cache = batch.from_cache;
+  out.signature_seconds = batch.wall_seconds;
+  out.placements = options.signatures.placements;
+  out.cache_dir = options.signatures.cache_dir.empty() ? DefaultCacheDir() : options.signatures.cache_dir;
+  std::vector<PairedShift> shifts;
+  for (size_t r = 1; r < requests.size(); ++r) {
+    shifts.push_back(PairedShift::Fit(batch.sets[0], batch.sets[r], sim_set, options.signatures.slope_ridge));
+  }
+
+  // 2. The real samples as the pipeline sees them (commands shared with the sim set).
+  std::vector<int> real_map = AlignCommands(sim_set, real_set);
+  std::vector<int> identity(sim_set.num_commands());
+  for (int c = 0; c < sim_set.num_commands(); ++c) identity[c] = c;
+  const Samples sim = MakeSamples(sim_set, identity);
+  Samples real = MakeSamples(real_set, real_map);
+  // MakeSamples keeps the set's order for mapped commands: recover the source rows for `step`.
+  std::vector<int> source_row;
+  for (int i = 0; i < real_set.size(); ++i) {
+    if (real_map[real_set.command(i)] >= 0) source_row.push_back(i);
+  }
+  {
+    std::set<int> sim_commands(sim.command.begin(), sim.command.end());
+    std::vector<int> keep, rows;
+    for (int i = 0; i < real.size(); ++i) {
+      if (sim_commands.count(real.command[i])) keep.push_back(i), rows.push_back(source_row[i]);
+    }
+    real = SubsetSamples(real, keep);
+    source_row = rows;
+  }
+  const LinearGaussianModel& model = base.sim_model;
+  const PoseLayout layout = base.layout;
+  const int dx = real.pose_dim();
+  const bool terrain = real.terrain_dim() >= 2;
+
+  // 3. Candidates: knob probes, the payload, and the measurement effects.
+  std::vector<EffectSpec> library;
+  std::vector<External> externals;  // parallel to library (unused entries for built-ins)
+  for (const auto& e : EffectLibrary(layout, dx, terrain, real.has_sequence)) {
+    if (e.id != EffectId::kBias && e.id != EffectId::kNoise) continue;
+    library.push_back(e);
+    externals.emplace_back();
+    KnobCandidate c;
+    c.key = e.id == EffectId::kBias ? "tracker_bias" : "tracker_noise";
+    c.family = c.key;
+    c.knob = e.id == EffectId::kBias ? "tracker.offset" : "tracker.noise_scale";
+    c.unit = e.id == EffectId::kBias ? "x units" : "";
+    c.nominal = e.id == EffectId::kBias ? 0.0 : 1.0;
+    out.candidates.push_back(c);
+  }
+  int payload_shift[3] = {-1, -1, -1};
+  for (size_t r = 0; r < probe_of.size(); ++r) {
+    const Knob& k = knobs[probe_of[r].first];
+    if (k.family == "payload") {
+      payload_shift[k.kind == KnobKind::kPayloadMass ? 0 : k.kind == KnobKind::kPayloadX ? 1 : 2] = static_cast<int>(r);
+      continue;
+    }
+    KnobCandidate c;
+    c.key = k.name + Fmt("@%.4g", probe_of[r].second);
+    c.family = k.family;
+    c.knob = k.name;
+    c.unit = k.unit;
+    c.nominal = k.nominal;
+    c.probe = probe_of[r].second;
+    c.lo = k.lo;
+    c.hi = k.hi;
+    c.physical = true;
+    out.candidates.push_back(c);
+    library.push_back(ExternalSpec(c.key, k.name + " (simulated)", 1, "fraction of the probe's change"));
+    External e;
+    e.shifts = {static_cast<int>(r)};
+    externals.push_back(e);
+  }
+  double payload_probe = 0;
+  if (payload_shift[0] >= 0 && payload_shift[1] >= 0 && payload_shift[2] >= 0) {
+    const Knob& k = knobs[probe_of[payload_shift[0]].first];
+    payload_probe = probe_of[payload_shift[0]].second - k.nominal;
+    KnobCandidate c;
+    c.key = "payload";
+    c.family = "payload";
+    c.knob = "payload.mass_kg";
+    c.unit = "kg";
+    c.nominal = k.nominal;
+    c.probe = probe_of[payload_shift[0]].second;
+    c.lo = k.lo;
+    c.hi = k.hi;
+    c.physical = true;
+    out.candidates.push_back(c);
+    library.push_back(ExternalSpec("payload", "payload on the torso (simulated)", 3, "fraction of the probe"));
+    External e;
+    e.kind = External::kPayload;
+    e.shifts = {payload_shift[0], payload_shift[1], payload_shift[2]};
+    externals.push_back(e);
+  }
+  if (terrain) {
+    KnobCandidate c{"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad", 0, 0, 0, 0, false, 0};
+    out.candidates.push_back(c);
+    library.push_back(ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"));
+    External e;
+    e.kind = External::kImuBias;
+    externals.push_back(e);
+  }
+  if (layout.dyaw >= 0) {
+    KnobCandidate c{"heading_drift", "heading_drift", "tracker.yaw_drift", "rad per execution", 0, 0, 0, 0, false, 0};
+    out.candidates.push_back(c);
+    library.push_back(ExternalSpec("heading_drift", "heading drift per execution", 1, "rad per execution"));
+    External e;
+    e.kind = External::kHeading;
+    externals.push_back(e);
+  }
+  FitProblem problem = MakeFitProblem(real, model, library, layout);
+  auto fill_design = [&](FitProblem* fp, int k) {
+    for (int i = 0; i < real.size(); ++i) {
+      const Prediction p = model.Predict(real.command[i], real.z.row(i).transpose(), real.first_execution[i]);
+      const Eigen::MatrixXd d = ExternalDesign(externals[k], shifts, model, layout, dx, real.command[i],
+                                               real.z.row(i).transpose(), real.first_execution[i]);
+      fp->d[k].middleRows(i * dx, dx) = d;
+      fp->g[k].middleRows(i * dx, dx) = p.chol.triangularView<Eigen::Lower>().solve(d);
+    }
+  };
+  for (size_t k = 0; k < library.size(); ++k) {
+    if (library[k].id == EffectId::kExternal) fill_design(&problem, static_cast<int>(k));
+  }
+
+  // 4. Selection by held-out real likelihood (the pipeline's machinery and thresholds).
+  std::mt19937_64 rng(options.seed);
+  std::vector<int> rows(real.size());
+  for (int i = 0; i < real.size(); ++i) rows[i] = i;
+  const std::vector<int> fold = MakeFolds(problem, rows, options.selection.folds, rng);
+  SelectionResult sel = ForwardSelect(problem, rows, fold, options.selection);
+  std::vector<double> inclusion(library.size(), -1.0);
+  if (options.selection.bootstrap_selection > 0) {
+    inclusion = Bootstrap(problem, sel, options.selection, rng).inclusion;
+  }
+  out.steps = sel.steps;
+  std::vector<int> order(sel.selected.size());
+  for (size_t k = 0; k < order.size(); ++k) order[k] = static_cast<int>(k);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return sel.importance[a] > sel.importance[b]; });
+  for (int k : order) out.selected.push_back(sel.selected[k]);
+  for (size_t k = 0; k < sel.selected.size(); ++k) out.candidates[sel.selected[k]].theta = sel.fit.theta[k](0);
+
+  // 5. Refine the first-named physical knob by re-simulation (secant on the fitted coefficient).
+  EffectFit final_fit = sel.fit;
+  Eigen::VectorXd heldout = sel.heldout_corrected;
+  const auto refine_start = std::chrono::steady_clock::now();
+  double refined_value = NAN;
+  if (!out.selected.empty() && options.refine_iterations > 0) {
+    const int top = out.selected.front();
+    KnobCandidate& c = out.candidates[top];
+    if (c.physical && externals[top].kind == External::kShift) {
+      const int knob = probe_of[externals[top].shifts[0]].first;
+      const int pos = static_cast<int>(std::find(sel.selected.begin(), sel.selected.end(), top) - sel.selected.begin());
+      double value = std::clamp(c.nominal + sel.fit.theta[pos](0) * (c.probe - c.nominal), c.lo, c.hi);
+      out.refine_trace.emplace_back(c.probe, sel.fit.theta[pos](0));
+      FitProblem trial = problem;
+      double best_err = std::abs(sel.fit.theta[pos](0) - 1);
+      int best_shift = externals[top].shifts[0];
+      refined_value = best_err < 0.1 ? c.probe : NAN;
+      for (int it = 0; it < options.refine_iterations && best_err >= 0.1; ++it) {
+        if (std::abs(value - c.nominal) < 1e-9 * (1 + std::abs(c.nominal))) break;
+        SimulationBatch one = SimulateBatch(config, protocol, seed, knobs, {{{KnobValue{knob, value}}}},
+                                            options.signatures);
+        out.simulations += one.simulated;
+        out.from_cache += one.from_cache;
+        shifts.push_back(PairedShift::Fit(batch.sets[0], one.sets[0], sim_set, options.signatures.slope_ridge));
+        externals[top].shifts = {static_cast<int>(shifts.size()) - 1};
+        fill_design(&trial, top);
+        EffectFit fit = FitEffects(trial, sel.selected, {}, options.selection.fit);
+        const double a = fit.theta[pos](0);
+        out.refine_trace.emplace_back(value, a);
+        if (std::abs(a - 1) < best_err) {
+          best_err = std::abs(a - 1);
+          refined_value = value;
+          best_shift = externals[top].shifts[0];
+          problem = trial;
+          final_fit = fit;
+        }
+        value = std::clamp(c.nominal + a * (value - c.nominal), c.lo, c.hi);
+      }
+      externals[top].shifts = {best_shift};
+      if (std::isfinite(refined_value) && refined_value != c.probe) {
+        heldout = CrossValidate(problem, sel.selected, rows, fold, options.selection.fit);
+      }
+    }
+  }
+  out.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_start).count();
+
+  // 6. Residual structure after the correction.
+  Eigen::MatrixXd resid = problem.r0;
+  for (size_t k = 0; k < final_fit.effects.size(); ++k) {
+    Eigen::VectorXd s = WhitenedShift(problem, final_fit, static_cast<int>(k));
+    resid -= Eigen::Map<Eigen::MatrixXd>(s.data(), dx, real.size()).transpose();
+  }
+  resid *= std::exp(-final_fit.log_tau);
+  std::vector<int> terrain_id(real.size(), -1), step(real.size(), -1);
+  if (real.terrain_dim() > 0 && base.terrain_centres.rows() > 0) terrain_id = NearestCentre(real.z, base.terrain_centres);
+  if (real.has_sequence && real_set.has_sequence()) {
+    for (int i = 0; i < real.size(); ++i) step[i] = real_set.step(source_row[i]);
+  }
+  const double sim_kurt = ExcessKurtosis(model.WhitenedResiduals(sim));
+  out.residual = TestResidualStructure(resid, real.command, terrain_id, real.episode, step, sim_kurt,
+                                       options.residual, options.seed);
+
+  // 7. The verdict.
+  Verdict& v = out.verdict;
+  out.ll_sim = sel.heldout_sim.mean();
+  out.ll_corrected = heldout.mean();
+  out.ll_ceiling = base.ll_ceiling;
+  const double gap = out.ll_ceiling - out.ll_sim;
+  v.gap_closed = gap > 1e-9 ? (out.ll_corrected - out.ll_sim) / gap : NAN;
+  const bool structured = !out.residual.structured_in.empty();
+  std::set<std::string> families;
+  for (int k : out.selected) {
+    const KnobCandidate& c = out.candidates[k];
+    if (families.count(c.family)) continue;
+    if (c.family == "tracker_noise" && structured) continue;  // noise only for a pure change of scale
+    families.insert(c.family);
+    const int pos = static_cast<int>(std::find(final_fit.effects.begin(), final_fit.effects.end(), k) -
+                                     final_fit.effects.begin());
+    const Eigen::VectorXd& t = final_fit.theta[pos];
+    VerdictNamed n;
+    n.family = c.family;
+    n.knob = c.knob;
+    n.unit = c.unit;
+    n.nominal = c.nominal;
+    n.inclusion = inclusion[k];
+    if (c.key == "payload") n.value = c.nominal + t(0) * payload_probe;
+    else if (c.physical) {
+      n.value = k == out.selected.front() && std::isfinite(refined_value)
+                    ? refined_value
+                    : std::clamp(c.nominal + t(0) * (c.probe - c.nominal), c.lo, c.hi);
+    } else if (c.family == "tracker_noise") n.value = std::exp(final_fit.log_tau);
+    else n.value = t.cwiseAbs().maxCoeff() * (c.family == "heading_drift" ? (t(0) < 0 ? -1 : 1) : 1);
+    out.candidates[k].theta = t(0);
+    v.named.push_back(n);
+  }
+  // Ties: at the step that added a named effect, another family whose gain is within reach and
+  // whose whitened signature on these samples is nearly collinear (or flagged by the selection).
+  for (size_t s = 0; s < sel.selected.size() && s < sel.steps.size(); ++s) {
+    const int chosen = sel.selected[s];
+    auto named = std::find_if(v.named.begin(), v.named.end(),
+                              [&](const VerdictNamed& n) { return n.family == out.candidates[chosen].family; });
+    if (named == v.named.end()) continue;
+    const SelectionStep& step_s = sel.steps[s];
+    const CandidateScore& best = step_s.candidates.front();
+    std::vector<std::string> family_of;
+    for (const auto& c : out.candidates) family_of.push_back(c.family);
+    std::vector<double> corr;
+    const std::vector<int> tied =
+        TiedCandidates(problem, step_s, chosen, family_of, options.tie_correlation, options.selection.fit, &corr);
+    VerdictTie tie;
+    tie.families.push_back(named->family);
+    EffectFit alone = FitEffects(problem, {chosen}, {}, options.selection.fit);
+    for (size_t q = 0; q < tied.size(); ++q) {
+      const int o = tied[q];
+      if (std::find(tie.families.begin(), tie.families.end(), family_of[o]) != tie.families.end()) continue;
+      tie.families.push_back(family_of[o]);
+      double gain_o = 0;
+      for (const auto& c : step_s.candidates) if (c.effect == o) gain_o = c.gain;
+      if (tie.why.empty()) {
+        tie.why = Fmt("signature correlation %.2f on the observed samples; held-out gains %.3f vs %.3f", corr[q],
+                      best.gain, gain_o) + Fmt(" nats per sample (SE %.3f)", best.se);
+      }
+      // Discriminating experiment: the command x terrain cell where the two fitted predictions
+      // differ most (whitened, per execution, first executions excluded).
+      if (library[chosen].is_noise || library[o].is_noise) continue;
+      EffectFit other = FitEffects(problem, {o}, {}, options.selection.fit);
+      const int nt = std::max<int>(1, base.terrain_centres.rows());
+      for (int c : base.real_commands) {
+        for (int t = 0; t < nt; ++t) {
+          const Eigen::VectorXd z = base.terrain_centres.rows() > 0 ? Eigen::VectorXd(base.terrain_centres.row(t).transpose())
+                                                                     : Eigen::VectorXd::Zero(real.terrain_dim());
+          const Prediction p = model.Predict(c, z, 0.0);
+          auto design = [&](int k, const EffectFit& f) -> Eigen::VectorXd {
+            if (library[k].id == EffectId::kExternal) {
+              return ExternalDesign(externals[k], shifts, model, layout, dx, c, z, 0.0) * f.theta[0];
+            }
+            return EffectDesign(library[k], layout, p.mean, BodyGravity(z.size() > 0 ? z(0) : 0, z.size() > 1 ? z(1) : 0),
+                                false) * f.theta[0];
+          };
+          const Eigen::VectorXd delta = p.chol.triangularView<Eigen::Lower>().solve(design(chosen, alone) - design(o, other));
+          const double sep = delta.squaredNorm();
+          if (sep > tie.experiment.separation) {
+            tie.experiment.separation = sep;
+            tie.experiment.commands = {base.command_labels[c]};
+            tie.experiment.terrain = {t < static_cast<int>(base.terrain_labels.size()) ? base.terrain_labels[t] : "all terrain"};
+          }
+        }
+      }
+    }
+    if (tie.families.size() < 2) continue;
+    // Executions for a one-sided 2.8-sigma separation (alpha 0.005, power 0.8): (2.58 + 0.84)^2 / d^2.
+    if (tie.experiment.separation > 0) {
+      tie.experiment.executions = static_cast<int>(std::ceil(11.7 / std::max(tie.experiment.separation, 1e-4)));
+    }
+    named->tie_group = static_cast<int>(v.ties.size());
+    v.ties.push_back(tie);
+  }
+  v.unexplained_present = structured;
+  v.structured_in = out.residual.structured_in;
+  if (v.named.empty()) {
+    v.status = (base.significant_mismatch || structured) ? "unexplained" : "clean";
+    v.unexplained_present = v.status == "unexplained";
+    if (v.unexplained_present && v.structured_in.empty()) v.structured_in = {"located regions"};
+  } else {
+    v.status = structured ? "partly_explained" : "explained";
+  }
+  // The sentence.
+  std::string s;
+  if (v.status == "clean") {
+    s = "No simulator knob or measurement effect improves the held-out real likelihood: clean.";
+  } else if (v.named.empty()) {
+    s = "Unexplained mismatch: no simulator knob or measurement effect fits";
+  } else {
+    s = "Simulator knobs and measurement effects, in order of evidence:";
+    for (size_t k = 0; k < v.named.size(); ++k) {
+      const auto& n = v.named[k];
+      s += Fmt(" (%.0f) ", k + 1.0) + n.family + " (" + n.knob + Fmt(" = %.4g", n.value) +
+           (n.unit.empty() ? "" : " " + n.unit) + Fmt(", nominal %.4g", n.nominal) +
+           (n.inclusion < 0 ? std::string(", inclusion not computed") : Fmt(", inclusion %.0f%%", 100 * n.inclusion)) + ")";
+      if (n.tie_group >= 0) {
+        const auto& t = v.ties[n.tie_group];
+        s += " - cannot be told apart from";
+        for (size_t f = 1; f < t.families.size(); ++f) s += " " + t.families[f];
+        s += " on these data (" + t.why + ")";
+        if (!t.experiment.commands.empty()) {
+          s += "; to separate them, record command " + t.experiment.commands[0] + " on " + t.experiment.terrain[0] +
+               Fmt(" about %.0f times", t.experiment.executions);
+        }
+      }
+      s += ";";
+    }
+  }
+  if (v.unexplained_present) {
+    s += " The residual is structured in";
+    for (const auto& w : v.structured_in) s += " " + w;
+  }
+  s += ".";
+  v.sentence = s;
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+std::string KnobAnalysisJson(const KnobAnalysis& a) {
+  using json = nlohmann::json;
+  json cands = json::array();
+  for (const auto& c : a.candidates) {
+    cands.push_back({{"key", c.key}, {"family", c.family}, {"knob", c.knob}, {"nominal", c.nominal},
+                     {"probe", c.probe}, {"range", {c.lo, c.hi}}, {"simulated", c.physical}});
+  }
+  json steps = json::array();
+  for (const auto& s : a.steps) {
+    json cs = json::array();
+    for (const auto& c : s.candidates) {
+      cs.push_back({{"key", a.candidates[c.effect].key}, {"gain", c.gain}, {"se", c.se}, {"z", c.z}});
+    }
+    steps.push_back({{"chosen", s.chosen >= 0 ? json(a.candidates[s.chosen].key) : json(nullptr)},
+                     {"threshold_z", s.threshold_z}, {"candidates", cs}});
+  }
+  json tests = json::array();
+  for (const auto& t : a.residual.tests) {
+    tests.push_back({{"where", t.where}, {"statistic", t.statistic}, {"p_value", t.p_value}, {"significant", t.significant}});
+  }
+  json trace = json::array();
+  for (const auto& [v, c] : a.refine_trace) trace.push_back({{"value", v}, {"coefficient", c}});
+  json out = {{"candidates", cands},
+              {"selection_steps", steps},
+              {"refinement", trace},
+              {"residual_tests", tests},
+              {"simulations", a.simulations},
+              {"from_cache", a.from_cache},
+              {"placements_per_simulation", a.placements},
+              {"cache_dir", a.cache_dir},
+              {"signature_seconds", a.signature_seconds},
+              {"refine_seconds", a.refine_seconds},
+              {"seconds", a.seconds},
+              {"heldout_ll", {{"sim", a.ll_sim}, {"corrected", a.ll_corrected}, {"ceiling", a.ll_ceiling}}},
+              {"note", a.note}};
+  return out.dump();
+}
+
+}  // namespace dgmm::sim2real

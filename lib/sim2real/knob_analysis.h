@@ -1,0 +1,72 @@
+#pragma once
+// The simulator-in-the-loop analysis (--sim-config; docs/sim2real.md, "Knobs"): candidate
+// effects are the simulator's own knobs (lib/sim/knobs.h) with signatures simulated on the sim
+// set's protocol and seed (signatures.h), plus measurement effects no simulator models
+// (imu_bias: z offset through the sim model's slopes; tracker_bias; heading_drift; tracker_noise).
+// Forward selection by held-out real likelihood (selection.h), ties from the signatures'
+// correlation on the observed samples with a discriminating experiment, the chosen knob refined
+// by re-simulation, the residual tested for structure, and the verdict.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/sample_set.h"
+#include "sim/sim_config.h"
+#include "sim2real/pipeline.h"
+#include "sim2real/residual_structure.h"
+#include "sim2real/signatures.h"
+#include "sim2real/verdict.h"
+
+namespace dgmm::sim2real {
+
+struct KnobAnalysisOptions {
+  std::uint64_t seed = 1;
+  SignatureOptions signatures;
+  SelectionOptions selection;      // bootstrap_selection 0: inclusion not computed
+  ResidualStructureOptions residual;
+  double tie_correlation = 0.9;    // |corr| of whitened signatures on the real samples
+  int refine_iterations = 2;       // re-simulations of the first-named knob (0: none)
+  bool IsValid(std::string* error) const;
+};
+
+struct KnobCandidate {
+  std::string key;      // e.g. "floor.friction.sliding@0.6"
+  std::string family;
+  std::string knob;     // knob name ("payload" for the payload effect)
+  std::string unit;
+  double nominal = 0, probe = 0, lo = 0, hi = 0;  // probe: the simulated value (1 param effects)
+  bool physical = false;
+  double theta = 0;     // fitted (first parameter) when selected
+};
+
+struct KnobAnalysis {
+  Verdict verdict;
+  std::vector<KnobCandidate> candidates;  // library order of `steps`
+  std::vector<SelectionStep> steps;
+  std::vector<int> selected;              // candidate indices, by importance
+  ResidualStructure residual;
+  int simulations = 0, from_cache = 0, placements = 0;
+  double signature_seconds = 0, refine_seconds = 0, seconds = 0;
+  std::string cache_dir;
+  std::vector<std::pair<double, double>> refine_trace;  // (value simulated, fitted coefficient)
+  double ll_sim = 0, ll_corrected = 0, ll_ceiling = 0;
+  std::string note;
+};
+
+// Candidates of `step` (indices into fp.library, `family` per library entry) the data cannot
+// tell apart from `chosen`: of another family, and either flagged by the selection (gain within
+// one SE of the paired difference, correlated fitted shifts) or with a held-out gain within two
+// SE of the best and whitened fitted shifts (each effect fitted alone on all samples) at
+// |cosine| >= tie_correlation. `correlation` (optional) gets the |cosine| of each.
+std::vector<int> TiedCandidates(const FitProblem& fp, const SelectionStep& step, int chosen,
+                                const std::vector<std::string>& family, double tie_correlation,
+                                const EffectFitOptions& fit, std::vector<double>* correlation = nullptr);
+
+// Throws InputError when the sim set lacks what the signatures need (command table, episodes).
+KnobAnalysis AnalyseKnobs(const SampleSet& sim_set, const SampleSet& real_set, const sim::SimConfig& config,
+                          const Sim2RealResult& base, const KnobAnalysisOptions& options);
+
+// JSON text of the analysis details (candidates, steps, refinement, residual tests, timing).
+std::string KnobAnalysisJson(const KnobAnalysis& a);
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,50 @@
+#pragma once
+// Is what remains after a correction structured, or a pure change of scale? Permutation tests on
+// the whitened residuals r_i (n x dx) of the corrected model, with placements (episodes) as the
+// exchangeable units, so the correlation of one placement's samples cannot fake structure:
+//   command:  between-command sum of squares of the episode means (labels permuted over episodes)
+//   terrain:  the same over terrain regions (nearest k-means centre of each episode's mean z)
+//   step:     sum of squares of the step-index means of r_i - (episode mean) (steps permuted
+//             within each episode); "periodic" when the step means alternate in sign
+//             (lag-1 autocorrelation of the step-mean profile < -0.3)
+//   tails:    excess kurtosis of |r_i|^2-normalised residuals over the sim set's own
+//             (a difference > max(1, 4 SE) with SE = sqrt(24 / (n dx)))
+// Bonferroni over the four tests.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dgmm::sim2real {
+
+struct ResidualStructureOptions {
+  int permutations = 1000;
+  double alpha = 0.01;  // family-wise over the four tests
+  bool IsValid(std::string* error) const;
+};
+
+struct ResidualTest {
+  std::string where;      // "command", "terrain", "step", "periodic", "tails"
+  double statistic = 0;
+  double p_value = 1;
+  bool significant = false;
+};
+
+struct ResidualStructure {
+  std::vector<ResidualTest> tests;
+  std::vector<std::string> structured_in;  // the significant `where`s
+  Eigen::VectorXd step_profile;            // mean whitened residual norm direction per step
+};
+
+// `residuals` n x dx; `command`, `terrain` (region id, -1: none), `episode`, `step` per sample
+// (step -1: no sequence data); `sim_kurtosis` the excess kurtosis of the sim set's own
+// whitened residuals (NaN: skip the tails test).
+ResidualStructure TestResidualStructure(const Eigen::MatrixXd& residuals, const std::vector<int>& command,
+                                        const std::vector<int>& terrain, const std::vector<int>& episode,
+                                        const std::vector<int>& step, double sim_kurtosis,
+                                        const ResidualStructureOptions& options, std::uint64_t seed);
+
+// Mean excess kurtosis over the columns of r (n x dx).
+double ExcessKurtosis(const Eigen::MatrixXd& r);
+
+}  // namespace dgmm::sim2real

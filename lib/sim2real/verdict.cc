@@ -1,0 +1,91 @@
+#include "sim2real/verdict.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <nlohmann/json.hpp>
+
+namespace dgmm::sim2real {
+namespace {
+
+using json = nlohmann::json;
+
+json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+}  // namespace
+
+std::string VerdictJson(const Verdict& v) {
+  json named = json::array();
+  for (const auto& n : v.named) {
+    named.push_back({{"family", n.family}, {"knob", n.knob}, {"value", Number(n.value)}, {"unit", n.unit},
+                     {"nominal", Number(n.nominal)},
+                     {"inclusion", n.inclusion < 0 ? json(nullptr) : json(n.inclusion)},
+                     {"tie_group", n.tie_group < 0 ? json(nullptr) : json(n.tie_group)}});
+  }
+  json ties = json::array();
+  for (const auto& t : v.ties) {
+    ties.push_back({{"families", t.families},
+                    {"why", t.why},
+                    {"experiment",
+                     {{"commands", t.experiment.commands},
+                      {"terrain", t.experiment.terrain},
+                      {"executions", t.experiment.executions},
+                      {"separation_per_execution", t.experiment.separation},
+                      {"checked_by_simulation", t.experiment.checked_by_simulation}}}});
+  }
+  json out = {{"status", v.status},
+              {"named", named},
+              {"ties", ties},
+              {"unexplained", {{"present", v.unexplained_present}, {"structured_in", v.structured_in}}},
+              {"gap_closed", Number(v.gap_closed)}};
+  return out.dump();
+}
+
+Verdict VerdictFromEffects(const Sim2RealResult& r) {
+  // The kinematic forms of the data-level library stand for these families.
+  static const std::map<std::string, std::string> family = {
+      {"slope_slip", "friction"},       {"stride_loss", "actuator_gain"}, {"slope_traction", "friction"},
+      {"payload_offset", "payload"},    {"actuator_asymmetry", "actuator_gain"}, {"latency", "latency"},
+      {"compliance", "contact"},        {"bias", "tracker_bias"},          {"noise", "tracker_noise"}};
+  Verdict v;
+  v.gap_closed = r.gap_closed;
+  const bool not_computed = r.bootstrap_resamples == 0;
+  for (const auto& e : r.effects) {
+    VerdictNamed n;
+    auto it = family.find(e.spec.key);
+    n.family = it == family.end() ? e.spec.key : it->second;
+    n.knob = e.spec.key;
+    n.value = e.theta.size() > 0 ? e.theta.cwiseAbs().maxCoeff() : NAN;
+    if (e.spec.is_noise && e.theta.size() > 0) n.value = std::exp(e.theta(0));
+    n.unit = e.spec.parameters.empty() ? "" : e.spec.parameters.front().unit;
+    n.nominal = e.spec.is_noise ? 1.0 : 0.0;
+    n.inclusion = not_computed ? -1 : e.inclusion;
+    if (!e.confusable_with.empty()) {
+      VerdictTie t;
+      t.families.push_back(n.family);
+      for (const auto& c : e.confusable_with) {
+        auto f = family.find(c);
+        const std::string name = f == family.end() ? c : f->second;
+        if (std::find(t.families.begin(), t.families.end(), name) == t.families.end()) t.families.push_back(name);
+      }
+      if (t.families.size() > 1) {
+        t.why = "held-out gains within one standard error and fitted shifts correlated (data-level library)";
+        n.tie_group = static_cast<int>(v.ties.size());
+        v.ties.push_back(t);
+      }
+    }
+    v.named.push_back(n);
+  }
+  v.unexplained_present = !r.unexplained.empty();
+  for (const auto& g : r.unexplained) {
+    if (std::find(v.structured_in.begin(), v.structured_in.end(), g.family) == v.structured_in.end()) {
+      v.structured_in.push_back(g.family);
+    }
+  }
+  if (!r.significant_mismatch && v.named.empty()) v.status = "clean";
+  else if (v.named.empty()) v.status = "unexplained", v.unexplained_present = true;
+  else v.status = v.unexplained_present ? "partly_explained" : "explained";
+  return v;
+}
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,50 @@
+#pragma once
+// What a user should believe: the `verdict` object of report.json (docs/sim2real.md,
+// "report.json verdict"), in the fixed family vocabulary scored by scripts/sim2real_battery.py.
+#include <string>
+#include <vector>
+
+#include "sim2real/pipeline.h"
+
+namespace dgmm::sim2real {
+
+struct VerdictExperiment {
+  std::vector<std::string> commands;  // command labels
+  std::vector<std::string> terrain;   // terrain region labels
+  int executions = 0;                 // per cell, to separate the two at about 2.8 sigma
+  bool checked_by_simulation = false;
+  double separation = 0;              // whitened distance of the two predictions per execution
+};
+
+struct VerdictTie {
+  std::vector<std::string> families;
+  std::string why;
+  VerdictExperiment experiment;
+};
+
+struct VerdictNamed {
+  std::string family, knob, unit;
+  double value = 0, nominal = 0;
+  double inclusion = -1;  // < 0: not computed (--bootstrap 0), written as null
+  int tie_group = -1;     // index into ties, -1: null
+};
+
+struct Verdict {
+  std::string status = "clean";  // clean, explained, partly_explained, unexplained, cannot_compare
+  std::vector<VerdictNamed> named;
+  std::vector<VerdictTie> ties;
+  bool unexplained_present = false;
+  std::vector<std::string> structured_in;
+  double gap_closed = 0;  // NaN: no gap (null)
+  std::string sentence;   // one plain-language paragraph for the conclusion
+};
+
+// JSON text of the verdict object (contract of docs/sim2real.md).
+std::string VerdictJson(const Verdict& v);
+
+// The verdict of the data-level analysis (no simulator): its effects mapped onto families
+// (bias -> tracker_bias, noise -> tracker_noise, the kinematic forms onto the physics they stand
+// for); values are the effects' own parameters, not simulator units.
+Verdict VerdictFromEffects(const Sim2RealResult& result);
+
+}  // namespace dgmm::sim2real
