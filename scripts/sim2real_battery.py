@@ -170,6 +170,10 @@ def generate(args, pair, nominals):
         return
     os.makedirs(pdir, exist_ok=True)
     os.makedirs(tdir, exist_ok=True)
+    try:  # another battery process (e.g. --reverse) may be recording this pair
+        os.close(os.open(os.path.join(tdir, ".recording"), os.O_CREAT | os.O_EXCL))
+    except FileExistsError:
+        return
     cfg = absolute_config(robot, nominals[robot])
     for e in pair["effects"]:
         cfg = draw.merge(cfg, e["config"])
@@ -206,6 +210,7 @@ def generate(args, pair, nominals):
     truth["real_sim_wall_s"] = time.time() - t
     with open(os.path.join(tdir, "truth.json"), "w") as f:
         json.dump(truth, f, indent=2)
+    os.remove(os.path.join(tdir, ".recording"))
 
 
 def analyse(args, pair):
@@ -224,11 +229,21 @@ def analyse(args, pair):
            "--no-figures"]
     # The analysis's signature cache lives in OUT (a fresh OUT starts uncached).
     env = dict(os.environ, XDG_CACHE_HOME=os.path.join(args.out, "xdg-cache"))
+    if args.stop_at and time.time() >= args.stop_at:
+        return None, 0.0, "not started: --stop-at reached"
     t = time.time()
-    try:
-        run(cmd, env=env)
-    except RuntimeError as e:
-        return None, time.time() - t, str(e)
+    with open(os.path.join(pdir, "analysis.log"), "w") as logf:
+        proc = subprocess.Popen(["nice", "-n", "5"] + cmd, stdout=logf, stderr=subprocess.STDOUT,
+                                env=env)
+        while proc.poll() is None:
+            if args.stop_at and time.time() >= args.stop_at:
+                proc.kill()  # this analysis only (its own pid)
+                proc.wait()
+                return None, time.time() - t, "stopped at --stop-at"
+            time.sleep(1)
+    if proc.returncode != 0:
+        with open(os.path.join(pdir, "analysis.log")) as logf:
+            return None, time.time() - t, f"exit {proc.returncode}: {logf.read()[-500:]}"
     wall = time.time() - t
     with open(timing, "w") as g:
         json.dump({"wall_s": wall}, g)
@@ -361,6 +376,20 @@ def write_section(name, text):
                    input=text, text=True, check=True)
 
 
+def find_key(obj, key):
+    """The first dict (depth first) in a parsed JSON holding `key`, or None."""
+    if isinstance(obj, dict):
+        if key in obj:
+            return obj
+        obj = list(obj.values())
+    if isinstance(obj, list):
+        for v in obj:
+            found = find_key(v, key)
+            if found is not None:
+                return found
+    return None
+
+
 def parse_seeds(text):
     a, _, b = text.partition("-")
     return list(range(int(a), int(b or a) + 1))
@@ -375,8 +404,13 @@ def main():
     ap.add_argument("--keep", action="store_true", help="keep the sets and analyses afterwards")
     ap.add_argument("--smoke", action="store_true", help="3 pairs, few placements (a quick check)")
     ap.add_argument("--generate-only", action="store_true", help="record the pairs, analyse none")
+    ap.add_argument("--reverse", action="store_true",
+                    help="record from the last seed down (a second recording process)")
     ap.add_argument("--realism", action="store_true",
                     help="plant the weakest end of every range and print its detectability")
+    ap.add_argument("--stop-at", default=None, metavar="HH:MM",
+                    help="UTC time after which no analysis starts and running ones are stopped "
+                         "(their pairs are listed as not analysed)")
     ap.add_argument("--rerun", action="store_true", help="rerun analyses already in OUT")
     ap.add_argument("--write-doc", action="store_true",
                     help="write the tables into docs/sim2real.md (section sim2real-battery)")
@@ -384,6 +418,11 @@ def main():
     if not 1 <= args.jobs <= 2:
         ap.error("--jobs: expected 1 or 2 (the machine has 2 cores)")
     seeds = parse_seeds(args.seeds)[: 3 if args.smoke else None]
+    if args.stop_at:
+        hh, mm = (int(v) for v in args.stop_at.split(":"))
+        now = time.gmtime()
+        args.stop_at = time.time() + ((hh * 60 + mm) - (now.tm_hour * 60 + now.tm_min)) * 60 \
+            - now.tm_sec
     args.out = os.path.abspath(args.out or os.path.join(ROOT, "out", f"battery-{args.seeds}"))
     args.dgmm = os.path.join(os.path.abspath(args.build), "app", "dgmm")
     if not os.access(args.dgmm, os.X_OK):
@@ -398,11 +437,12 @@ def main():
         sim_set(args, robot)
     log(f"generating {len(pairs)} pairs")
     with cf.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(lambda p: generate(args, p, nominals), pairs))
+        list(pool.map(lambda p: generate(args, p, nominals), pairs[::-1] if args.reverse else pairs))
     log(f"generated in {time.time() - t0:.0f} s")
     if args.generate_only:
         return 0
-    # The first analysis per robot runs alone: it fills the signature cache the others reuse.
+    # Built-in robot first, in seed order (its signature cache fills with the first analysis);
+    # then the second robot's pairs, in seed order.
     firsts = {}
     for p in pairs:
         firsts.setdefault(p["robot"], p["seed"])
@@ -422,17 +462,23 @@ def main():
             r["error"] = error
         else:
             r["score"] = score.score_pair(truth, report)
+            stats = find_key(report, "from_cache")
+            if stats is not None:
+                r["simulations"], r["from_cache"] = stats.get("simulations"), stats["from_cache"]
         results[p["seed"]] = r
         log(f"pair {p['seed']} ({p['robot']}, {p['kind']}): {wall:.0f} s")
-    for p in pairs:
-        if firsts[p["robot"]] == p["seed"]:
-            one(p)
+    order = sorted(pairs, key=lambda p: (p["robot"] != "scorpion", p["seed"]))
     with cf.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(one, [p for p in pairs if firsts[p["robot"]] != p["seed"]]))
+        list(pool.map(one, order))
     ordered = [results[s] for s in seeds]
     summary = score.summarize(ordered)
-    command = "scripts/sim2real_battery.py " + " ".join(
-        a for a in sys.argv[1:] if not a.startswith("--out") and not a.startswith("--build"))
+    shown, skip = [], False
+    for a in sys.argv[1:]:  # the command line without the machine-specific folders
+        if skip or a.split("=")[0] in ("--out", "--build"):
+            skip = not skip and "=" not in a
+            continue
+        shown.append(a)
+    command = "scripts/sim2real_battery.py " + " ".join(shown)
     doc = tables.markdown(ordered, summary, command, smoke=args.smoke)
     out = {"seeds": args.seeds, "smoke": args.smoke, "summary": summary, "pairs": ordered}
     tmp = os.path.join(args.out, "results.json.tmp")
