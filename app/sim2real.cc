@@ -26,11 +26,14 @@ namespace {
 struct Sim2RealArgs {
   std::string sim, real, out, sim_config, cache;
   int signature_placements = 78;
+  std::vector<std::string> effects;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
   bool json = false;
   bool no_figures = false;
+  bool legacy_resim = false;
+  bool no_knobs = false;
 };
 
 void WriteText(const std::filesystem::path& path, const std::string& text) {
@@ -59,6 +62,7 @@ void Run(const Sim2RealArgs& args) {
   options.seed = args.seed;
   options.selection.bootstrap_selection = args.bootstrap;
   options.locate.mmd.permutations = args.permutations;
+  options.only_effects = args.effects;
   if (ShowProgress()) std::cerr << "sim2real: analysing " << real.size() << " real vs " << sim.size() << " sim samples\n";
   const sim2real::Sim2RealResult result = sim2real::RunSim2Real(sim, real, options);
 
@@ -70,21 +74,26 @@ void Run(const Sim2RealArgs& args) {
   WriteModel(sim2real::BuildCorrectedModel(result, sim), (fs::path(args.out) / ctx.corrected_model_file).string());
   WriteModel(sim2real::BuildSimModel(result, sim), (fs::path(args.out) / ctx.sim_model_file).string());
   sim2real::Verdict verdict = sim2real::VerdictFromEffects(result);
-  if (!args.sim_config.empty()) {
+  if (!args.sim_config.empty() && !args.no_knobs) {
     if (ShowProgress()) std::cerr << "sim2real: simulator knobs (signatures, selection, refinement)\n";
     sim2real::KnobAnalysisOptions ko;
     ko.seed = args.seed;
     ko.selection = options.selection;
     ko.signatures.cache_dir = args.cache;
     ko.signatures.placements = args.signature_placements;
-    const sim2real::KnobAnalysis knobs =
-        sim2real::AnalyseKnobs(sim, real, sim::LoadSimConfig(args.sim_config), result, ko);
-    verdict = knobs.verdict;
-    ctx.knob_analysis_json = sim2real::KnobAnalysisJson(knobs);
+    const sim::SimConfig config = sim::LoadSimConfig(args.sim_config);  // a bad config is the user's error
+    try {
+      const sim2real::KnobAnalysis knobs = sim2real::AnalyseKnobs(sim, real, config, result, ko);
+      verdict = knobs.verdict;
+      ctx.knob_analysis_json = sim2real::KnobAnalysisJson(knobs);
+    } catch (const InputError& e) {
+      // E.g. a sim set without episodes: the data-level verdict stands, and the report says why.
+      ctx.notes.push_back(std::string("simulator-knob analysis skipped: ") + e.what());
+    }
   }
   ctx.verdict_json = sim2real::VerdictJson(verdict);
   ctx.verdict_sentence = verdict.sentence;
-  if (!args.sim_config.empty()) {
+  if (!args.sim_config.empty() && args.legacy_resim) {
     if (ShowProgress()) std::cerr << "sim2real: re-simulating with fitted physical parameters\n";
     sim2real::RecalibrationOptions recal;
     recal.sim_config_path = args.sim_config;
@@ -131,6 +140,10 @@ void Setup(CLI::App& root) {
   cmd->add_option("-o,--output", args->out, "output folder")->required();
   cmd->add_option("--seed", args->seed, "seed of folds, bootstrap and permutations")->capture_default_str();
   cmd->add_option("--sim-config", args->sim_config, "simulation config of the sim set (JSON)");
+  cmd->add_option("--effects", args->effects,
+                  "restrict the data-level effect library to these keys (comma-separated), e.g. "
+                  "bias,noise")
+      ->delimiter(',');
   cmd->add_option("--cache", args->cache,
                   "folder of cached knob simulations (default $XDG_CACHE_HOME/dgmm or ~/.cache/dgmm; - for none)");
   cmd->add_option("--signature-placements", args->signature_placements,
@@ -141,6 +154,12 @@ void Setup(CLI::App& root) {
   cmd->add_option("--permutations", args->permutations, "permutations per two-sample test")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_flag("--no-figures", args->no_figures, "skip the PNG figures");
+  cmd->add_flag("--no-knobs", args->no_knobs,
+                "with --sim-config, skip the simulator-knob analysis (the verdict then comes from the "
+                "data-level effects)");
+  cmd->add_flag("--legacy-resim", args->legacy_resim,
+                "with --sim-config, also run the scans of the data-level effects (friction, payload, "
+                "leg gain; report.json \"recalibration\", recalibrated_config.json)");
   cmd->add_flag("--json", args->json, "print report.json to stdout instead of the conclusion");
   cmd->callback([args] { Run(*args); });
 }

@@ -51,7 +51,7 @@ done
 step "Sim vs real: a shipped pair (the 'real' robot slips downhill; the sim does not)"
 "${render[@]}" "$dgmm" sim2real --sim "$root/datasets/sim2real/sim.h5" \
   --real "$root/datasets/sim2real/slip/real.h5" \
-  --sim-config "$root/datasets/sim2real/configs/nominal.json" -o "$out/sim2real" --seed 1
+  --sim-config "$root/datasets/sim2real/configs/nominal.json" -o "$out/sim2real" --seed 1 --legacy-resim
 
 step "Done. Results in $out"
 ls "$out"

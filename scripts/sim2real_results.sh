@@ -28,7 +28,7 @@ for pair in slip payload weak_leg null; do
   if [ "$pair" != null ]; then
     start=$(date +%s.%N)
     "$dgmm" sim2real --sim "$data/sim.h5" --real "$data/$pair/real.h5" -o "$work/$pair-resim" \
-      --no-figures --bootstrap 0 --sim-config "$data/configs/nominal.json" > /dev/null
+      --no-figures --bootstrap 0 --sim-config "$data/configs/nominal.json" --legacy-resim > /dev/null
     echo "$(date +%s.%N) - $start" | bc -l > "$work/$pair-resim/wall_seconds"
   fi
   # Robustness of the ranking to the random folds: the first effect named with fold seeds 2-5.

@@ -106,6 +106,9 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
                            {0.6, 1.5}));
   knobs.push_back(MakeKnob(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0,
                            0.05, 10.0, {0.25, 4.0}));
+  const double lat = config.actuators.latency_s;
+  knobs.push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, 0.2,
+                           {lat + 0.04}));
   return knobs;
 }
 
@@ -150,6 +153,7 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
         break;
       case KnobKind::kKpScale: c.actuators.kp_nm_per_rad = config.actuators.kp_nm_per_rad * v.value; break;
       case KnobKind::kDampingScale: damping_scale = v.value; break;
+      case KnobKind::kLatency: c.actuators.latency_s = v.value; break;
     }
   }
   if (payload) {

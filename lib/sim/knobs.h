@@ -3,7 +3,7 @@
 // loaded robot model and its SimConfig (not from hard-coded body names): floor friction, floor
 // contact softness (solref), all-body mass scale, a payload on the torso, actuator gain per leg
 // (legs = the torso's child subtrees that carry actuators), per side (sign of the leg root's y),
-// of all legs (kp), joint damping. Each knob knows its nominal value, a physical range, the
+// of all legs (kp), joint damping, actuation latency. Each knob knows its nominal value, a physical range, the
 // probe values simulated for its signature (docs/sim2real.md, "Signatures from the simulator")
 // and how to apply a value (to the SimConfig, or to the compiled mjModel through a ModelEdit).
 #include <string>
@@ -29,6 +29,7 @@ enum class KnobKind {
   kSideGain,           // kp scale of the legs on one side (index 0: left, y > 0; 1: right)
   kKpScale,            // kp scale of every leg actuator
   kDampingScale,       // joint damping scale of every leg hinge
+  kLatency,            // actuation latency [s] (actuators.latency_s)
 };
 
 // Confusion-matrix family of a knob (docs/sim2real.md, "report.json verdict").
@@ -36,7 +37,7 @@ struct Knob {
   KnobKind kind;
   int index = -1;            // leg or side for kLegGain / kSideGain
   std::string name;          // e.g. "floor.friction.sliding", "actuators.leg3.gain"
-  std::string family;        // friction, contact, mass, payload, actuator_gain, joint_damping
+  std::string family;        // friction, contact, mass, payload, actuator_gain, joint_damping, latency
   std::string unit;          // "" for factors
   double nominal = 0;        // value in the nominal config / model
   double lo = 0, hi = 0;     // physical range searched

@@ -214,6 +214,27 @@ Sim2RealResult RunSim2Real(const SampleSet& sim_in, const SampleSet& real_in,
   // Models: sim-trained, and the real folds shared by every held-out comparison.
   r.sim_model = LinearGaussianModel::Fit(sim, options.model);
   r.library = EffectLibrary(r.layout, r.pose_dim, r.terrain_dim > 0, real.has_sequence);
+  if (!options.only_effects.empty()) {
+    const auto all = EffectLibrary(PoseLayout{0, 1, 2, 3, 4, 5}, 6, true, true);
+    std::string valid;
+    for (const auto& e : all) valid += (valid.empty() ? "" : ", ") + e.key;
+    for (const auto& key : options.only_effects) {
+      if (std::none_of(all.begin(), all.end(), [&](const EffectSpec& e) { return e.key == key; })) {
+        throw MakeInputError("--effects", key, "unknown effect; expected one of " + valid);
+      }
+    }
+    std::vector<EffectSpec> kept;
+    for (const auto& e : r.library) {
+      if (std::find(options.only_effects.begin(), options.only_effects.end(), e.key) != options.only_effects.end()) {
+        kept.push_back(e);
+      }
+    }
+    if (kept.empty()) {
+      throw MakeInputError("--effects", "", "none of the chosen effects is usable with these sets "
+                                           "(terrain, sequence or pose dimensions missing)");
+    }
+    r.library = kept;
+  }
   FitProblem problem = MakeFitProblem(real, r.sim_model, r.library, r.layout);
   std::vector<int> all_rows(real.size());
   for (int i = 0; i < real.size(); ++i) all_rows[i] = i;

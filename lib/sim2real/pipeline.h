@@ -23,6 +23,9 @@ struct Sim2RealOptions {
   LinearGaussianOptions model;
   SelectionOptions selection;
   LocateOptions locate;
+  // Restricts the data-level effect library to these keys (empty: all usable ones). An unknown
+  // key is an InputError naming the valid ones.
+  std::vector<std::string> only_effects;
   bool IsValid(std::string* error) const;
 };
 

@@ -107,7 +107,8 @@ TEST(Sim2RealApp, SlipPairRecalibratesFriction) {
   RunResult r = RunDgmm({"sim2real", "--sim", SourcePath("datasets/sim2real/sim.h5").string(),
                          "--real", SourcePath("datasets/sim2real/slip/real.h5").string(), "-o",
                          dir.string(), "--no-figures", "--bootstrap", "0", "--sim-config",
-                         SourcePath("datasets/sim2real/configs/nominal.json").string(), "--json"});
+                         SourcePath("datasets/sim2real/configs/nominal.json").string(), "--json",
+                         "--no-knobs", "--legacy-resim"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   json j = json::parse(r.out);
   ASSERT_TRUE(j.contains("recalibration"));
@@ -124,7 +125,8 @@ json RunRecalibration(const std::string& real, const std::string& name) {
   RunResult r = RunDgmm({"sim2real", "--sim", SourcePath("datasets/sim2real/sim.h5").string(),
                          "--real", SourcePath(real).string(), "-o", dir.string(), "--no-figures",
                          "--bootstrap", "0", "--sim-config",
-                         SourcePath("datasets/sim2real/configs/nominal.json").string(), "--json"});
+                         SourcePath("datasets/sim2real/configs/nominal.json").string(), "--json",
+                         "--no-knobs", "--legacy-resim"});
   EXPECT_EQ(r.exit_code, 0) << r.err;
   json j = json::parse(r.out, nullptr, /*allow_exceptions=*/false);
   if (j.is_discarded() || !j.contains("recalibration")) return json::object();

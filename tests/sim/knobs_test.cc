@@ -29,7 +29,7 @@ TEST(Knobs, BuiltInRobotHasEveryFamilyAndBothSides) {
   }
   EXPECT_EQ(legs, kNumLegs);
   EXPECT_EQ(sides, 2);
-  for (const char* f : {"friction", "contact", "mass", "payload", "actuator_gain", "joint_damping"}) {
+  for (const char* f : {"friction", "contact", "mass", "payload", "actuator_gain", "joint_damping", "latency"}) {
     EXPECT_TRUE(families.count(f)) << f;
   }
   EXPECT_TRUE(names.count("floor.solref.timeconst"));

@@ -207,3 +207,24 @@ TEST(RawUnits, UndoesTheTransformAndRefusesAMismatchedOne) {
 
 }  // namespace
 }  // namespace dgmm::sim2real
+
+namespace dgmm::sim2real {
+namespace {
+
+TEST(OnlyEffects, RestrictsTheLibraryAndRejectsUnknownKeys) {
+  const SampleSet sim = GenerateSynthetic(SyntheticWorld{}, "paper-830", 31);
+  const SampleSet real = GenerateSynthetic(SyntheticWorld{}, "paper", 1031);
+  Sim2RealOptions options;
+  options.selection.bootstrap_selection = 0;
+  options.selection.bootstrap_parameters = 10;
+  options.locate.mmd.permutations = 50;
+  options.only_effects = {"bias", "noise"};
+  const Sim2RealResult r = RunSim2Real(sim, real, options);
+  ASSERT_EQ(r.library.size(), 2u);
+  for (const auto& e : r.library) EXPECT_TRUE(e.key == "bias" || e.key == "noise");
+  options.only_effects = {"slip"};
+  EXPECT_THROW(RunSim2Real(sim, real, options), InputError);
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real
