@@ -170,6 +170,10 @@ def generate(args, pair, nominals):
         return
     os.makedirs(pdir, exist_ok=True)
     os.makedirs(tdir, exist_ok=True)
+    try:  # another battery process (e.g. --reverse) may be recording this pair
+        os.close(os.open(os.path.join(tdir, ".recording"), os.O_CREAT | os.O_EXCL))
+    except FileExistsError:
+        return
     cfg = absolute_config(robot, nominals[robot])
     for e in pair["effects"]:
         cfg = draw.merge(cfg, e["config"])
@@ -206,6 +210,7 @@ def generate(args, pair, nominals):
     truth["real_sim_wall_s"] = time.time() - t
     with open(os.path.join(tdir, "truth.json"), "w") as f:
         json.dump(truth, f, indent=2)
+    os.remove(os.path.join(tdir, ".recording"))
 
 
 def analyse(args, pair):
@@ -224,11 +229,21 @@ def analyse(args, pair):
            "--no-figures"]
     # The analysis's signature cache lives in OUT (a fresh OUT starts uncached).
     env = dict(os.environ, XDG_CACHE_HOME=os.path.join(args.out, "xdg-cache"))
+    if args.stop_at and time.time() >= args.stop_at:
+        return None, 0.0, "not started: --stop-at reached"
     t = time.time()
-    try:
-        run(cmd, env=env)
-    except RuntimeError as e:
-        return None, time.time() - t, str(e)
+    with open(os.path.join(pdir, "analysis.log"), "w") as logf:
+        proc = subprocess.Popen(["nice", "-n", "5"] + cmd, stdout=logf, stderr=subprocess.STDOUT,
+                                env=env)
+        while proc.poll() is None:
+            if args.stop_at and time.time() >= args.stop_at:
+                proc.kill()  # this analysis only (its own pid)
+                proc.wait()
+                return None, time.time() - t, "stopped at --stop-at"
+            time.sleep(1)
+    if proc.returncode != 0:
+        with open(os.path.join(pdir, "analysis.log")) as logf:
+            return None, time.time() - t, f"exit {proc.returncode}: {logf.read()[-500:]}"
     wall = time.time() - t
     with open(timing, "w") as g:
         json.dump({"wall_s": wall}, g)
@@ -240,7 +255,9 @@ def detectability(sim_path, real_path):
     """Method-free size of the planted change. Cells: command x heading sector (8 sectors of the
     terrain's (pitch, roll) direction). mean_shift_z: per cell and pose/terrain dimension a Welch z
     of the mean difference real - sim, summed as (chi2 - df) / sqrt(2 df) (about N(0, 1) when
-    nothing differs). spread_z: per dimension the log ratio of the within-cell standard deviations
+    nothing differs). consistent_z: the same z's combined per dimension as sum / sqrt(cells)
+    (a shift of one sign everywhere), largest |value| of the 8 dimensions (about 2 when nothing
+    differs). spread_z: per dimension the log ratio of the within-cell standard deviations
     over its standard error, largest |value| of the 8 dimensions (about 2 when nothing differs)."""
     def load(p):
         with h5py.File(p, "r") as f:
@@ -253,7 +270,7 @@ def detectability(sim_path, real_path):
         return c * 8 + sector
     ks, kr = cells(zs, cs), cells(zr, cr)
     chi2, df = 0.0, 0
-    res_s, res_r = [], []
+    res_s, res_r, zsum, cells_used = [], [], 0.0, 0
     for k in np.intersect1d(ks, kr):
         a, b = ys[ks == k], yr[kr == k]
         if len(a) < 3 or len(b) < 3:
@@ -262,14 +279,17 @@ def detectability(sim_path, real_path):
         res_r.append(b - b.mean(0))
         se = np.sqrt(a.var(0, ddof=1) / len(a) + b.var(0, ddof=1) / len(b))
         ok = se > 0
-        chi2 += float(np.sum(((b.mean(0) - a.mean(0))[ok] / se[ok]) ** 2))
+        z = np.where(ok, (b.mean(0) - a.mean(0)) / np.where(ok, se, 1), 0.0)
+        chi2 += float(np.sum(z ** 2))
         df += int(ok.sum())
+        zsum, cells_used = zsum + z, cells_used + 1
     if not df:
-        return {"mean_shift_z": None, "spread_z": None}
+        return {"mean_shift_z": None, "consistent_z": None, "spread_z": None}
     rs, rr = np.vstack(res_s), np.vstack(res_r)
     log_ratio = 0.5 * np.log(np.mean(rr ** 2, 0) / np.mean(rs ** 2, 0))
     se = np.sqrt(1 / (2 * len(rr)) + 1 / (2 * len(rs)))
     return {"mean_shift_z": (chi2 - df) / np.sqrt(2 * df),
+            "consistent_z": float(np.max(np.abs(zsum)) / np.sqrt(cells_used)),
             "spread_z": float(np.max(np.abs(log_ratio)) / se)}
 
 
@@ -333,11 +353,13 @@ def realism(args, nominals):
     sim_set(args, "scorpion")
     with cf.ThreadPoolExecutor(args.jobs) as pool:
         list(pool.map(lambda p: generate(args, p, nominals), pairs))
-    rows = ["| weakest planted change | mean shift z | spread z |", "|---|---|---|"]
+    rows = ["| weakest planted change | mean shift z | consistent shift z | spread z |",
+            "|---|---|---|---|"]
     for p in pairs:
         d = detectability(sim_set(args, "scorpion"),
                           os.path.join(args.out, "pairs", str(p["seed"]), "real.h5"))
-        rows.append(f"| {p['effects'][0]['what']} | {d['mean_shift_z']:.1f} | {d['spread_z']:.1f} |")
+        rows.append(f"| {p['effects'][0]['what']} | {d['mean_shift_z']:.1f} | "
+                    f"{d['consistent_z']:.1f} | {d['spread_z']:.1f} |")
     text = ("Generated by `scripts/sim2real_battery.py --seeds 900 --realism --write-doc` "
             "(real sets seeded 100900, ...; nominal sim set seed 100, 166 placements).\n\n"
             + "\n".join(rows) + "\n")
@@ -354,6 +376,20 @@ def write_section(name, text):
                    input=text, text=True, check=True)
 
 
+def find_key(obj, key):
+    """The first dict (depth first) in a parsed JSON holding `key`, or None."""
+    if isinstance(obj, dict):
+        if key in obj:
+            return obj
+        obj = list(obj.values())
+    if isinstance(obj, list):
+        for v in obj:
+            found = find_key(v, key)
+            if found is not None:
+                return found
+    return None
+
+
 def parse_seeds(text):
     a, _, b = text.partition("-")
     return list(range(int(a), int(b or a) + 1))
@@ -368,8 +404,13 @@ def main():
     ap.add_argument("--keep", action="store_true", help="keep the sets and analyses afterwards")
     ap.add_argument("--smoke", action="store_true", help="3 pairs, few placements (a quick check)")
     ap.add_argument("--generate-only", action="store_true", help="record the pairs, analyse none")
+    ap.add_argument("--reverse", action="store_true",
+                    help="record from the last seed down (a second recording process)")
     ap.add_argument("--realism", action="store_true",
                     help="plant the weakest end of every range and print its detectability")
+    ap.add_argument("--stop-at", default=None, metavar="HH:MM",
+                    help="UTC time after which no analysis starts and running ones are stopped "
+                         "(their pairs are listed as not analysed)")
     ap.add_argument("--rerun", action="store_true", help="rerun analyses already in OUT")
     ap.add_argument("--write-doc", action="store_true",
                     help="write the tables into docs/sim2real.md (section sim2real-battery)")
@@ -377,6 +418,11 @@ def main():
     if not 1 <= args.jobs <= 2:
         ap.error("--jobs: expected 1 or 2 (the machine has 2 cores)")
     seeds = parse_seeds(args.seeds)[: 3 if args.smoke else None]
+    if args.stop_at:
+        hh, mm = (int(v) for v in args.stop_at.split(":"))
+        now = time.gmtime()
+        args.stop_at = time.time() + ((hh * 60 + mm) - (now.tm_hour * 60 + now.tm_min)) * 60 \
+            - now.tm_sec
     args.out = os.path.abspath(args.out or os.path.join(ROOT, "out", f"battery-{args.seeds}"))
     args.dgmm = os.path.join(os.path.abspath(args.build), "app", "dgmm")
     if not os.access(args.dgmm, os.X_OK):
@@ -391,11 +437,12 @@ def main():
         sim_set(args, robot)
     log(f"generating {len(pairs)} pairs")
     with cf.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(lambda p: generate(args, p, nominals), pairs))
+        list(pool.map(lambda p: generate(args, p, nominals), pairs[::-1] if args.reverse else pairs))
     log(f"generated in {time.time() - t0:.0f} s")
     if args.generate_only:
         return 0
-    # The first analysis per robot runs alone: it fills the signature cache the others reuse.
+    # Built-in robot first, in seed order (its signature cache fills with the first analysis);
+    # then the second robot's pairs, in seed order.
     firsts = {}
     for p in pairs:
         firsts.setdefault(p["robot"], p["seed"])
@@ -415,17 +462,26 @@ def main():
             r["error"] = error
         else:
             r["score"] = score.score_pair(truth, report)
+            stats = find_key(report, "from_cache")
+            if stats is not None:
+                r["simulations"], r["from_cache"] = stats.get("simulations"), stats["from_cache"]
         results[p["seed"]] = r
         log(f"pair {p['seed']} ({p['robot']}, {p['kind']}): {wall:.0f} s")
-    for p in pairs:
-        if firsts[p["robot"]] == p["seed"]:
-            one(p)
+    order = sorted(pairs, key=lambda p: (p["robot"] != "scorpion", p["seed"]))
+    # The first analysis runs alone: two analyses on a cold cache would simulate the same
+    # signatures twice (each analysis simulates on 2 threads itself).
+    one(order[0])
     with cf.ThreadPoolExecutor(args.jobs) as pool:
-        list(pool.map(one, [p for p in pairs if firsts[p["robot"]] != p["seed"]]))
+        list(pool.map(one, order[1:]))
     ordered = [results[s] for s in seeds]
     summary = score.summarize(ordered)
-    command = "scripts/sim2real_battery.py " + " ".join(
-        a for a in sys.argv[1:] if not a.startswith("--out") and not a.startswith("--build"))
+    shown, skip = [], False
+    for a in sys.argv[1:]:  # the command line without the machine-specific folders
+        if skip or a.split("=")[0] in ("--out", "--build"):
+            skip = not skip and "=" not in a
+            continue
+        shown.append(a)
+    command = "scripts/sim2real_battery.py " + " ".join(shown)
     doc = tables.markdown(ordered, summary, command, smoke=args.smoke)
     out = {"seeds": args.seeds, "smoke": args.smoke, "summary": summary, "pairs": ordered}
     tmp = os.path.join(args.out, "results.json.tmp")

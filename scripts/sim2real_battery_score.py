@@ -155,8 +155,12 @@ def summarize(results):
     gaps = [r["score"]["gap_closed"] for r in scored
             if r["kind"] != "null" and r["score"].get("gap_closed") is not None]
     times = [r["analysis_wall_s"] for r in scored if r.get("analysis_wall_s") is not None]
-    first = [r["analysis_wall_s"] for r in scored if r.get("first_of_robot")]
-    cached = [r["analysis_wall_s"] for r in scored if not r.get("first_of_robot")]
+    # Uncached: the analysis simulated its signatures (nothing from the cache), when the report
+    # says so; else the first analysis per robot of this run.
+    uncached = lambda r: r["from_cache"] == 0 if r.get("from_cache") is not None \
+        else r.get("first_of_robot")
+    first = [r["analysis_wall_s"] for r in scored if uncached(r)]
+    cached = [r["analysis_wall_s"] for r in scored if not uncached(r)]
     return {
         "pairs": len(scored),
         "null_clean": _rate(r["score"]["clean"] for r in nulls),

@@ -60,7 +60,7 @@ class DrawTest(unittest.TestCase):
         for s in range(3000, 3400):
             for e in draw.draw_pair(s, n)["effects"]:
                 if e["family"] == "latency":
-                    self.assertTrue(0.01 <= e["value"] <= 0.06)
+                    self.assertTrue(0.04 <= e["value"] <= 0.1)
                 if e["family"] == "friction":
                     self.assertTrue(0.45 <= e["value"] <= 0.85 or 1.3 <= e["value"] <= 2.0)
                 if e["family"] == "tracker_noise":
