@@ -205,8 +205,12 @@ void SliceExplorer::StepY(int step) {
 void SliceExplorer::SetTerrain(int i, double value) {
   TerrainSlider& s = terrain_.at(static_cast<size_t>(i));
   if (!std::isfinite(value)) return;
+  if (!locked_window_) {
+    locked_window_ = window();
+    held_by_terrain_ = true;
+  }
   s.value = std::clamp(value, s.min, s.max);
-  Update();
+  Update(/*keep_window=*/true);
 }
 
 void SliceExplorer::ToggleConditioned() {
@@ -216,7 +220,7 @@ void SliceExplorer::ToggleConditioned() {
 
 void SliceExplorer::ScaleNearFraction(double factor) {
   near_fraction_ = std::clamp(near_fraction_ * factor, 0.01, 1.0);
-  Update();
+  Update(/*keep_window=*/true);
 }
 
 PlotRange SliceExplorer::window() const {
@@ -231,16 +235,21 @@ void SliceExplorer::Zoom(double factor, double x, double y) {
   if (!(factor > 0) || !std::isfinite(x) || !std::isfinite(y)) return;
   PlotRange z{x + (w.x_min - x) * factor, x + (w.x_max - x) * factor,
               y + (w.y_min - y) * factor, y + (w.y_max - y) * factor};
-  if (z.IsValid()) locked_window_ = z;
+  if (z.IsValid()) {
+    locked_window_ = z;
+    held_by_terrain_ = false;
+  }
 }
 
 void SliceExplorer::Pan(double fx, double fy) {
   PlotRange w = window();
   const double dx = fx * (w.x_max - w.x_min), dy = fy * (w.y_max - w.y_min);
   locked_window_ = PlotRange{w.x_min + dx, w.x_max + dx, w.y_min + dy, w.y_max + dy};
+  held_by_terrain_ = false;
 }
 
-void SliceExplorer::Update() {
+void SliceExplorer::Update(bool keep_window) {
+  if (held_by_terrain_ && !keep_window) ResetWindow();
   SliceSpec spec;
   spec.command = command_labels_[command_index_];
   spec.x_dim = names_[x_index_];

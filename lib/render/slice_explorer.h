@@ -62,7 +62,10 @@ class SliceExplorer {
   void StepY(int step);
 
   const std::vector<TerrainSlider>& terrain() const { return terrain_; }
-  void SetTerrain(int i, double value);  // clamped to the slider's span
+  // Clamped to the slider's span. The window is held while the terrain moves (the axes stay put
+  // and the density moves in them); a change of command, axes or conditioning frames it again
+  // unless the user zoomed or panned.
+  void SetTerrain(int i, double value);
   // Conditioned on the sliders (default) or marginal over the terrain.
   bool conditioned() const { return conditioned_; }
   void ToggleConditioned();
@@ -71,12 +74,16 @@ class SliceExplorer {
   double near_fraction() const { return near_fraction_; }
   void ScaleNearFraction(double factor);  // kept in [0.01, 1]
 
-  // The plot window: chosen as `dgmm render` does (SliceWindow) until zoomed or panned.
+  // The plot window: chosen as `dgmm render` does (SliceWindow) until zoomed, panned or held by a
+  // terrain move.
   PlotRange window() const;
   bool window_locked() const { return locked_window_.has_value(); }
   void Zoom(double factor, double x, double y);  // factor < 1 zooms in, about (x, y)
   void Pan(double fx, double fy);                // by fractions of the window's width, height
-  void ResetWindow() { locked_window_.reset(); }
+  void ResetWindow() {
+    locked_window_.reset();
+    held_by_terrain_ = false;
+  }
 
   // Current slices (A, then B) over the two shown dimensions.
   const std::vector<ModelSlice>& slices() const { return slices_; }
@@ -95,7 +102,9 @@ class SliceExplorer {
   std::vector<std::string> RenderArguments(const std::string& png) const;
 
  private:
-  void Update();  // recomputes slices and points after a change of picks
+  // Recomputes slices and points after a change of picks; a window held by a terrain move is
+  // released unless keep_window.
+  void Update(bool keep_window = false);
 
   ExplorerInputs in_;
   SliceFigureOptions figure_;
@@ -107,6 +116,7 @@ class SliceExplorer {
   bool conditioned_ = true, ellipses_ = false;
   double near_fraction_ = 0.1;
   std::optional<PlotRange> locked_window_;
+  bool held_by_terrain_ = false;  // locked_window_ set by SetTerrain, not by the user
   std::vector<ModelSlice> slices_;
   Eigen::MatrixX2d points_;
 };

@@ -165,6 +165,34 @@ TEST(SliceExplorerTest, RenderArgumentsCarryExactValuesAndTheZoomedWindow) {
   EXPECT_FALSE(explorer.window_locked());
 }
 
+// A terrain move holds the window (axes stay put while the density moves); the held window is
+// printed for `render` like a zoomed one, and a change of command frames the picture again.
+TEST(SliceExplorerTest, TerrainMovesHoldTheWindowUntilTheCommandChanges) {
+  SliceExplorer explorer(Inputs(false), {});
+  const TerrainSlider s = explorer.terrain()[0];
+  explorer.SetTerrain(0, s.min);
+  const PlotRange held = explorer.window();
+  EXPECT_TRUE(explorer.window_locked());
+  explorer.SetTerrain(0, s.max);
+  EXPECT_EQ(explorer.window().x_min, held.x_min);
+  EXPECT_EQ(explorer.window().y_max, held.y_max);
+  const auto args = explorer.RenderArguments("out.png");
+  EXPECT_NE(std::find(args.begin(), args.end(), "--window"), args.end());
+  // Re-framed at the same terrain, the automatic window differs from the held one.
+  explorer.ResetWindow();
+  const PlotRange framed = explorer.window();
+  EXPECT_FALSE(framed.x_min == held.x_min && framed.x_max == held.x_max &&
+               framed.y_min == held.y_min && framed.y_max == held.y_max);
+  explorer.SetTerrain(0, s.min);
+  explorer.StepCommand(1);
+  EXPECT_FALSE(explorer.window_locked());
+  // A user's zoom is not released by a change of command.
+  explorer.Zoom(0.5, 0, 0);
+  explorer.SetTerrain(0, s.max);
+  explorer.StepCommand(1);
+  EXPECT_TRUE(explorer.window_locked());
+}
+
 TEST(SliceExplorerTest, BadInputsNameTheFile) {
   ExplorerOptions options;
   options.x_dim = "pitch";  // terrain, not pose

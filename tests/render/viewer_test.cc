@@ -97,12 +97,9 @@ int DifferentPixels(const test::PngImage& a, const test::PngImage& b) {
 void RenderLikeTheCommand(const SliceExplorer& explorer, const std::vector<SliceSource>& sources,
                           const SliceFigureOptions& figure, const std::string& png) {
   std::vector<const ModelSlice*> slices;
-  std::vector<const Mixture*> mixtures;
-  for (const ModelSlice& s : explorer.slices()) {
-    slices.push_back(&s);
-    mixtures.push_back(&s.mixture);
-  }
-  const PlotRange window = SliceWindow(mixtures, explorer.points());
+  for (const ModelSlice& s : explorer.slices()) slices.push_back(&s);
+  // The automatic window, or the one `render --window` gets when zoomed or held by a slider.
+  const PlotRange window = explorer.window();
   const auto panels = SliceHeatMaps(slices, sources, explorer.points(), window, figure);
   if (panels.size() == 1) {
     RenderHeatMap(panels[0], png);
