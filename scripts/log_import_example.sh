@@ -20,15 +20,18 @@ cd "$root"
   --window 1.5 --drop-invalid -o "$out/walk.h5"
 "$dgmm" info "$out/walk.h5"
 
-# 2. The merge rate k with the best cross-validated held-out log-likelihood.
-"$dgmm" tune-k "$out/walk.h5" --folds 5 --repeats 2 --seed 1 | tee "$out/tune_k.txt"
-k=$(sed -n 's/^chosen k = \([^:]*\):.*/\1/p' "$out/tune_k.txt")
+# 2. k, the S0 scale and the prior strength with the best cross-validated held-out
+#    log-likelihood; the "fit with:" line carries all three as fit flags.
+"$dgmm" tune "$out/walk.h5" --folds 5 --repeats 2 --seed 1 | tee "$out/tune.txt"
+settings=$(sed -n 's/^fit with: dgmm fit .* \(--k .*\) -o model.h5$/\1/p' "$out/tune.txt")
+[ -n "$settings" ] || { echo "log_import_example: no 'fit with:' line from tune" >&2; exit 1; }
+read -r -a tuned <<< "$settings"
 
-# 3. Cross-validation at that k (DGMM and EM-BIC, with and without terrain).
-"$dgmm" cv "$out/walk.h5" --k "$k" --folds 5 --repeats 2 --seed 1 | tee "$out/cv.txt"
+# 3. Cross-validation at those settings (DGMM and EM-BIC, with and without terrain).
+"$dgmm" cv "$out/walk.h5" "${tuned[@]}" --folds 5 --repeats 2 --seed 1 | tee "$out/cv.txt"
 
 # 4. The model, and a heat map of p(dx, dy | command) per command with the samples on top.
-"$dgmm" fit "$out/walk.h5" --k "$k" --seed 1 -o "$out/walk_dgmm.h5"
+"$dgmm" fit "$out/walk.h5" "${tuned[@]}" --seed 1 -o "$out/walk_dgmm.h5"
 for command in forward back left right turn_left turn_right stop; do
   "$dgmm" render "$out/walk_dgmm.h5" --command "$command" --x-dim dx --y-dim dy --marginalise \
     --data "$out/walk.h5" --size 640x520 -o "$out/heat_$command.png"

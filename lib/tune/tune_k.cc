@@ -285,10 +285,40 @@ TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions:
                             Evaluator& evaluate, std::vector<TuneKPoint>* curve, bool* flat) {
   std::vector<TuneKPoint> pts = {start};
   const double kept = evaluate.dgmm().*field;
+  auto value_of = [&](const TuneKPoint& t) {
+    return field == &DgmmOptions::initial_covariance_fraction ? t.init_scale : t.prior_count;
+  };
   for (double value : grid) {
     if (value == kept) continue;  // the start point already has it
     evaluate.dgmm().*field = value;
     pts.push_back(evaluate(k, role));
+  }
+  // The grid is a guess at the data's needs, not a bound: while the best value is the grid's
+  // largest (smallest), step on geometrically by the grid's outer ratio, at most kMaxExtension
+  // steps, until a step is worse than the best. (On the shipped log the best S0 scale was the
+  // grid's top, 10, and the held-out likelihood kept rising beyond it.)
+  constexpr int kMaxExtension = 4;
+  std::vector<double> sorted = grid;
+  sorted.push_back(kept);
+  std::sort(sorted.begin(), sorted.end());
+  sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+  if (sorted.size() >= 2) {
+    for (int direction : {+1, -1}) {
+      const double ratio = direction > 0 ? sorted[sorted.size() - 1] / sorted[sorted.size() - 2]
+                                         : sorted[0] / sorted[1];
+      for (int step = 0; step < kMaxExtension; ++step) {
+        const auto best = std::max_element(pts.begin(), pts.end(), [](const auto& a, const auto& b) {
+          return a.log_likelihood < b.log_likelihood;
+        });
+        const auto extreme = std::minmax_element(
+            pts.begin(), pts.end(),
+            [&](const auto& a, const auto& b) { return value_of(a) < value_of(b); });
+        const TuneKPoint& edge = direction > 0 ? *extreme.second : *extreme.first;
+        if (value_of(*best) != value_of(edge)) break;
+        evaluate.dgmm().*field = value_of(edge) * ratio;
+        pts.push_back(evaluate(k, role));
+      }
+    }
   }
   const Plateau p = FindPlateau(pts, evaluate.Tolerance(pts));
   *flat = p.flat;

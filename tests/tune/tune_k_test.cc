@@ -122,6 +122,29 @@ TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
   EXPECT_EQ(s.components, 1.0);
 }
 
+// A grid of S0 scales far below what the data want: the best is the grid's top, so the tuner
+// steps on beyond it (by the grid's ratio) instead of reporting the edge as the optimum.
+TEST(TuneK, StepsBeyondAGridWhoseEdgeIsBest) {
+  const SampleSet set = test::MakeTerrainSet(2, 30, 1.0, 5);
+  TuneKOptions options;
+  options.cv.folds = 4;
+  options.cv.repeats = 1;
+  options.k_min = 0.1;
+  options.k_max = 10;
+  options.grid_points = 3;
+  options.refine_points = 1;
+  options.cycles = 1;
+  options.init_scales = {1e-4, 3e-4};
+  options.cv.dgmm.initial_covariance_fraction = 1e-4;  // the start is on the grid too
+  options.prior_counts.clear();
+  const TuneKSummary s = TuneK(set, options);
+  ASSERT_TRUE(s.init_scale_tuned);
+  double largest = 0;
+  for (const auto& p : s.scale_curve) largest = std::max(largest, p.init_scale);
+  EXPECT_GT(largest, 3e-4 * 2);  // evaluated beyond the grid
+  EXPECT_GT(s.init_scale, 3e-4 * 2) << "chose the grid's edge";
+}
+
 TEST(TuneK, RejectsBadOptions) {
   const SampleSet set = test::MakeTerrainSet(2, 10, 1.0, 5);
   TuneKOptions options;
