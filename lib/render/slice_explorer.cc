@@ -338,7 +338,9 @@ std::string SliceExplorer::Status() const {
     text += "  | " + std::to_string(points_.rows()) + " samples";
     if (conditioned_ && !terrain_.empty()) text += " within " + Number(100 * near_fraction_) + "%";
   }
-  text += window_locked() ? "  | window: zoomed" : "  | window: auto";
+  text += !window_locked()   ? "  | window: auto"
+          : held_by_terrain_ ? "  | window: held (r: re-frame)"
+                             : "  | window: zoomed";
   return text;
 }
 
