@@ -465,6 +465,7 @@ def main():
             stats = find_key(report, "from_cache")
             if stats is not None:
                 r["simulations"], r["from_cache"] = stats.get("simulations"), stats["from_cache"]
+                r["signature_simulations"] = stats.get("signature_simulations")
         results[p["seed"]] = r
         log(f"pair {p['seed']} ({p['robot']}, {p['kind']}): {wall:.0f} s")
     order = sorted(pairs, key=lambda p: (p["robot"] != "scorpion", p["seed"]))

@@ -148,6 +148,8 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
   SimulationBatch batch = SimulateBatch(config, protocol, seed, knobs, requests, options.signatures);
   out.simulations = batch.simulated;
   out.from_cache = batch.from_cache;
+  out.signature_simulations = batch.simulated;
+  out.signature_requests = static_cast<int>(requests.size());
   out.signature_seconds = batch.wall_seconds;
   out.placements = options.signatures.placements;
   out.cache_dir = options.signatures.cache_dir.empty() ? DefaultCacheDir() : options.signatures.cache_dir;
@@ -533,6 +535,8 @@ std::string KnobAnalysisJson(const KnobAnalysis& a) {
               {"residual_tests", tests},
               {"simulations", a.simulations},
               {"from_cache", a.from_cache},
+              {"signature_simulations", a.signature_simulations},
+              {"signature_requests", a.signature_requests},
               {"placements_per_simulation", a.placements},
               {"cache_dir", a.cache_dir},
               {"signature_seconds", a.signature_seconds},

@@ -46,6 +46,8 @@ struct KnobAnalysis {
   std::vector<int> selected;              // candidate indices, by importance
   ResidualStructure residual;
   int simulations = 0, from_cache = 0, placements = 0;
+  // Of those, the signature stage's (nominal + probes): 0 simulated = "signatures cached".
+  int signature_simulations = 0, signature_requests = 0;
   double signature_seconds = 0, refine_seconds = 0, seconds = 0;
   std::string cache_dir;
   std::vector<std::pair<double, double>> refine_trace;  // (value simulated, fitted coefficient)
