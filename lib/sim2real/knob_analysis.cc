@@ -494,14 +494,17 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
                Fmt(" about %.0f times", t.experiment.executions);
         }
       }
-      s += ";";
+      if (k + 1 < v.named.size()) s += ";";
     }
   }
+  if (s.back() != '.') s += ".";
   if (v.unexplained_present) {
     s += " The residual is structured in";
-    for (const auto& w : v.structured_in) s += " " + w;
+    for (size_t w = 0; w < v.structured_in.size(); ++w) {
+      s += (w == 0 ? " " : ", ") + v.structured_in[w];
+    }
+    s += ".";
   }
-  s += ".";
   v.sentence = s;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
