@@ -19,6 +19,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "render/heat_map_chart.h"
 #include "render/text_fit.h"
@@ -139,6 +140,47 @@ vtkSmartPointer<vtkTable> CurveSegments(const CurveOverlay& curve) {
   return table;
 }
 
+// At most about `max_ticks` ticks at round values (1, 2, 2.5 or 5 times a power of ten) inside
+// [lo, hi], labelled with just the decimals the step needs. VTK's automatic ticks put up to ~20
+// labels on an axis; a panel then drew ~50 distinct strings, the size of the OpenGL device's
+// text texture cache, so every redraw of `dgmm view` re-rasterised all of them (perf: a fifth of
+// a slider move). Fewer, rounder labels also read better.
+void SetRoundTicks(vtkAxis* axis, double lo, double hi, int max_ticks) {
+  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return;
+  const double raw = (hi - lo) / std::max(2, max_ticks);
+  const double power = std::pow(10.0, std::floor(std::log10(raw)));
+  double step = 10 * power;
+  for (double m : {1.0, 2.0, 2.5, 5.0}) {
+    if (m * power >= raw) {
+      step = m * power;
+      break;
+    }
+  }
+  int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
+  if (std::abs(step / std::pow(10.0, -decimals) - std::round(step / std::pow(10.0, -decimals))) >
+      1e-6) {
+    ++decimals;  // 2.5 x 10^e needs one more digit
+  }
+  auto positions = vtkSmartPointer<vtkDoubleArray>::New();
+  auto labels = vtkSmartPointer<vtkStringArray>::New();
+  for (double t = std::ceil(lo / step - 1e-9) * step; t <= hi + 1e-9 * step; t += step) {
+    const double v = std::abs(t) < 1e-12 * step ? 0.0 : t;
+    char text[64];
+    std::snprintf(text, sizeof text, "%.*f", decimals, v);
+    positions->InsertNextValue(v);
+    labels->InsertNextValue(text);
+  }
+  axis->SetCustomTickPositions(positions, labels);
+}
+
+// The axis of a colour legend (a child item of vtkColorLegend), or nullptr.
+vtkAxis* LegendAxis(vtkColorLegend* legend) {
+  for (vtkIdType i = 0; i < legend->GetNumberOfItems(); ++i) {
+    if (auto* axis = vtkAxis::SafeDownCast(legend->GetItem(i))) return axis;
+  }
+  return nullptr;
+}
+
 // Ticks at the centres of equal blocks over [lo, hi], labelled with the names.
 void SetCategories(vtkAxis* axis, const std::vector<std::string>& names, double lo, double hi) {
   auto positions = vtkSmartPointer<vtkDoubleArray>::New();
@@ -230,6 +272,9 @@ vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
   }
   if (auto* legend = vtkColorLegend::SafeDownCast(chart->GetLegend())) {
     legend->SetTitle(raster.value_label);
+    if (vtkAxis* axis = LegendAxis(legend)) {
+      SetRoundTicks(axis, raster.lo, raster.hi, std::max(4, spec.height / 50));
+    }
   }
   chart->SetShowLegend(true);
   // The legend takes about 110 px on the right; the title is centred on the whole image.
@@ -282,8 +327,16 @@ vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
   for (vtkAxis* axis : {x_axis, y_axis}) axis->SetBehavior(vtkAxis::FIXED);
   x_axis->SetRange(bg.range.x_min, bg.range.x_max);
   y_axis->SetRange(bg.range.y_min, bg.range.y_max);
-  if (!spec.x_categories.empty()) SetCategories(x_axis, spec.x_categories, bg.range.x_min, bg.range.x_max);
-  if (!spec.y_categories.empty()) SetCategories(y_axis, spec.y_categories, bg.range.y_min, bg.range.y_max);
+  if (!spec.x_categories.empty()) {
+    SetCategories(x_axis, spec.x_categories, bg.range.x_min, bg.range.x_max);
+  } else {
+    SetRoundTicks(x_axis, bg.range.x_min, bg.range.x_max, std::max(4, spec.width / 80));
+  }
+  if (!spec.y_categories.empty()) {
+    SetCategories(y_axis, spec.y_categories, bg.range.y_min, bg.range.y_max);
+  } else {
+    SetRoundTicks(y_axis, bg.range.y_min, bg.range.y_max, std::max(4, spec.height / 50));
+  }
 
   return chart;
 }
