@@ -3,7 +3,11 @@
 
 Usage: multimodality.py [--set S.h5] [--dgmm EXE] [--tune-with T.json] [--tune-without T.json]
                         [--bootstrap B] [--restarts R] [--fit-seeds N] [--alpha A] [--seed S]
-                        [--section OUT.md]
+                        [--planar-dims dx,dy,dyaw] [--section OUT.md] [--json-out OUT.json]
+                        [--from-json IN.json] [--write-doc]
+The doc's section: multimodality.py --write-doc --json-out docs/figures/table1/multimodality.json
+(about 15 min on two shared cores with the defaults; --from-json IN.json --write-doc rewrites the
+text alone).
 
 The test does not use the episode (placement) labels or the DGMM. Per command, on the pose
 change x (n samples, d dimensions):
