@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <numeric>
@@ -195,12 +196,19 @@ nlohmann::json RunVariant(const ExperimentArgs& a, const std::string& variant,
     ReportProgress(variant + " MISE runs", static_cast<long long>(ise.size()), a.runs);
   }
   WriteText(fs::path(a.out_dir) / (variant + "_mise_runs.csv"), runs_csv);
+  // How all fits at k ended: number of Gaussians -> number of fits (with --runs above
+  // --max-attempts this is a fixed number of shuffles, free of the stop-at-`runs` rule).
+  std::map<int, int> histogram;
+  for (double c : all_counts) ++histogram[static_cast<int>(c)];
+  nlohmann::json components_histogram = nlohmann::json::array();
+  for (const auto& [components, fits] : histogram) components_histogram.push_back({components, fits});
   out["mise"] = {{"k", a.k},
                  {"target_components", a.target},
                  {"runs", ise.size()},
                  {"attempts", attempts},
                  {"fraction_with_target", ise.size() / double(std::max(1, attempts))},
                  {"mean_components_all_attempts", Mean(all_counts)},
+                 {"components_histogram", components_histogram},
                  {"mean", Mean(ise)},
                  {"sd", Sd(ise)},
                  {"median", Quantile(ise, 0.5)},

@@ -34,6 +34,17 @@ echo "== k sweep, MISE runs and cross-validation (faithful and improved)" >&2
   --variants faithful-blend,improved-prior --init-cov identity --prior-count 1 --k 0.7 --grid-points 19 --seeds-per-k 50 --runs 100 \
   --target 2 --folds 10 --cv-seeds 10 --seed 1 --json > "$work/summary.json"
 
+echo "== raw units (minutes): how often a run at k = 0.7 ends with 1, 2, 3, ... Gaussians" >&2
+# A genuine raw-unit fit (no standardisation), the paper's S0 = I, a fixed number of shuffles
+# (--runs above --max-attempts: no stop at the 100th 2-Gaussian run); sweep and CV kept minimal.
+"$dgmm" import "$root/datasets/old_faithful.csv" -o "$work/raw.h5" --pose-cols eruptions,waiting >/dev/null
+"$dgmm" em "$work/raw.h5" -o "$work/em_raw.h5" --components 2 --n-init 10 --seed 1 >/dev/null
+mkdir -p "$work/raw"
+"$dgmm" experiment old-faithful "$work/raw.h5" --em "$work/em_raw.h5" --out-dir "$work/raw" \
+  --variants faithful-literal,faithful-blend,improved-prior --init-cov identity --prior-count 1 \
+  --k 0.7 --grid-points 2 --seeds-per-k 1 --runs 1000000 --max-attempts "${RAW_FITS:-400}" \
+  --target 2 --folds 2 --cv-seeds 1 --seed 1 --json > "$work/raw/summary.json"
+
 echo "== figures" >&2
 python3 "$root/scripts/old_faithful_report.py" join "$work" > "$work/k_sweep.csv"
 xvfb "$dgmm" plot --csv "$work/k_sweep.csv" --x k --y faithful-blend_mean,improved-prior_mean \

@@ -136,10 +136,11 @@ are chosen by cross-validation. The table shows whether, with it, the estimation
 extra dimensions falls below what terrain explains (the sign the paper reports). The tuned models
 use one Gaussian per command when `dgmm tune` reports a plateau over k: with 10–30 samples per
 command cross-validation finds no mixture better than one well-regularised Gaussian, so it keeps
-the simplest. Whether any command is truly multimodal cannot be told from these sets: EM-BIC may
-only try as many parameters as samples (one 6-D Gaussian has 27, a second one needs 28 more), so
-it can only return one component, and its unregularised plug-in covariance is what collapses in
-its rows when whole placements are held out.
+the simplest. EM-BIC may only try as many parameters as samples (one 6-D Gaussian has 27, a
+second one needs 28 more), so it can only return one component, and its unregularised plug-in
+covariance is what collapses in its rows when whole placements are held out. Which commands are
+multimodal, tested apart from both models, and why folds by episode reward one Gaussian there:
+section multimodality below (`scripts/multimodality.py`).
 
 **Why the absolute values differ from the paper's.** A log-likelihood of continuous data is not
 unit-free: scaling one dimension by s shifts every sample's log-density by −log s. Our pose change

@@ -72,5 +72,33 @@ TEST_F(MiseCommandTest, MismatchedOrMissingModelsAreErrors) {
   EXPECT_NE(r.exit_code, 0);
 }
 
+// The hidden `experiment old-faithful` reports how all fits at k ended: with --runs above
+// --max-attempts exactly --max-attempts shuffles, each counted once under its number of Gaussians,
+// and the 2-Gaussian count equals the MISE runs.
+TEST_F(MiseCommandTest, ExperimentCountsHowEveryFitEnded) {
+  const fs::path out = *dir_ / "experiment";
+  fs::create_directories(out);
+  ASSERT_EQ(RunDgmm({"em", P("of.h5"), "-o", P("em.h5"), "--components", "2", "--seed", "1"})
+                .exit_code, 0);
+  RunResult r = RunDgmm({"--quiet", "experiment", "old-faithful", P("of.h5"), "--em", P("em.h5"),
+                         "--out-dir", out.string(), "--variants", "faithful-literal", "--k", "0.7",
+                         "--grid-points", "2", "--seeds-per-k", "1", "--runs", "1000",
+                         "--max-attempts", "60", "--folds", "2", "--cv-seeds", "1", "--json"});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json mise = nlohmann::json::parse(r.out)["faithful-literal"]["mise"];
+  int total = 0, twos = 0, previous = 0;
+  for (const auto& entry : mise["components_histogram"]) {
+    const int components = entry[0].get<int>(), fits = entry[1].get<int>();
+    EXPECT_GT(components, previous);  // ascending, each number once
+    EXPECT_GT(fits, 0);
+    previous = components;
+    total += fits;
+    if (components == 2) twos = fits;
+  }
+  EXPECT_EQ(total, 60);
+  EXPECT_EQ(mise["attempts"].get<int>(), 60);
+  EXPECT_EQ(twos, mise["runs"].get<int>());
+}
+
 }  // namespace
 }  // namespace dgmm::test
