@@ -24,14 +24,32 @@ std::string VerdictJson(const Verdict& v) {
   }
   json ties = json::array();
   for (const auto& t : v.ties) {
-    ties.push_back({{"families", t.families},
-                    {"why", t.why},
-                    {"experiment",
-                     {{"commands", t.experiment.commands},
-                      {"terrain", t.experiment.terrain},
-                      {"executions", t.experiment.executions},
-                      {"separation_per_execution", t.experiment.separation},
-                      {"checked_by_simulation", t.experiment.checked_by_simulation}}}});
+    const VerdictExperiment& e = t.experiment;
+    json experiment = {{"commands", e.commands},
+                       {"terrain", e.terrain},
+                       {"executions", e.executions},
+                       {"separation_per_execution", e.separation},
+                       {"checked_by_simulation", e.checked_by_simulation},
+                       {"confirmed", e.checked_by_simulation ? json(e.confirmed) : json(nullptr)},
+                       {"not_checked_because", e.checked_by_simulation ? json(nullptr) : json(e.not_checked_because)}};
+    if (e.checked_by_simulation) {
+      experiment["simulation"] = {{"knobs", e.simulated_knobs},
+                                  {"values", e.simulated_values},
+                                  {"executions", e.executions_simulated},
+                                  {"placements", e.placements},
+                                  {"seed", e.seed},
+                                  {"heading_deg", e.heading_deg},
+                                  {"spread_scale", e.spread_scale},
+                                  {"separation_per_execution", e.simulated_separation},
+                                  {"z", e.z},
+                                  {"z_required", e.z_required},
+                                  {"p_value", e.p_value},
+                                  {"executions_needed", e.executions_needed < 0 ? json(nullptr) : json(e.executions_needed)},
+                                  {"seconds", e.seconds}};
+    } else {
+      experiment["simulation"] = nullptr;
+    }
+    ties.push_back({{"families", t.families}, {"why", t.why}, {"experiment", experiment}});
   }
   json out = {{"status", v.status},
               {"named", named},
