@@ -139,4 +139,23 @@ ExperimentCheck CheckExperiment(const sim::SimConfig& config, const std::vector<
   return out;
 }
 
+void RecordCheck(const ExperimentCheck& check, double z_required, VerdictExperiment* ex) {
+  ex->checked_by_simulation = check.checked;
+  ex->not_checked_because = check.why_not;
+  ex->confirmed = check.confirmed;
+  ex->simulated_knobs = check.knobs;
+  ex->simulated_values = check.values;
+  ex->executions_simulated = check.executions_simulated;
+  ex->placements = check.placements;
+  ex->seed = check.seed;
+  ex->heading_deg = check.heading_rad * 180.0 / M_PI;
+  ex->spread_scale = check.spread_scale;
+  ex->simulated_separation = check.separation.d2;
+  ex->z = check.separation.z;
+  ex->z_required = z_required;
+  ex->p_value = check.separation.p_value;
+  ex->executions_needed = check.separation.executions_needed;
+  ex->seconds = check.seconds;
+}
+
 }  // namespace dgmm::sim2real

@@ -10,6 +10,7 @@
 
 #include "sim/knobs.h"
 #include "sim/sim_config.h"
+#include "sim2real/verdict.h"
 
 namespace dgmm::sim2real {
 
@@ -65,5 +66,8 @@ ExperimentCheck CheckExperiment(const sim::SimConfig& config, const std::vector<
                                 const sim::KnobValue& a, const sim::KnobValue& b, const Eigen::Vector3d& command,
                                 double pitch_rad, double roll_rad, int proposed_executions,
                                 const ExperimentCheckOptions& options, double spread_scale = 1.0);
+
+// Writes the check into the verdict's experiment (checked_by_simulation, confirmed, simulation).
+void RecordCheck(const ExperimentCheck& check, double z_required, VerdictExperiment* experiment);
 
 }  // namespace dgmm::sim2real

@@ -511,22 +511,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
                             base.terrain_centres(best_t, pitch_col), base.terrain_centres(best_t, roll_col),
                             ex.executions, options.experiment, std::max(1.0, std::exp(final_fit.log_tau)));
         ++out.experiment_checks;
-        ex.checked_by_simulation = check.checked;
-        ex.not_checked_because = check.why_not;
-        ex.confirmed = check.confirmed;
-        ex.simulated_knobs = check.knobs;
-        ex.simulated_values = check.values;
-        ex.executions_simulated = check.executions_simulated;
-        ex.placements = check.placements;
-        ex.seed = check.seed;
-        ex.heading_deg = check.heading_rad * 180.0 / M_PI;
-        ex.spread_scale = check.spread_scale;
-        ex.simulated_separation = check.separation.d2;
-        ex.z = check.separation.z;
-        ex.z_required = options.experiment.z_required;
-        ex.p_value = check.separation.p_value;
-        ex.executions_needed = check.separation.executions_needed;
-        ex.seconds = check.seconds;
+        RecordCheck(check, options.experiment.z_required, &ex);
       } catch (const InputError& e) {
         ex.not_checked_because = std::string("simulation failed: ") + e.what();
       }
@@ -563,23 +548,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
         for (size_t f = 1; f < t.families.size(); ++f) s += " " + t.families[f];
         s += " on these data (" + t.why + ")";
         if (!t.experiment.commands.empty()) {
-          const VerdictExperiment& e = t.experiment;
-          s += "; to separate them, record command " + e.commands[0] + " on " + e.terrain[0] +
-               Fmt(" about %.0f times", e.executions);
-          if (!e.checked_by_simulation) {
-            s += " (not checked by simulation: " + e.not_checked_because + ")";
-          } else if (e.confirmed) {
-            s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the proposed experiment separates "
-                     "them, z %.1f >= %.2f", e.executions_simulated, e.z, e.z_required) + Fmt(", p %.3g)", e.p_value);
-          } else if (e.executions_needed < 0) {
-            s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the two make no measurable "
-                     "difference in that cell, p %.3g; the proposed experiment would not separate them)",
-                     e.executions_simulated, e.p_value);
-          } else {
-            s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the proposed experiment would not "
-                     "separate them, z %.1f (needed %.2f)", e.executions_simulated, e.z, e.z_required) +
-                 Fmt(", p %.3g; more executions needed: %.0f)", e.p_value, e.executions_needed);
-          }
+          s += "; to separate them, " + DescribeExperiment(t.experiment);
         }
       }
       s += ";";

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -12,7 +13,33 @@ using json = nlohmann::json;
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[300];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
 }  // namespace
+
+std::string DescribeExperiment(const VerdictExperiment& e) {
+  if (e.commands.empty() || e.terrain.empty()) return "";
+  std::string s = "record command " + e.commands[0] + " on " + e.terrain[0] + Fmt(" about %.0f times", e.executions);
+  if (!e.checked_by_simulation) {
+    s += " (not checked by simulation: " + e.not_checked_because + ")";
+  } else if (e.confirmed) {
+    s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the proposed experiment separates "
+             "them, z %.1f >= %.2f", e.executions_simulated, e.z, e.z_required) + Fmt(", p %.3g)", e.p_value);
+  } else if (e.executions_needed < 0) {
+    s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the two make no measurable "
+             "difference in that cell, p %.3g; the proposed experiment would not separate them)",
+             e.executions_simulated, e.p_value);
+  } else {
+    s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the proposed experiment would not "
+             "separate them, z %.1f (needed %.2f)", e.executions_simulated, e.z, e.z_required) +
+         Fmt(", p %.3g; more executions needed: %.0f)", e.p_value, e.executions_needed);
+  }
+  return s;
+}
 
 std::string VerdictJson(const Verdict& v) {
   json named = json::array();

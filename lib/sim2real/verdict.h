@@ -52,6 +52,11 @@ struct Verdict {
   std::string sentence;   // one plain-language paragraph for the conclusion
 };
 
+// The experiment in words, for the conclusion: "record command C on T about N times (checked by
+// simulation, ...: the proposed experiment separates them / would not separate them ...; more
+// executions needed: M)" or "(not checked by simulation: why)". Empty when no cell was proposed.
+std::string DescribeExperiment(const VerdictExperiment& e);
+
 // JSON text of the verdict object (contract of docs/sim2real.md).
 std::string VerdictJson(const Verdict& v);
 

@@ -151,6 +151,16 @@ TEST(Verdict, ExperimentCheckFieldsInTheJson) {
   EXPECT_EQ(checked["simulation"]["executions_needed"], 40);
   EXPECT_EQ(checked["simulation"]["seed"], 5);
   EXPECT_EQ(checked["executions"], 9);  // the agreed fields stay
+  // The conclusion never claims more than measured.
+  EXPECT_NE(DescribeExperiment(v.ties[0].experiment).find("not checked by simulation: x"), std::string::npos);
+  const std::string refuted = DescribeExperiment(v.ties[1].experiment);
+  EXPECT_NE(refuted.find("would not separate them"), std::string::npos);
+  EXPECT_NE(refuted.find("more executions needed: 40"), std::string::npos);
+  v.ties[1].experiment.confirmed = true;
+  EXPECT_NE(DescribeExperiment(v.ties[1].experiment).find("separates them"), std::string::npos);
+  v.ties[1].experiment.confirmed = false;
+  v.ties[1].experiment.executions_needed = -1;
+  EXPECT_NE(DescribeExperiment(v.ties[1].experiment).find("no measurable difference"), std::string::npos);
 }
 
 }  // namespace
