@@ -37,6 +37,7 @@ struct Sim2RealArgs {
   bool no_figures = false;
   bool legacy_resim = false;
   bool no_knobs = false;
+  bool no_experiment_check = false;
 };
 
 void WriteText(const std::filesystem::path& path, const std::string& text) {
@@ -106,6 +107,8 @@ void Run(const Sim2RealArgs& args) {
     ko.selection = options.selection;
     ko.signatures.cache_dir = args.cache;
     ko.signatures.placements = args.signature_placements;
+    ko.experiment.enabled = !args.no_experiment_check;
+    ko.experiment.seed = args.seed;
     const sim::SimConfig config = sim::LoadSimConfig(args.sim_config);  // a bad config is the user's error
     try {
       const sim2real::KnobAnalysis knobs = sim2real::AnalyseKnobs(sim, real, config, result, ko);
@@ -183,6 +186,9 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--no-knobs", args->no_knobs,
                 "with --sim-config, skip the simulator-knob analysis (the verdict then comes from the "
                 "data-level effects)");
+  cmd->add_flag("--no-experiment-check", args->no_experiment_check,
+                "with --sim-config, do not simulate the discriminating experiment proposed for a tie of two "
+                "simulator knobs (report.json verdict.ties[].experiment.checked_by_simulation stays false)");
   cmd->add_flag("--legacy-resim", args->legacy_resim,
                 "with --sim-config, also run the scans of the data-level effects (friction, payload, "
                 "leg gain; report.json \"recalibration\", recalibrated_config.json)");

@@ -143,19 +143,17 @@ std::string SimSummary::BriefReport() const {
   return out.str();
 }
 
-SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
-                           const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit) {
-  std::string error;
-  if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
-  if (!options.IsValid(&error)) throw MakeInputError("protocol options", "", error);
+namespace {
+
+// Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
+// set (command table already filled), its metadata and the summary.
+void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std::vector<Placement>& plan,
+             std::mt19937_64& rng, const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit,
+             SampleSet* out) {
   const auto wall_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   Simulator sim(config, edit);
-  std::mt19937_64 rng(options.seed);
-
-  SampleSet set;
-  FillCommandTable(&set);
-  const std::vector<Placement> plan = PlanPlacements(options, set.num_commands(), rng);
+  SampleSet& set = *out;
   const int reps = options.executions_per_placement;
 
   std::vector<int> command, episode, step;
@@ -201,7 +199,6 @@ SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& optio
     if (!kept) ++sum.abandoned_placements;
     if (progress) progress(p + 1, static_cast<long long>(plan.size()));
   }
-
   const int n = static_cast<int>(xs.size());
   set.command.resize(n);
   set.episode.resize(n);
@@ -243,7 +240,77 @@ SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& optio
   meta["z_frame"] = "IMU pitch/roll relative to gravity before each execution; pitch > 0 nose "
                     "down, roll > 0 left side up";
   if (summary) *summary = sum;
+}
+
+}  // namespace
+
+
+SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
+                           const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit) {
+  std::string error;
+  if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
+  if (!options.IsValid(&error)) throw MakeInputError("protocol options", "", error);
+  std::mt19937_64 rng(options.seed);
+  SampleSet set;
+  FillCommandTable(&set);
+  const std::vector<Placement> plan = PlanPlacements(options, set.num_commands(), rng);
+  RunPlan(config, options, plan, rng, progress, summary, edit, &set);
   return set;
+}
+
+SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSummary* summary,
+                       const ModelEdit& edit) {
+  std::string error;
+  if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
+  ProtocolOptions options;
+  options.seed = cell.seed;
+  options.executions_per_placement = cell.executions_per_placement;
+  options.placements = cell.placements;
+  if (!options.IsValid(&error) || cell.placements < 1 || !std::isfinite(cell.heading_rad)) {
+    throw MakeInputError("cell options", "", error.empty() ? "placements >= 1 and a finite heading" : error);
+  }
+  std::mt19937_64 rng(cell.seed);
+  SampleSet set;
+  FillCommandTable(&set);
+  int row = -1;
+  for (int c = 0; c < set.num_commands(); ++c) {
+    if ((set.commands.row(c).transpose() - cell.command).norm() < 1e-9) row = c;
+  }
+  if (row < 0) {
+    // Not a protocol command: a one-row table of its own.
+    set.commands = cell.command.transpose();
+    set.command_labels = {"cell"};
+    row = 0;
+  }
+  std::uniform_real_distribution<double> position(-1.0, 1.0);
+  std::vector<Placement> plan(cell.placements);
+  for (auto& p : plan) {
+    p.command = row;
+    p.heading_rad = cell.heading_rad;
+    p.x_m = position(rng);
+    p.y_m = position(rng);
+  }
+  RunPlan(config, options, plan, rng, {}, summary, edit, &set);
+  set.metadata["protocol"] = "cell";
+  return set;
+}
+
+double HeadingForTerrain(const SimConfig& config, double pitch_rad, double roll_rad, int headings,
+                         const ModelEdit& edit) {
+  if (headings < 1 || !std::isfinite(pitch_rad) || !std::isfinite(roll_rad)) {
+    throw MakeInputError("terrain", "", "headings >= 1 and a finite pitch and roll");
+  }
+  Simulator sim(config, edit);
+  double best = 0, best_d = INFINITY;
+  for (int h = 0; h < headings; ++h) {
+    const double heading = -kPi + 2 * kPi * h / headings;
+    if (sim.Place(0.0, 0.0, heading) != RunOutcome::kCompleted) continue;
+    const Eigen::Vector2d z = sim.TruePitchRoll();
+    const double d = std::hypot(z[0] - pitch_rad, z[1] - roll_rad);
+    if (d < best_d) best_d = d, best = heading;
+  }
+  if (!std::isfinite(best_d)) throw MakeInputError("terrain", "", "the robot fell at every heading");
+  return best;
 }
 
 }  // namespace dgmm::sim

@@ -64,4 +64,28 @@ SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& optio
                            const ProgressFn& progress = {}, SimSummary* summary = nullptr,
                            const ModelEdit& edit = {});
 
+
+// One command x terrain cell of a discriminating experiment (docs/sim2real.md, "The experiment
+// check"): `placements` placements at seeded random positions on the slope, all at one heading,
+// each repeating `command` executions_per_placement times.
+struct CellOptions {
+  Eigen::Vector3d command = Eigen::Vector3d::Zero();  // (long, lat, turn)
+  double heading_rad = 0;  // slope frame, 0 = facing uphill
+  int placements = 4;
+  int executions_per_placement = 5;
+  std::uint64_t seed = 0;
+};
+
+// Runs one cell; the same options and seed draw the same positions and sensor noise, so two runs
+// differing only in physics (`edit`, the config) are paired. The set has the protocol's command
+// table (or a one-row table when `command` is not one of its rows) and metadata protocol "cell".
+// Throws InputError for an invalid config or options.
+SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSummary* summary = nullptr,
+                       const ModelEdit& edit = {});
+
+// The heading (slope frame) whose settled standing pose has the IMU (pitch, roll) closest to the
+// given one, among `headings` evenly spaced headings (the robot placed at the slope's centre).
+double HeadingForTerrain(const SimConfig& config, double pitch_rad, double roll_rad, int headings = 24,
+                         const ModelEdit& edit = {});
+
 }  // namespace dgmm::sim

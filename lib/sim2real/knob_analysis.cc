@@ -87,11 +87,12 @@ double Cosine(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
 }  // namespace
 
 bool KnobAnalysisOptions::IsValid(std::string* error) const {
-  if (!(tie_correlation > 0 && tie_correlation <= 1) || refine_iterations < 0) {
-    if (error) *error = "0 < tie_correlation <= 1 and refine_iterations >= 0";
+  if (!(tie_correlation > 0 && tie_correlation <= 1) || refine_iterations < 0 || max_experiment_checks < 0) {
+    if (error) *error = "0 < tie_correlation <= 1, refine_iterations >= 0, max_experiment_checks >= 0";
     return false;
   }
-  return signatures.IsValid(error) && selection.IsValid(error) && residual.IsValid(error);
+  return signatures.IsValid(error) && selection.IsValid(error) && residual.IsValid(error) &&
+         experiment.IsValid(error);
 }
 
 std::vector<int> TiedCandidates(const FitProblem& fp, const SelectionStep& step, int chosen,
@@ -258,6 +259,14 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     e.kind = External::kHeading;
     externals.push_back(e);
   }
+  // The knob of each one-parameter simulated candidate (its probe's), before refinement moves
+  // the shifts.
+  std::vector<int> knob_of(library.size(), -1);
+  for (size_t k = 0; k < library.size(); ++k) {
+    if (out.candidates[k].physical && externals[k].kind == External::kShift) {
+      knob_of[k] = probe_of[externals[k].shifts[0]].first;
+    }
+  }
   FitProblem problem = MakeFitProblem(real, model, library, layout);
   auto fill_design = [&](FitProblem* fp, int k) {
     for (int i = 0; i < real.size(); ++i) {
@@ -400,6 +409,15 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     out.candidates[k].theta = t(0);
     v.named.push_back(n);
   }
+  // The value a one-parameter simulated candidate's coefficient stands for: its signature was
+  // simulated at the probe, or at the refined value for the refined knob.
+  const int refined_k = out.selected.empty() ? -1 : out.selected.front();
+  auto value_of = [&](int k, double theta) {
+    const KnobCandidate& c = out.candidates[k];
+    const double at = k == refined_k && std::isfinite(refined_value) ? refined_value : c.probe;
+    return std::clamp(c.nominal + theta * (at - c.nominal), c.lo, c.hi);
+  };
+  const auto experiment_start = std::chrono::steady_clock::now();
   // Ties: at the step that added a named effect, another family whose gain is within reach and
   // whose whitened signature on these samples is nearly collinear (or flagged by the selection).
   for (size_t s = 0; s < sel.selected.size() && s < sel.steps.size(); ++s) {
@@ -417,6 +435,8 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     VerdictTie tie;
     tie.families.push_back(named->family);
     EffectFit alone = FitEffects(problem, {chosen}, {}, options.selection.fit);
+    int best_o = -1, best_c = -1, best_t = -1;
+    double best_theta_o = 0;
     for (size_t q = 0; q < tied.size(); ++q) {
       const int o = tied[q];
       if (std::find(tie.families.begin(), tie.families.end(), family_of[o]) != tie.families.end()) continue;
@@ -447,6 +467,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
           const Eigen::VectorXd delta = p.chol.triangularView<Eigen::Lower>().solve(design(chosen, alone) - design(o, other));
           const double sep = delta.squaredNorm();
           if (sep > tie.experiment.separation) {
+            best_o = o, best_c = c, best_t = t, best_theta_o = other.theta[0](0);
             tie.experiment.separation = sep;
             tie.experiment.commands = {base.command_labels[c]};
             tie.experiment.terrain = {t < static_cast<int>(base.terrain_labels.size()) ? base.terrain_labels[t] : "all terrain"};
@@ -459,9 +480,46 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     if (tie.experiment.separation > 0) {
       tie.experiment.executions = static_cast<int>(std::ceil(11.7 / std::max(tie.experiment.separation, 1e-4)));
     }
+    // The check by simulation: the robot at each knob's fitted value in the proposed cell.
+    VerdictExperiment& ex = tie.experiment;
+    if (best_o < 0 || ex.executions <= 0) {
+      ex.not_checked_because = "no experiment proposed (a pure change of scale has no cell where the means differ)";
+    } else if (!options.experiment.enabled) {
+      ex.not_checked_because = "the check was turned off (--no-experiment-check)";
+    } else if (knob_of[chosen] < 0 || knob_of[best_o] < 0) {
+      const int m = knob_of[chosen] < 0 ? chosen : best_o;
+      ex.not_checked_because = out.candidates[m].physical
+                                   ? out.candidates[m].family + " is a multi-parameter knob; not simulated"
+                                   : out.candidates[m].family + " is a measurement effect: no simulator models it";
+    } else if (out.experiment_checks >= options.max_experiment_checks) {
+      ex.not_checked_because = Fmt("only the first %.0f ties are checked (cost bound)", options.max_experiment_checks);
+    } else if (base.terrain_centres.rows() <= best_t || base.terrain_centres.cols() < 2 ||
+               sim_set.commands.cols() != 3) {
+      ex.not_checked_because = "the cell has no (pitch, roll) terrain or no (long, lat, turn) command";
+    } else {
+      // The two hypotheses the proposal compares: each knob fitted alone.
+      const KnobValue va{knob_of[chosen], value_of(chosen, alone.theta[0](0))};
+      const KnobValue vb{knob_of[best_o], value_of(best_o, best_theta_o)};
+      int pitch_col = 0, roll_col = 1;
+      for (int j = 0; j < static_cast<int>(sim_set.z_names.size()); ++j) {
+        if (sim_set.z_names[j] == "pitch") pitch_col = j;
+        if (sim_set.z_names[j] == "roll") roll_col = j;
+      }
+      try {
+        const ExperimentCheck check =
+            CheckExperiment(config, knobs, va, vb, sim_set.commands.row(best_c).transpose(),
+                            base.terrain_centres(best_t, pitch_col), base.terrain_centres(best_t, roll_col),
+                            ex.executions, options.experiment, std::max(1.0, std::exp(final_fit.log_tau)));
+        ++out.experiment_checks;
+        RecordCheck(check, options.experiment.z_required, &ex);
+      } catch (const InputError& e) {
+        ex.not_checked_because = std::string("simulation failed: ") + e.what();
+      }
+    }
     named->tie_group = static_cast<int>(v.ties.size());
     v.ties.push_back(tie);
   }
+  out.experiment_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - experiment_start).count();
   v.structured_in = out.residual.structured_in;
   v.unexplained_present = structured || (!v.structured_in.empty() && !base.unexplained.empty());
   if (v.named.empty()) {
@@ -490,8 +548,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
         for (size_t f = 1; f < t.families.size(); ++f) s += " " + t.families[f];
         s += " on these data (" + t.why + ")";
         if (!t.experiment.commands.empty()) {
-          s += "; to separate them, record command " + t.experiment.commands[0] + " on " + t.experiment.terrain[0] +
-               Fmt(" about %.0f times", t.experiment.executions);
+          s += "; to separate them, " + DescribeExperiment(t.experiment);
         }
       }
       if (k + 1 < v.named.size()) s += ";";
@@ -544,6 +601,8 @@ std::string KnobAnalysisJson(const KnobAnalysis& a) {
               {"cache_dir", a.cache_dir},
               {"signature_seconds", a.signature_seconds},
               {"refine_seconds", a.refine_seconds},
+              {"experiment_checks", a.experiment_checks},
+              {"experiment_check_seconds", a.experiment_seconds},
               {"seconds", a.seconds},
               {"heldout_ll", {{"sim", a.ll_sim}, {"corrected", a.ll_corrected}, {"ceiling", a.ll_ceiling}}},
               {"note", a.note}};

@@ -12,6 +12,7 @@
 
 #include "core/sample_set.h"
 #include "sim/sim_config.h"
+#include "sim2real/experiment_check.h"
 #include "sim2real/pipeline.h"
 #include "sim2real/residual_structure.h"
 #include "sim2real/signatures.h"
@@ -26,6 +27,8 @@ struct KnobAnalysisOptions {
   ResidualStructureOptions residual;
   double tie_correlation = 0.9;    // |corr| of whitened signatures on the real samples
   int refine_iterations = 2;       // re-simulations of the first-named knob (0: none)
+  ExperimentCheckOptions experiment;  // the check by simulation of each tie's proposed experiment
+  int max_experiment_checks = 3;      // ties checked at most (the rest say so)
   bool IsValid(std::string* error) const;
 };
 
@@ -49,6 +52,8 @@ struct KnobAnalysis {
   // Of those, the signature stage's (nominal + probes): 0 simulated = "signatures cached".
   int signature_simulations = 0, signature_requests = 0;
   double signature_seconds = 0, refine_seconds = 0, seconds = 0;
+  int experiment_checks = 0;        // ties whose experiment was simulated (2 cell runs each)
+  double experiment_seconds = 0;    // wall time of those checks
   std::string cache_dir;
   std::vector<std::pair<double, double>> refine_trace;  // (value simulated, fitted coefficient)
   double ll_sim = 0, ll_corrected = 0, ll_ceiling = 0;

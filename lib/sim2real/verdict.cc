@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 
@@ -12,7 +13,33 @@ using json = nlohmann::json;
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
+  char buf[300];
+  std::snprintf(buf, sizeof buf, f, a, b, c);
+  return buf;
+}
+
 }  // namespace
+
+std::string DescribeExperiment(const VerdictExperiment& e) {
+  if (e.commands.empty() || e.terrain.empty()) return "";
+  std::string s = "record command " + e.commands[0] + " on " + e.terrain[0] + Fmt(" about %.0f times", e.executions);
+  if (!e.checked_by_simulation) {
+    s += " (not checked by simulation: " + e.not_checked_because + ")";
+  } else if (e.confirmed) {
+    s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the proposed experiment separates "
+             "them, z %.1f >= %.2f", e.executions_simulated, e.z, e.z_required) + Fmt(", p %.3g)", e.p_value);
+  } else if (e.executions_needed < 0) {
+    s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the two make no measurable "
+             "difference in that cell, p %.3g; the proposed experiment would not separate them)",
+             e.executions_simulated, e.p_value);
+  } else {
+    s += Fmt(" (checked by simulation, %.0f executions at each fitted value: the proposed experiment would not "
+             "separate them, z %.1f (needed %.2f)", e.executions_simulated, e.z, e.z_required) +
+         Fmt(", p %.3g; more executions needed: %.0f)", e.p_value, e.executions_needed);
+  }
+  return s;
+}
 
 std::string VerdictJson(const Verdict& v) {
   json named = json::array();
@@ -24,14 +51,32 @@ std::string VerdictJson(const Verdict& v) {
   }
   json ties = json::array();
   for (const auto& t : v.ties) {
-    ties.push_back({{"families", t.families},
-                    {"why", t.why},
-                    {"experiment",
-                     {{"commands", t.experiment.commands},
-                      {"terrain", t.experiment.terrain},
-                      {"executions", t.experiment.executions},
-                      {"separation_per_execution", t.experiment.separation},
-                      {"checked_by_simulation", t.experiment.checked_by_simulation}}}});
+    const VerdictExperiment& e = t.experiment;
+    json experiment = {{"commands", e.commands},
+                       {"terrain", e.terrain},
+                       {"executions", e.executions},
+                       {"separation_per_execution", e.separation},
+                       {"checked_by_simulation", e.checked_by_simulation},
+                       {"confirmed", e.checked_by_simulation ? json(e.confirmed) : json(nullptr)},
+                       {"not_checked_because", e.checked_by_simulation ? json(nullptr) : json(e.not_checked_because)}};
+    if (e.checked_by_simulation) {
+      experiment["simulation"] = {{"knobs", e.simulated_knobs},
+                                  {"values", e.simulated_values},
+                                  {"executions", e.executions_simulated},
+                                  {"placements", e.placements},
+                                  {"seed", e.seed},
+                                  {"heading_deg", e.heading_deg},
+                                  {"spread_scale", e.spread_scale},
+                                  {"separation_per_execution", e.simulated_separation},
+                                  {"z", e.z},
+                                  {"z_required", e.z_required},
+                                  {"p_value", e.p_value},
+                                  {"executions_needed", e.executions_needed < 0 ? json(nullptr) : json(e.executions_needed)},
+                                  {"seconds", e.seconds}};
+    } else {
+      experiment["simulation"] = nullptr;
+    }
+    ties.push_back({{"families", t.families}, {"why", t.why}, {"experiment", experiment}});
   }
   json out = {{"status", v.status},
               {"named", named},

@@ -13,7 +13,20 @@ struct VerdictExperiment {
   std::vector<std::string> terrain;   // terrain region labels
   int executions = 0;                 // per cell, to separate the two at about 2.8 sigma
   bool checked_by_simulation = false;
-  double separation = 0;              // whitened distance of the two predictions per execution
+  double separation = 0;              // squared whitened distance of the two predictions per execution
+  // The check by simulation (experiment_check.h); meaningful when checked_by_simulation.
+  bool confirmed = false;
+  std::string not_checked_because;    // why not checked (empty when checked)
+  std::vector<std::string> simulated_knobs;
+  std::vector<double> simulated_values;
+  int executions_simulated = 0, placements = 0;
+  unsigned long long seed = 0;
+  double heading_deg = 0;
+  double spread_scale = 1;            // simulated within-cell spread scaled by the fitted noise scale (>= 1)
+  double simulated_separation = 0;    // d2 measured by simulation (same units as `separation`)
+  double z = 0, z_required = 0, p_value = 1;
+  int executions_needed = -1;         // by simulation; -1: no separation measured
+  double seconds = 0;                 // wall time of the check
 };
 
 struct VerdictTie {
@@ -38,6 +51,11 @@ struct Verdict {
   double gap_closed = 0;  // NaN: no gap (null)
   std::string sentence;   // one plain-language paragraph for the conclusion
 };
+
+// The experiment in words, for the conclusion: "record command C on T about N times (checked by
+// simulation, ...: the proposed experiment separates them / would not separate them ...; more
+// executions needed: M)" or "(not checked by simulation: why)". Empty when no cell was proposed.
+std::string DescribeExperiment(const VerdictExperiment& e);
 
 // JSON text of the verdict object (contract of docs/sim2real.md).
 std::string VerdictJson(const Verdict& v);
