@@ -141,10 +141,10 @@ vtkSmartPointer<vtkTable> CurveSegments(const CurveOverlay& curve) {
 }
 
 // At most about `max_ticks` ticks at round values (1, 2, 2.5 or 5 times a power of ten) inside
-// [lo, hi], labelled with just the decimals the step needs. VTK's automatic ticks put up to ~20
-// labels on an axis; a panel then drew ~50 distinct strings, the size of the OpenGL device's
-// text texture cache, so every redraw of `dgmm view` re-rasterised all of them (perf: a fifth of
-// a slider move). Fewer, rounder labels also read better.
+// [lo, hi], labelled with just the decimals the step needs (VTK's automatic ticks put up to ~15
+// labels on an axis). Used on the plot axes; the colour bar keeps VTK's ticks, because custom
+// ticks there made the three-panel `dgmm view --compare` redraw ~30 ms slower (measured side by
+// side with scripts/bench_viewer.sh's benchmark).
 void SetRoundTicks(vtkAxis* axis, double lo, double hi, int max_ticks) {
   if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return;
   const double raw = (hi - lo) / std::max(2, max_ticks);
@@ -171,14 +171,6 @@ void SetRoundTicks(vtkAxis* axis, double lo, double hi, int max_ticks) {
     labels->InsertNextValue(text);
   }
   axis->SetCustomTickPositions(positions, labels);
-}
-
-// The axis of a colour legend (a child item of vtkColorLegend), or nullptr.
-vtkAxis* LegendAxis(vtkColorLegend* legend) {
-  for (vtkIdType i = 0; i < legend->GetNumberOfItems(); ++i) {
-    if (auto* axis = vtkAxis::SafeDownCast(legend->GetItem(i))) return axis;
-  }
-  return nullptr;
 }
 
 // Ticks at the centres of equal blocks over [lo, hi], labelled with the names.
@@ -272,9 +264,6 @@ vtkSmartPointer<vtkChartHistogram2D> MakeHeatMapChart(const HeatMapSpec& spec) {
   }
   if (auto* legend = vtkColorLegend::SafeDownCast(chart->GetLegend())) {
     legend->SetTitle(raster.value_label);
-    if (vtkAxis* axis = LegendAxis(legend)) {
-      SetRoundTicks(axis, raster.lo, raster.hi, std::max(4, spec.height / 50));
-    }
   }
   chart->SetShowLegend(true);
   // The legend takes about 110 px on the right; the title is centred on the whole image.
