@@ -11,7 +11,9 @@ permutations, no knob cache) is first made twice without interruption: its durat
 spread of the kill moments and its files are the "complete new" reference. The "older" result is
 the null pair's report (other files, other bytes). Each trial starts from an output folder
 holding the older result (even trials) or no folder (odd trials), kills the run with SIGKILL
-after a delay drawn uniformly from [0, 1.1 T] (seeded), and classifies the folder:
+after a delay drawn (seeded) uniformly from [0, 1.1 T] for half the trials and within 0.3 s of
+the moment S the reference run's folder appeared (the swap) for the other half, and classifies
+the folder:
   old     byte-identical to the older result (same file list, same SHA-256 per file)
   new     the reference's file list; identical files except the run time recorded in
           report.json ("seconds") and report.html ("Analysis took")
@@ -95,17 +97,26 @@ def main():
         subprocess.run(command(dgmm, "null", older, 2), env=env, check=True)
         old_exact = exact(older)
         refs, times = [], []
+        swaps = []
         for i in range(2):
             ref = os.path.join(work, f"new{i}")
             t0 = time.monotonic()
-            subprocess.run(command(dgmm, "slip", ref, 1), env=env, check=True)
+            p = subprocess.Popen(command(dgmm, "slip", ref, 1), env=env,
+                                 stdout=subprocess.DEVNULL)
+            while p.poll() is None:  # the moment the folder is swapped in
+                if not swaps[i:] and os.path.exists(ref):
+                    swaps.append(time.monotonic() - t0)
+                time.sleep(0.002)
+            if p.returncode != 0:
+                sys.exit("the uninterrupted run failed")
             times.append(time.monotonic() - t0)
+            swaps[i:] = swaps[i:] or [times[-1]]
             refs.append(digest(ref))
         if refs[0] != refs[1]:
             diff = [k for k in refs[0] if refs[0].get(k) != refs[1].get(k)]
             sys.exit(f"two uninterrupted runs differ in {diff}: cannot tell a complete result")
         new_ref = refs[0]
-        duration = min(times)
+        duration, swap = min(times), min(swaps)
         rng = random.Random(a.seed)
         out = os.path.join(work, "out")
         counts = {"old": 0, "new": 0, "absent": 0, "BROKEN": 0}
@@ -117,7 +128,10 @@ def main():
             if with_old:
                 shutil.copytree(older, out)
             before = set(temps(work))
-            delay = rng.uniform(0, 1.1 * duration)
+            # Half the moments anywhere in the run, half within 0.3 s of the swap.
+            near_swap = (trial // 2) % 2 == 1
+            delay = (rng.uniform(max(0.0, swap - 0.3), swap + 0.3) if near_swap
+                     else rng.uniform(0, 1.1 * duration))
             p = subprocess.Popen(command(dgmm, "slip", out, 1), env=env,
                                  stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
             time.sleep(delay)
@@ -155,8 +169,9 @@ def main():
     ok = counts["old"] + counts["new"] + counts["absent"]
     cmd = (f"/usr/bin/python3 scripts/sim2real_kill9.py build/app/dgmm <workdir> --seed {a.seed} "
            f"--kills {a.kills}")
-    md = [f"Command: `{cmd}`; uninterrupted run {duration:.2f} s (wall), kill moments uniform in "
-          f"[0, {1.1 * duration:.2f}] s.", "",
+    md = [f"Command: `{cmd}`; uninterrupted run {duration:.2f} s (wall), folder swapped in at "
+          f"{swap:.2f} s; kill moments: half uniform in [0, {1.1 * duration:.2f}] s, half "
+          f"within 0.3 s of the swap.", "",
           "| kills | ok | complete old | complete new | no folder (started without) | broken |"
           " kills that left a temporary folder | stale temporaries kept by a later run |"
           " after a final run: temporaries, result complete |",
