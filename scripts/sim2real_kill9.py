@@ -83,7 +83,7 @@ def main():
     ap.add_argument("dgmm")
     ap.add_argument("workdir")
     ap.add_argument("--seed", type=int, default=9)
-    ap.add_argument("--kills", type=int, default=40)
+    ap.add_argument("--kills", type=int, default=48)
     ap.add_argument("--markdown", default="")
     a = ap.parse_args()
     dgmm, work = os.path.abspath(a.dgmm), os.path.abspath(a.workdir)
