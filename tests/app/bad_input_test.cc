@@ -175,6 +175,10 @@ TEST_F(BadInput, MessagesNameTheFlagOrWord) {
   Import("x,y\n1,2\n2,3\n1.5,2.5\n", "set.h5", {"--pose-cols", "x,y"});
   ExpectCleanFailure({"frobnicate", P("set.h5")}, {"unknown command 'frobnicate'"});
   ExpectCleanFailure({"--quiet", "frobnicate"}, {"unknown command 'frobnicate'"});
+  ExpectCleanFailure({"--quiet"}, {"subcommand is required"});
+  ExpectCleanFailure({"tune-k", P("set.h5"), "--frobnicate"}, {"--frobnicate"});
+  EXPECT_EQ(RunDgmm({"tune-k", P("set.h5"), "--frobnicate"}).err.find("unknown command"),
+            std::string::npos);
   ExpectCleanFailure({"em", P("set.h5"), "-o", P("m.h5"), "--components", "0"},
                      {"set.h5", "--components"}, P("m.h5"));
   ExpectCleanFailure({"em", P("set.h5"), "-o", P("m.h5"), "--reg-covar", "-1"},
