@@ -4,6 +4,11 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
+
+#include <fmt/format.h>
+
+#include "util/error.h"
 
 namespace dgmm::app {
 
@@ -80,6 +85,28 @@ void WarnIfUnderdetermined(const SampleSet& set, bool with_terrain, const std::s
        " parameters of one Gaussian in d = " + std::to_string(d) + " for command(s) " + list +
        "; their components rest on the covariance floor and prior more than on data (record more "
        "samples, or use --pose-dims/--terrain-dims or --without-terrain)");
+}
+
+InputError OptionsError(const std::string& file, const std::string& message,
+                        const std::vector<std::pair<std::string, std::string>>& flags) {
+  for (const auto& [field, flag] : flags) {
+    if (message.find(field) != std::string::npos) return MakeInputError(file, flag, message);
+  }
+  return MakeInputError(file, "options", message);
+}
+
+void RefuseMoreFoldsThanSamples(const SampleSet& set, int folds, const std::string& path) {
+  std::map<int, int> per_command;
+  for (int i = 0; i < set.size(); ++i) ++per_command[set.command[i]];
+  for (const auto& [id, count] : per_command) {
+    if (folds <= count) continue;
+    const std::string label =
+        id < static_cast<int>(set.command_labels.size()) ? " '" + set.command_labels[id] + "'" : "";
+    throw MakeInputError(path, "--folds",
+                         fmt::format("{} folds, but command {}{} has {} samples ({} in all); at "
+                                     "most {} folds expected",
+                                     folds, id, label, count, set.size(), count));
+  }
 }
 
 void Warn(const std::string& text) {

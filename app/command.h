@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/sample_set.h"
+#include "util/error.h"
 
 namespace dgmm::app {
 
@@ -48,6 +49,17 @@ void Warn(const std::string& text);
 // covariance Gaussian over d = pose (+ terrain) dimensions: its EM or DGMM components are then
 // fixed by the covariance floor and initial covariance more than by the data.
 void WarnIfUnderdetermined(const SampleSet& set, bool with_terrain, const std::string& what);
+
+// An Options::IsValid message as InputError "<file>: <flag>: <message>", where flag is the
+// command-line flag of the first field in `flags` (pairs field name -> flag, e.g. {"n_init",
+// "--n-init"}) that the message mentions; "options" when it mentions none.
+InputError OptionsError(const std::string& file, const std::string& message,
+                        const std::vector<std::pair<std::string, std::string>>& flags);
+
+// Throws InputError "<path>: --folds: ..." when `folds` exceeds the samples of any command:
+// every command's samples are spread over the folds, so no fold may be empty for a command (and
+// a huge --folds must not run for minutes on empty folds). Used by cv and tune.
+void RefuseMoreFoldsThanSamples(const SampleSet& set, int folds, const std::string& path);
 
 }  // namespace dgmm::app
 

@@ -4,7 +4,6 @@
 #include <fmt/ranges.h>
 
 #include <cmath>
-#include <map>
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -56,20 +55,7 @@ void RunCv(const CvArgs& args) {
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
   WarnIfUnderdetermined(set, true, "cv");
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  // Stratified folds: every command's samples are spread over the folds, so no fold may be
-  // empty for any command (and a huge --folds must not run for minutes on empty folds).
-  std::map<int, int> per_command;
-  for (int i = 0; i < set.size(); ++i) ++per_command[set.command[i]];
-  for (const auto& [id, count] : per_command) {
-    if (args.folds > count) {
-      const std::string label =
-          id < static_cast<int>(set.command_labels.size()) ? " '" + set.command_labels[id] + "'" : "";
-      throw MakeInputError(args.path, "--folds",
-                           fmt::format("{} folds, but command {}{} has {} samples ({} in all); at "
-                                       "most {} folds expected",
-                                       args.folds, id, label, count, set.size(), count));
-    }
-  }
+  RefuseMoreFoldsThanSamples(set, args.folds, args.path);
   CvOptions options;
   options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
   options.dgmm.k = args.k;
@@ -84,7 +70,11 @@ void RunCv(const CvArgs& args) {
   options.em.n_init = args.em_n_init;
   options.progress = [](int done, int total) { ReportProgress("cv folds", done, total); };
   std::string error;
-  if (!options.IsValid(&error)) throw MakeInputError("", "options", error);
+  if (!options.IsValid(&error)) {
+    throw OptionsError(args.path, error,
+                       {{"em_max_components", "--em-max-components"}, {"threads", "--threads"},
+                        {"folds", "--folds"}, {"repeats", "--repeats"}, {"n_init", "--em-n-init"}});
+  }
   const CvSummary summary = CrossValidate(set, options);
 
   struct Row {

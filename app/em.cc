@@ -38,7 +38,12 @@ nlohmann::json OptionsJson(const EmArgs& args) {
 
 void Run(const EmArgs& args) {
   std::string error;
-  if (!args.em.IsValid(&error)) throw MakeInputError(args.set, "options", error);
+  if (!args.em.IsValid(&error)) {
+    throw OptionsError(args.set, error,
+                       {{"components", "--components"}, {"n_init", "--n-init"},
+                        {"max_iterations", "--max-iter"}, {"tolerance", "--tol"},
+                        {"reg_covar", "--reg-covar"}});
+  }
   RefuseOutputThatIsAnInput(args.output, {args.set});
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const SampleSet set = ReadSampleSet(args.set);

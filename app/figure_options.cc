@@ -11,7 +11,11 @@ std::pair<int, int> ParseSize(const std::string& text) {
   int w = 0, h = 0;
   char x = 0, extra = 0;
   if (std::sscanf(text.c_str(), "%d%c%d%c", &w, &x, &h, &extra) != 3 || (x != 'x' && x != 'X')) {
-    throw MakeInputError("", "--size", "expected WIDTHxHEIGHT, got '" + text + "'");
+    throw MakeInputError("", "--size", "expected WIDTHxHEIGHT, got '" + text.substr(0, 80) + "'");
+  }
+  // The limits of the heat map and chart writers, checked here so the message names the flag.
+  if (w < 200 || h < 150 || w > 8000 || h > 8000) {
+    throw MakeInputError("", "--size", "expected 200x150 to 8000x8000 pixels, got '" + text + "'");
   }
   return {w, h};
 }

@@ -31,7 +31,8 @@ struct FitArgs {
   std::uint64_t seed = 1;
   bool without_terrain = false;
   int chunk_rows = 65536;
-  long long max_components = -1;  // -1: DefaultMaxComponents
+  long long max_components = 0;
+  bool max_components_given = false;  // false: DefaultMaxComponents
   bool json = false;
 };
 
@@ -64,12 +65,12 @@ MotionModelOptions Options(const FitArgs& args) {
   } catch (const InputError& e) {
     throw MakeInputError(args.set, "", e.what());
   }
-  if (args.max_components == 0 || args.max_components < -1 || args.max_components > 1000000000) {
+  if (args.max_components_given && (args.max_components < 1 || args.max_components > 1000000000)) {
     throw MakeInputError(args.set, "--max-components",
                          fmt::format("{}; expected 1 to 1e9", args.max_components));
   }
   o.dgmm.max_components = static_cast<int>(
-      args.max_components > 0 ? args.max_components : DefaultMaxComponents(reader.size(), dim));
+      args.max_components_given ? args.max_components : DefaultMaxComponents(reader.size(), dim));
   o.dgmm.k = args.k;
   std::string error;
   if (!o.dgmm.IsValid(&error)) throw MakeInputError(args.set, "options", error);
@@ -165,12 +166,15 @@ void Setup(CLI::App& root) {
   cmd->add_option("--chunk-rows", args->chunk_rows, "samples read per chunk")
       ->capture_default_str()
       ->check(CLI::Range(1, 100000000));
-  cmd->add_option("--max-components", args->max_components,
+  CLI::Option* cap = cmd->add_option("--max-components", args->max_components,
                   "cap on components per mixture; at the cap every sample merges (default: "
                   "max(50, min(ceil(sqrt(N)), N / (d + 1), 2e9 / (N d^2))) for N samples of "
                   "dimension d)");
   cmd->add_flag("--json", args->json, "print the summary as JSON");
-  cmd->callback([args] { Run(*args); });
+  cmd->callback([args, cap] {
+    args->max_components_given = cap->count() > 0;
+    Run(*args);
+  });
 }
 
 }  // namespace

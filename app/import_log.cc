@@ -10,6 +10,7 @@
 #include "io/log_import.h"
 #include "io/sample_set_io.h"
 #include "util/atomic_file.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -30,6 +31,7 @@ void Run(ImportLogArgs args) {
       if (s->time_column == "t") s->time_column = args.time_column;
     }
   }
+  RefuseOutputThatIsAnInput(args.output, {o.commands.path, o.pose.path, o.attitude.path});
   { AtomicFile probe(args.output); }  // fail before reading when the output is unwritable
   LogImportSummary summary;
   const SampleSet set = ImportLog(o, &summary);

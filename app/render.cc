@@ -74,7 +74,9 @@ void Run(const RenderArgs& args) {
   if (!args.labels.empty()) ParseLabels(args.labels);
   ParseColorScale(args.color_scale);
   // Before any VTK call: a missing display is one clear line, never a crash.
-  RefuseOutputThatIsAnInput(args.output, args.models);
+  std::vector<std::string> inputs = args.models;
+  if (!args.data.empty()) inputs.push_back(args.data);
+  RefuseOutputThatIsAnInput(args.output, inputs);
   RequireDisplay();
   if (args.diff != (args.models.size() == 2)) {
     throw MakeInputError("", "models", args.diff ? "--diff needs exactly two model files"

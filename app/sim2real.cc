@@ -5,6 +5,7 @@
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
@@ -79,6 +80,13 @@ void Run(const Sim2RealArgs& args) {
   namespace fs = std::filesystem;
   const SampleSet sim = ReadSampleSet(args.sim);
   const SampleSet real = ReadSampleSet(args.real);
+  if (sim.pose_dim() != real.pose_dim() || sim.terrain_dim() != real.terrain_dim()) {
+    throw MakeInputError(args.real, sim.pose_dim() != real.pose_dim() ? "x" : "z",
+                         fmt::format("{} pose and {} terrain dimensions; expected those of --sim "
+                                     "{} ({} and {})",
+                                     real.pose_dim(), real.terrain_dim(), args.sim, sim.pose_dim(),
+                                     sim.terrain_dim()));
+  }
   CheckInputs(args);
   // Everything is written into a sibling folder that replaces -o whole at the end.
   AtomicDir output(args.out, "report.json");

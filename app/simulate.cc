@@ -46,7 +46,11 @@ void RunSimulate(const SimulateArgs& args) {
   options.placements = args.placements;
   options.executions_per_placement = args.executions;
   std::string error;
-  if (!options.IsValid(&error)) throw MakeInputError("", "options", error);
+  if (!options.IsValid(&error)) {
+    throw OptionsError("", error,
+                       {{"executions_per_placement", "--executions"},
+                        {"placements", "--placements"}});
+  }
 
   sim::SimSummary summary;
   const SampleSet set = sim::SimulateProtocol(

@@ -19,6 +19,7 @@
 #include "tune/dimensions.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -94,12 +95,16 @@ void RunTuneK(const TuneKArgs& args) {
     throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
   }
   // Unwritable output folders are reported before the long run, not after it.
-  for (const std::string& output : {args.plot, args.curve_csv}) {
-    if (!output.empty()) AtomicFile probe(output);
+  for (const auto& [output, flag] : {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
+    if (output.empty()) continue;
+    RefuseOutputThatIsAnInput(output, {args.path}, flag);
+    AtomicFile probe(output);
   }
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
+  if (args.folds < 2) throw MakeInputError(args.path, "--folds", "must be >= 2");
+  RefuseMoreFoldsThanSamples(set, args.folds, args.path);
   WarnIfUnderdetermined(set, !args.without_terrain, "tune-k");
   if (args.with_terrain && set.terrain_dim() == 0) {
     throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
@@ -128,7 +133,14 @@ void RunTuneK(const TuneKArgs& args) {
     }
   };
   std::string error;
-  if (!options.IsValid(&error)) throw MakeInputError("", "options", error);
+  if (!options.IsValid(&error)) {
+    throw OptionsError(args.path, error,
+                       {{"k_min", "--k-min/--k-max"}, {"grid_points", "--grid-points"},
+                        {"refine_points", "--refine-points"},
+                        {"plateau_tolerance", "--plateau-tolerance"},
+                        {"init_scales", "--init-scales"}, {"prior_counts", "--prior-counts"},
+                        {"threads", "--threads"}, {"folds", "--folds"}, {"repeats", "--repeats"}});
+  }
   const TuneKSummary s = TuneK(set, options);
   const std::string folds_by = s.folds_by;
   if (!args.curve_csv.empty()) WriteCurveCsv(s, args.curve_csv);

@@ -125,8 +125,12 @@ ModelSlice SliceModel(const MotionModel& model, const SliceSpec& spec, const std
   if (!given.empty()) {
     std::vector<int> given_local;
     for (size_t g = 0; g < given.size(); ++g) given_local.push_back(2 + static_cast<int>(g));
+    // p(given values) must be a number: a value whose distance from every component overflows
+    // (e.g. pitch=1e308) has no conditional, even when one component's weight renormalises to 1.
+    const bool reachable = std::isfinite(kept.Marginal(given_local).LogDensity(values));
     kept = kept.Conditional(given_local, values);
-    bool usable = !kept.empty() && std::isfinite(kept.total_weight()) && kept.total_weight() > 0;
+    bool usable = reachable && !kept.empty() && std::isfinite(kept.total_weight()) &&
+                  kept.total_weight() > 0;
     for (int i = 0; usable && i < kept.size(); ++i) {
       usable = std::isfinite(kept.weight(i)) && kept.component(i).mean().allFinite();
     }

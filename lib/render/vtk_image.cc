@@ -4,9 +4,10 @@
 #include <vtkPNGWriter.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderer.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
-#include <filesystem>
+#include <fstream>
 
 #include "render/display.h"
 #include "util/atomic_file.h"
@@ -54,14 +55,23 @@ vtkSmartPointer<vtkImageData> AppendHorizontally(
 
 void WritePngAtomically(vtkImageData* image, const std::string& png_path) {
   AtomicFile file(png_path);
+  // Encoded in memory and written here: a write error (disk full) is then one line of ours, not
+  // libpng's and VTK's messages on stderr.
   auto writer = vtkSmartPointer<vtkPNGWriter>::New();
-  writer->SetFileName(file.temp_path().c_str());
+  writer->WriteToMemoryOn();
   writer->SetInputData(image);
   writer->Write();
-  std::error_code ec;
-  if (writer->GetErrorCode() != 0 || !std::filesystem::exists(file.temp_path(), ec) ||
-      std::filesystem::file_size(file.temp_path(), ec) == 0) {
-    throw MakeInputError(png_path, "", "cannot write the PNG");
+  vtkUnsignedCharArray* bytes = writer->GetResult();
+  if (writer->GetErrorCode() != 0 || bytes == nullptr || bytes->GetNumberOfTuples() == 0) {
+    throw MakeInputError(png_path, "", "cannot encode the PNG");
+  }
+  {
+    std::ofstream out(file.temp_path(), std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes->GetPointer(0)),
+              static_cast<std::streamsize>(bytes->GetNumberOfTuples() *
+                                           bytes->GetNumberOfComponents()));
+    out.close();
+    if (!out) throw MakeInputError(png_path, "", "cannot write (disk full?)");
   }
   file.Commit();
 }

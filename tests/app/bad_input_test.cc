@@ -160,6 +160,49 @@ TEST_F(BadInput, ModelWhereASetIsExpected) {
   ExpectCleanFailure({"score", P("set.h5"), P("set.h5")}, {"set.h5", "expected a model"});
 }
 
+// Found by scripts/bad_input_battery.py (issue #13).
+TEST_F(BadInput, TuneRefusesMoreFoldsThanSamples) {
+  Import("c,x,y\n0,1,2\n0,2,3\n0,1.5,2.5\n1,1,1\n1,2,2\n1,3,1\n", "set.h5",
+         {"--command-cols", "c", "--pose-cols", "x,y"});
+  // Ran for minutes on empty folds before.
+  ExpectCleanFailure({"tune", P("set.h5"), "--folds", "100000", "--without-terrain"},
+                     {"set.h5", "--folds", "at most 3 folds"});
+  ExpectCleanFailure({"tune", P("set.h5"), "--folds", "1", "--without-terrain"},
+                     {"set.h5", "--folds", ">= 2"});
+}
+
+TEST_F(BadInput, MessagesNameTheFlagOrWord) {
+  Import("x,y\n1,2\n2,3\n1.5,2.5\n", "set.h5", {"--pose-cols", "x,y"});
+  ExpectCleanFailure({"frobnicate", P("set.h5")}, {"unknown command 'frobnicate'"});
+  ExpectCleanFailure({"--quiet", "frobnicate"}, {"unknown command 'frobnicate'"});
+  ExpectCleanFailure({"--quiet"}, {"subcommand is required"});
+  ExpectCleanFailure({"tune-k", P("set.h5"), "--frobnicate"}, {"--frobnicate"});
+  EXPECT_EQ(RunDgmm({"tune-k", P("set.h5"), "--frobnicate"}).err.find("unknown command"),
+            std::string::npos);
+  ExpectCleanFailure({"em", P("set.h5"), "-o", P("m.h5"), "--components", "0"},
+                     {"set.h5", "--components"}, P("m.h5"));
+  ExpectCleanFailure({"em", P("set.h5"), "-o", P("m.h5"), "--reg-covar", "-1"},
+                     {"set.h5", "--reg-covar"}, P("m.h5"));
+  // (--quiet: the 3-sample set also draws a warning about too few samples.)
+  ExpectCleanFailure({"--quiet", "tune", P("set.h5"), "--folds", "2", "--k-min", "0",
+                      "--without-terrain"},
+                     {"set.h5", "--k-min"});
+  ExpectCleanFailure({"--quiet", "cv", P("set.h5"), "--folds", "2", "--em-max-components", "0"},
+                     {"set.h5", "--em-max-components"});
+  ExpectCleanFailure({"simulate", "-o", P("sim.h5"), "--executions", "0"}, {"--executions"},
+                     P("sim.h5"));
+  // -1 was the internal "not given" value and so silently meant the default cap.
+  ExpectCleanFailure({"fit", P("set.h5"), "-o", P("m.h5"), "--max-components", "-1"},
+                     {"set.h5", "--max-components", "expected 1 to 1e9"}, P("m.h5"));
+}
+
+TEST_F(BadInput, Sim2RealNamesTheSetWhoseDimensionsDiffer) {
+  Import("x,y\n1,2\n2,3\n1.5,2.5\n", "set.h5", {"--pose-cols", "x,y"});
+  ExpectCleanFailure({"sim2real", "--sim", SourcePath("datasets/sim2real/sim.h5").string(),
+                      "--real", P("set.h5"), "-o", P("report")},
+                     {"set.h5", "2 pose and 0 terrain dimensions", "(6 and 2)"}, P("report"));
+}
+
 TEST_F(BadInput, InitCovOfTheWrongLength) {
   Import("x,y\n1,2\n2,3\n", "set.h5", {"--pose-cols", "x,y"});
   ExpectCleanFailure({"fit", P("set.h5"), "-o", P("m.h5"), "--init-cov", "1,2,3"},

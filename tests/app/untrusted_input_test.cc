@@ -101,6 +101,12 @@ TEST_F(Untrusted, OutputThatIsAnInputIsRefusedAndTheInputUntouched) {
       {"export", P("m.h5"), "-o", P("m.h5")},
       {"import", P("set.csv"), "-o", P("set.csv"), "--pose-cols", "x,y"},
       {"upgrade", P("set.h5"), "-o", P("set.h5")},
+      // Found by scripts/bad_input_battery.py: these overwrote their input.
+      {"import-log", "--commands", P("set.csv"), "--pose", P("set.csv"), "--pose-cols", "x,y",
+       "-o", P("set.csv")},
+      {"tune", P("set.h5"), "--curve-csv", P("set.h5")},
+      {"tune", P("set.h5"), "--plot", P("set.h5")},
+      {"render", P("m.h5"), "--data", P("set.h5"), "-o", P("set.h5")},
   };
   for (const auto& args : cases) {
     RunResult r = RunDgmm(args);

@@ -94,6 +94,29 @@ TEST(ModelSliceTest, BadSelectionsAreInputErrors) {
   EXPECT_THROW(SliceModel(model, spec, "m.h5"), InputError);
 }
 
+// A condition whose distance from every component overflows has no conditional, also when the
+// mixture has a single component (whose weight would renormalise to 1): issue #13's
+// `render --condition pitch=1e308` drew a blank picture with exit 0.
+TEST(ModelSliceTest, ConditionBeyondEveryComponentIsRefusedForOneComponentToo) {
+  MotionModel model = FourDimModel();
+  Mixture one(4);
+  one.Add(2, model.mixtures[3].component(0));
+  model.mixtures[3] = one;
+  SliceSpec spec;
+  spec.marginalise = true;
+  for (double far : {1e308, -1e308}) {
+    spec.conditions = {{"pitch", far}};
+    try {
+      SliceModel(model, spec, "m.h5");
+      ADD_FAILURE() << "pitch=" << far << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("not a number"), std::string::npos) << e.what();
+    }
+  }
+  spec.conditions = {{"pitch", 0.5}};  // far from the data (sd 0.12) but a number: drawn
+  EXPECT_NO_THROW(SliceModel(model, spec, "m.h5"));
+}
+
 TEST(ModelSliceTest, CommandsByIdOrLabel) {
   MotionModel model = FourDimModel();
   EXPECT_EQ(ResolveCommand(model, "", "m.h5"), 3);
