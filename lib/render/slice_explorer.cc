@@ -339,7 +339,7 @@ std::string SliceExplorer::Status() const {
     if (conditioned_ && !terrain_.empty()) text += " within " + Number(100 * near_fraction_) + "%";
   }
   text += !window_locked()   ? "  | window: auto"
-          : held_by_terrain_ ? "  | window: held (r: re-frame)"
+          : held_by_terrain_ ? "  | window: held"
                              : "  | window: zoomed";
   return text;
 }
