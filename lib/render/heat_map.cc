@@ -19,9 +19,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 
 #include "render/heat_map_chart.h"
+#include "render/round_ticks.h"
 #include "render/text_fit.h"
 #include "render/vtk_image.h"
 #include "util/error.h"
@@ -140,35 +140,18 @@ vtkSmartPointer<vtkTable> CurveSegments(const CurveOverlay& curve) {
   return table;
 }
 
-// At most about `max_ticks` ticks at round values (1, 2, 2.5 or 5 times a power of ten) inside
-// [lo, hi], labelled with just the decimals the step needs (VTK's automatic ticks put up to ~15
-// labels on an axis). Used on the plot axes; the colour bar keeps VTK's ticks, because custom
-// ticks there made the three-panel `dgmm view --compare` redraw ~30 ms slower (measured side by
-// side with scripts/bench_viewer.sh's benchmark).
+// Round ticks (RoundTicks) on a plot axis; VTK's automatic ticks put up to ~15 labels on an
+// axis. The colour bar keeps VTK's ticks, because custom ticks there made the three-panel
+// `dgmm view --compare` redraw ~30 ms slower (measured side by side with scripts/bench_viewer.sh's
+// benchmark).
 void SetRoundTicks(vtkAxis* axis, double lo, double hi, int max_ticks) {
-  if (!(hi > lo) || !std::isfinite(lo) || !std::isfinite(hi)) return;
-  const double raw = (hi - lo) / std::max(2, max_ticks);
-  const double power = std::pow(10.0, std::floor(std::log10(raw)));
-  double step = 10 * power;
-  for (double m : {1.0, 2.0, 2.5, 5.0}) {
-    if (m * power >= raw) {
-      step = m * power;
-      break;
-    }
-  }
-  int decimals = std::max(0, static_cast<int>(-std::floor(std::log10(step) + 1e-9)));
-  if (std::abs(step / std::pow(10.0, -decimals) - std::round(step / std::pow(10.0, -decimals))) >
-      1e-6) {
-    ++decimals;  // 2.5 x 10^e needs one more digit
-  }
+  const std::vector<Tick> ticks = RoundTicks(lo, hi, max_ticks);
+  if (ticks.empty()) return;
   auto positions = vtkSmartPointer<vtkDoubleArray>::New();
   auto labels = vtkSmartPointer<vtkStringArray>::New();
-  for (double t = std::ceil(lo / step - 1e-9) * step; t <= hi + 1e-9 * step; t += step) {
-    const double v = std::abs(t) < 1e-12 * step ? 0.0 : t;
-    char text[64];
-    std::snprintf(text, sizeof text, "%.*f", decimals, v);
-    positions->InsertNextValue(v);
-    labels->InsertNextValue(text);
+  for (const Tick& t : ticks) {
+    positions->InsertNextValue(t.value);
+    labels->InsertNextValue(t.label);
   }
   axis->SetCustomTickPositions(positions, labels);
 }
