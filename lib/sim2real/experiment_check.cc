@@ -24,6 +24,8 @@ bool ExperimentCheckOptions::IsValid(std::string* error) const {
   return true;
 }
 
+int ExecutionsToSeparate(double d2) { return static_cast<int>(std::ceil(11.7 / d2)); }
+
 PairedSeparation SeparationOfPairs(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, int proposed_executions,
                                    int permutations, std::uint64_t seed, double spread_scale) {
   const int n = static_cast<int>(a.rows()), dx = static_cast<int>(a.cols());
@@ -51,7 +53,7 @@ PairedSeparation SeparationOfPairs(const Eigen::MatrixXd& a, const Eigen::Matrix
   const double bias = (ldlt.solve(s_d)).trace() / n;
   out.d2 = std::max(0.0, t_obs - bias);
   out.z = std::sqrt(std::max(proposed_executions, 0) * out.d2);
-  out.executions_needed = out.d2 > 0 ? static_cast<int>(std::ceil(11.7 / out.d2)) : -1;
+  out.executions_needed = out.d2 > 0 ? ExecutionsToSeparate(out.d2) : -1;
   // Paired sign-flip permutation test of "no difference in the cell".
   std::mt19937_64 rng(seed);
   std::bernoulli_distribution flip(0.5);

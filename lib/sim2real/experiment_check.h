@@ -27,6 +27,12 @@ struct ExperimentCheckOptions {
   bool IsValid(std::string* error) const;
 };
 
+// Executions of a cell that separate two predictions d2 apart (squared whitened distance per
+// execution) by a one-sided test at alpha 0.005 (2.58 sigma) with power 0.8 (0.84):
+// ceil((2.58 + 0.84)^2 / d2) = ceil(11.7 / d2). d2 > 0. Used by the proposal (knob_analysis.cc)
+// and by its check here, so both apply the same criterion.
+int ExecutionsToSeparate(double d2);
+
 // Separation of paired outcome sets a (n x dx) and b (rows paired by common random numbers):
 //   D_i = a_i - b_i, delta = mean D, S_D = cov D, Sigma = s^2 x the pooled within-set covariance
 //   of a and b (the spread one recording of the cell shows; s = spread_scale, e.g. the real set's
@@ -34,7 +40,7 @@ struct ExperimentCheckOptions {
 //   d2 = max(0, delta^T Sigma^-1 delta - tr(Sigma^-1 S_D) / n)  (squared whitened distance per
 //        execution, debiased for the estimation error of delta),
 //   z = sqrt(N d2) for N proposed executions (expected z of N recorded executions against the
-//       other value's prediction), executions_needed = ceil(11.7 / d2),
+//       other value's prediction), executions_needed = ExecutionsToSeparate(d2),
 //   p = sign-flip permutation p-value of T = delta^T Sigma^-1 delta (H0: no difference in the cell).
 struct PairedSeparation {
   int pairs = 0;

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <random>
@@ -13,6 +12,7 @@
 #include "sim/protocol.h"
 #include "sim2real/effect_fit.h"
 #include "sim2real/locate.h"
+#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -21,12 +21,6 @@ namespace {
 using sim::Knob;
 using sim::KnobKind;
 using sim::KnobValue;
-
-std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[300];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 // One external candidate: how its design is made for a sample.
 struct External {
@@ -478,7 +472,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     if (tie.families.size() < 2) continue;
     // Executions for a one-sided 2.8-sigma separation (alpha 0.005, power 0.8): (2.58 + 0.84)^2 / d^2.
     if (tie.experiment.separation > 0) {
-      tie.experiment.executions = static_cast<int>(std::ceil(11.7 / std::max(tie.experiment.separation, 1e-4)));
+      tie.experiment.executions = ExecutionsToSeparate(std::max(tie.experiment.separation, 1e-4));
     }
     // The check by simulation: the robot at each knob's fitted value in the proposed cell.
     VerdictExperiment& ex = tie.experiment;

@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <random>
 #include <set>
 
+#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -67,12 +67,6 @@ Eigen::MatrixXd HeatMap(const std::vector<Region>& regions, const std::vector<in
     if (it != commands.end()) h(it - commands.begin(), r.terrain) = r.deficit;
   }
   return h;
-}
-
-std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[400];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
 }
 
 std::string Conclude(const Sim2RealResult& r) {

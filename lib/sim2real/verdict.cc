@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <map>
 #include <nlohmann/json.hpp>
+
+#include "sim2real/sentence_format.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -12,12 +13,6 @@ namespace {
 using json = nlohmann::json;
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
-  char buf[300];
-  std::snprintf(buf, sizeof buf, f, a, b, c);
-  return buf;
-}
 
 }  // namespace
 
