@@ -391,13 +391,17 @@ def find_key(obj, key):
 
 
 def parse_seeds(text):
-    a, _, b = text.partition("-")
-    return list(range(int(a), int(b or a) + 1))
+    """Seeds from "A-B", "A" or a comma-separated list of those ("1019,1020,1030-1039")."""
+    seeds = []
+    for part in text.split(","):
+        a, _, b = part.strip().partition("-")
+        seeds += range(int(a), int(b or a) + 1)
+    return seeds
 
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", required=True, help="seed range A-B (DEV 1000-1999, REPORT 5000-...)")
+    ap.add_argument("--seeds", required=True, help="seeds: A-B, or a comma-separated list of seeds and ranges (DEV 1000-1999)")
     ap.add_argument("--jobs", type=int, default=2, help="parallel simulations/analyses (<= 2)")
     ap.add_argument("--build", default=os.path.join(ROOT, "build"))
     ap.add_argument("--out", default=None, help="work folder (default out/battery-A-B)")
@@ -412,6 +416,9 @@ def main():
                     help="UTC time after which no analysis starts and running ones are stopped "
                          "(their pairs are listed as not analysed)")
     ap.add_argument("--rerun", action="store_true", help="rerun analyses already in OUT")
+    ap.add_argument("--kinds", default=None, metavar="K[,K]",
+                    help="keep only pairs of these kinds (null, single, two, out_of_library): "
+                         "for development on one kind; a report runs every pair of its range")
     ap.add_argument("--write-doc", action="store_true",
                     help="write the tables into docs/sim2real.md (section sim2real-battery)")
     args = ap.parse_args()
@@ -432,6 +439,12 @@ def main():
         realism(args, nominals)
         return 0
     pairs = [draw.draw_pair(s, nominals) for s in seeds]
+    if args.kinds:
+        kinds = set(args.kinds.split(","))
+        pairs = [p for p in pairs if p["kind"] in kinds]
+        seeds = [p["seed"] for p in pairs]
+        if not pairs:
+            sys.exit(f"sim2real_battery: no pair of kind {args.kinds} among seeds {args.seeds}")
     t0 = time.time()
     for robot in sorted({p["robot"] for p in pairs}):
         sim_set(args, robot)

@@ -4,8 +4,9 @@
 // set's protocol and seed (signatures.h), plus measurement effects no simulator models
 // (imu_bias: z offset through the sim model's slopes; tracker_bias; heading_drift; tracker_noise).
 // Forward selection by held-out real likelihood (selection.h), ties from the signatures'
-// correlation on the observed samples with a discriminating experiment, the chosen knob refined
-// by re-simulation, the residual tested for structure, and the verdict.
+// correlation on the observed samples with a discriminating experiment, the most important knobs
+// refined by re-simulation (each followed by a new selection), the residual tested for structure,
+// and the verdict.
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -26,7 +27,8 @@ struct KnobAnalysisOptions {
   SelectionOptions selection;      // bootstrap_selection 0: inclusion not computed
   ResidualStructureOptions residual;
   double tie_correlation = 0.9;    // |corr| of whitened signatures on the real samples
-  int refine_iterations = 2;       // re-simulations of the first-named knob (0: none)
+  int refine_iterations = 3;       // re-simulations per refined knob (0: no refinement)
+  int refine_knobs = 2;            // knobs refined at most (most important first), each followed by a new selection
   ExperimentCheckOptions experiment;  // the check by simulation of each tie's proposed experiment
   int max_experiment_checks = 3;      // ties checked at most (the rest say so)
   bool IsValid(std::string* error) const;
@@ -55,7 +57,12 @@ struct KnobAnalysis {
   int experiment_checks = 0;        // ties whose experiment was simulated (2 cell runs each)
   double experiment_seconds = 0;    // wall time of those checks
   std::string cache_dir;
-  std::vector<std::pair<double, double>> refine_trace;  // (value simulated, fitted coefficient)
+  std::vector<int> removed;               // candidate indices dropped by the selection's backward pass
+  struct RefineStep {
+    std::string knob;
+    double value = 0, coefficient = 0;  // value simulated, fitted coefficient of its signature
+  };
+  std::vector<RefineStep> refine_trace;
   double ll_sim = 0, ll_corrected = 0, ll_ceiling = 0;
   std::string note;
 };

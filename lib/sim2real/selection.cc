@@ -200,6 +200,26 @@ SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows
     remaining.erase(std::find(remaining.begin(), remaining.end(), best.effect));
     result.steps.push_back(step);
   }
+  // Backward pass: drop the effect whose removal costs least while that cost is insignificant.
+  while (options.backward && result.selected.size() > 1) {
+    const double threshold = UpperQuantile(options.alpha / result.selected.size());
+    size_t weakest = 0;
+    double weakest_z = INFINITY, weakest_gain = 0;
+    Eigen::VectorXd weakest_ll;
+    for (size_t k = 0; k < result.selected.size(); ++k) {
+      std::vector<int> without = result.selected;
+      without.erase(without.begin() + k);
+      Eigen::VectorXd ll = CrossValidate(fp, without, rows, fold, options.fit);
+      double gain, se;
+      ClusteredMean(current - ll, cluster, &gain, &se);
+      const double z = se > 0 ? gain / se : (gain > 0 ? INFINITY : 0.0);
+      if (z < weakest_z) weakest = k, weakest_z = z, weakest_gain = gain, weakest_ll = ll;
+    }
+    if (weakest_z > threshold && weakest_gain > options.min_gain_nats) break;
+    result.removed.push_back(result.selected[weakest]);
+    result.selected.erase(result.selected.begin() + weakest);
+    current = weakest_ll;
+  }
   result.heldout_corrected = current;
   result.fit = FitEffects(fp, result.selected, rows, options.fit);
   for (size_t k = 0; k < result.selected.size(); ++k) {

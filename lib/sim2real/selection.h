@@ -20,6 +20,11 @@ struct SelectionOptions {
   int bootstrap_selection = 20;    // resamples of the whole selection (inclusion probability)
   int bootstrap_parameters = 200;  // resamples of the final fit (confidence intervals)
   double confusion_correlation = 0.8;  // |corr| of fitted shifts above which two effects may be confused
+  // After the forward steps, remove one at a time the selected effect whose removal costs the
+  // least held-out likelihood while that cost is not significant (same Bonferroni level over the
+  // selected effects): an effect that won an early step only because the right one was not yet in
+  // the model (e.g. noise inflating the variance of a mean shift) is dropped again.
+  bool backward = false;
   EffectFitOptions fit;
   bool IsValid(std::string* error) const;
 };
@@ -56,6 +61,7 @@ struct SelectionStep {
 struct SelectionResult {
   std::vector<int> selected;            // library indices, in order of selection
   std::vector<SelectionStep> steps;
+  std::vector<int> removed;             // library indices dropped by the backward pass, in order
   // Per selected effect: held-out nats per real sample lost when it alone is removed from the
   // final set (its importance given the others; effects are ranked by it).
   std::vector<double> importance;

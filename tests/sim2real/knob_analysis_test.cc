@@ -91,6 +91,28 @@ TEST(SimulationCache, SecondRequestIsReadBackIdentical) {
   std::filesystem::remove_all(dir);
 }
 
+// Fills the sim-side fields of `fp` (whitened designs = designs, unit log-normaliser) with real
+// residuals r0 = shift(i, j) + N(0, 1), episodes of 5 samples and 3 commands; returns the rows
+// 0..n-1 and their 5 episode folds in *fold.
+template <typename Shift>
+std::vector<int> FillResidualsAndFolds(FitProblem* fp, Shift shift, std::uint64_t seed, std::vector<int>* fold) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> unit(0, 1);
+  fp->g = fp->d;
+  fp->r0.resize(fp->n, fp->dx);
+  fp->log_norm = Eigen::VectorXd::Constant(fp->n, -fp->dx * 0.5 * std::log(2 * M_PI));
+  for (int i = 0; i < fp->n; ++i) {
+    for (int j = 0; j < fp->dx; ++j) fp->r0(i, j) = shift(i, j) + unit(rng);
+    fp->episode.push_back(i / 5);
+    fp->command.push_back(i % 3);
+  }
+  std::vector<int> rows(fp->n);
+  for (int i = 0; i < fp->n; ++i) rows[i] = i;
+  std::mt19937_64 frng(1);
+  *fold = MakeFolds(*fp, rows, 5, frng);
+  return rows;
+}
+
 // Two candidates with the same design (perfectly collinear signatures) from different families
 // must be reported as a tie; a third, orthogonal one must not.
 TEST(TiedCandidates, CollinearSignaturesTie) {
@@ -98,8 +120,6 @@ TEST(TiedCandidates, CollinearSignaturesTie) {
   FitProblem fp;
   fp.n = n;
   fp.dx = dx;
-  std::mt19937_64 rng(3);
-  std::normal_distribution<double> unit(0, 1);
   Eigen::MatrixXd d1(n * dx, 1), d3(n * dx, 1);
   for (int i = 0; i < n; ++i) {
     d1(i * dx) = 1.0 + 0.5 * std::sin(i);
@@ -115,20 +135,11 @@ TEST(TiedCandidates, CollinearSignaturesTie) {
     fp.library.push_back(s);
   }
   fp.d = {d1, d1, d3};
-  fp.g = fp.d;
-  fp.r0.resize(n, dx);
-  fp.log_norm = Eigen::VectorXd::Constant(n, -dx * 0.5 * std::log(2 * M_PI));
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < dx; ++j) fp.r0(i, j) = 0.8 * d1(i * dx + j) + unit(rng);
-    fp.episode.push_back(i / 5);
-    fp.command.push_back(i % 3);
-  }
-  std::vector<int> rows(n);
-  for (int i = 0; i < n; ++i) rows[i] = i;
-  std::mt19937_64 frng(1);
+  std::vector<int> fold;
+  const std::vector<int> rows =
+      FillResidualsAndFolds(&fp, [&](int i, int j) { return 0.8 * d1(i * dx + j); }, 3, &fold);
   SelectionOptions so;
   so.bootstrap_selection = 0;
-  const std::vector<int> fold = MakeFolds(fp, rows, 5, frng);
   const SelectionResult sel = ForwardSelect(fp, rows, fold, so);
   ASSERT_FALSE(sel.selected.empty());
   const int chosen = sel.selected[0];
@@ -141,6 +152,52 @@ TEST(TiedCandidates, CollinearSignaturesTie) {
   EXPECT_NEAR(corr[0], 1.0, 1e-6);
   // The same family is never a tie with itself.
   EXPECT_TRUE(TiedCandidates(fp, sel.steps[0], chosen, {"friction", "friction", "contact"}, 0.9, so.fit).empty());
+}
+
+// Two mean shifts, each too weak alone to beat a wider variance: forward selection takes noise
+// first, then both shifts; the backward pass drops the noise again (the residual left by the two
+// shifts has the simulated scale), and keeps both shifts.
+TEST(ForwardSelect, BackwardPassDropsNoiseThatOnlyStoodInForMissingShifts) {
+  const int n = 400, dx = 2;
+  FitProblem fp;
+  fp.n = n;
+  fp.dx = dx;
+  Eigen::MatrixXd d1 = Eigen::MatrixXd::Zero(n * dx, 1), d2 = Eigen::MatrixXd::Zero(n * dx, 1);
+  for (int i = 0; i < n; ++i) {
+    d1(i * dx) = (i % 2 ? 1.0 : -1.0);
+    d2(i * dx + 1) = ((i / 2) % 2 ? 1.0 : -1.0);
+  }
+  EffectSpec noise;
+  noise.id = EffectId::kNoise;
+  noise.key = "noise";
+  noise.is_noise = true;
+  noise.parameters = {{"log_tau", ""}};
+  fp.library.push_back(noise);
+  for (int k = 1; k <= 2; ++k) {
+    EffectSpec s;
+    s.id = EffectId::kExternal;
+    s.key = "e" + std::to_string(k);
+    s.parameters = {{"t", ""}};
+    fp.library.push_back(s);
+  }
+  fp.d = {Eigen::MatrixXd::Zero(n * dx, 1), d1, d2};
+  std::vector<int> fold;
+  const std::vector<int> rows = FillResidualsAndFolds(
+      &fp, [&](int i, int j) { return 2.5 * d1(i * dx + j) + 2.5 * d2(i * dx + j); }, 5, &fold);
+  SelectionOptions so;
+  so.bootstrap_selection = 0;
+  const SelectionResult forward = ForwardSelect(fp, rows, fold, so);
+  ASSERT_FALSE(forward.steps.empty());
+  ASSERT_EQ(forward.steps[0].chosen, 0) << "the case needs noise to win the first step";
+  EXPECT_EQ(forward.selected.size(), 3u);
+  so.backward = true;
+  const SelectionResult both = ForwardSelect(fp, rows, fold, so);
+  EXPECT_EQ(both.removed, std::vector<int>{0});
+  std::vector<int> kept = both.selected;
+  std::sort(kept.begin(), kept.end());
+  EXPECT_EQ(kept, (std::vector<int>{1, 2}));
+  EXPECT_NEAR(both.fit.log_tau, 0.0, 0.15);
+  EXPECT_GE(both.heldout_corrected.mean(), forward.heldout_corrected.mean() - 0.01);
 }
 
 // Residuals with a step-periodic offset (alternating sign along the five executions of each
