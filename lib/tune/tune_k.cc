@@ -6,10 +6,11 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <map>
+#include <limits>
 #include <sstream>
 #include <tuple>
 
+#include "tune/quadratic_surrogate.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -79,6 +80,7 @@ bool TuneKOptions::IsValid(std::string* error) const {
   }
   if (grid_points < 3) return fail("grid_points must be >= 3");
   if (cycles < 1) return fail("cycles must be >= 1");
+  if (joint && joint_rounds < 1) return fail("joint_rounds must be >= 1");
   if (refine_points < 0) return fail("refine_points must be >= 0");
   if (!(plateau_tolerance >= 0) || !std::isfinite(plateau_tolerance)) {
     return fail("plateau_tolerance must be finite and >= 0");
@@ -110,10 +112,17 @@ Plateau FindPlateau(const std::vector<TuneKPoint>& points, double tolerance) {
     }
   }
   p.flat = p.members.size() > 1;
-  p.k_lo = p.k_hi = points[p.best].k;
+  const TuneKPoint& top = points[p.best];
+  p.k_lo = p.k_hi = top.k;
+  p.init_scale_lo = p.init_scale_hi = top.init_scale;
+  p.prior_count_lo = p.prior_count_hi = top.prior_count;
   for (int i : p.members) {
     p.k_lo = std::min(p.k_lo, points[i].k);
     p.k_hi = std::max(p.k_hi, points[i].k);
+    p.init_scale_lo = std::min(p.init_scale_lo, points[i].init_scale);
+    p.init_scale_hi = std::max(p.init_scale_hi, points[i].init_scale);
+    p.prior_count_lo = std::min(p.prior_count_lo, points[i].prior_count);
+    p.prior_count_hi = std::max(p.prior_count_hi, points[i].prior_count);
   }
   return p;
 }
@@ -193,11 +202,15 @@ class Evaluator {
   Evaluator(const SampleSet& set, CvOptions cv, const TuneKOptions& options, TuneKSummary* summary)
       : set_(set), cv_(std::move(cv)), options_(options), summary_(summary) {}
   DgmmOptions& dgmm() { return cv_.dgmm; }
+  // The cached evaluation at (k, f, nu0) (equal to within a relative 1e-9, so a design point
+  // computed as exp(log k + step) finds the grid's k), else a new cross-validation.
   TuneKPoint operator()(double k, const char* role) {
     cv_.dgmm.k = k;
-    const auto key =
-        std::make_tuple(k, cv_.dgmm.initial_covariance_fraction, cv_.dgmm.prior_pseudo_count);
-    if (auto it = cache_.find(key); it != cache_.end()) return it->second;
+    const double f = cv_.dgmm.initial_covariance_fraction, nu = cv_.dgmm.prior_pseudo_count;
+    auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::abs(b); };
+    for (const TuneKPoint& p : cache_) {
+      if (same(p.k, k) && same(p.init_scale, f) && same(p.prior_count, nu)) return p;
+    }
     if (options_.progress) options_.progress(static_cast<int>(cache_.size()), -1);
     const CvSummary result = CrossValidate(set_, cv_);
     summary_->folds = result.folds;
@@ -205,11 +218,13 @@ class Evaluator {
     summary_->samples = result.samples;
     summary_->folds_by = result.folds_by;
     summary_->evaluations = static_cast<int>(cache_.size()) + 1;
-    return cache_[key] = ToPoint(
-               cv_.dgmm,
-               summary_->with_terrain ? result.dgmm_with_terrain : result.dgmm_without_terrain,
-               role);
+    cache_.push_back(ToPoint(
+        cv_.dgmm, summary_->with_terrain ? result.dgmm_with_terrain : result.dgmm_without_terrain,
+        role));
+    return cache_.back();
   }
+  // Every evaluation so far, in order.
+  const std::vector<TuneKPoint>& all() const { return cache_; }
   double Tolerance(const std::vector<TuneKPoint>& pts) const {
     if (options_.plateau_tolerance > 0) return options_.plateau_tolerance;
     return std::max(pts[FindPlateau(pts, 0.0).best].standard_error, 1e-9);
@@ -220,7 +235,7 @@ class Evaluator {
   CvOptions cv_;
   const TuneKOptions& options_;
   TuneKSummary* summary_;
-  std::map<std::tuple<double, double, double>, TuneKPoint> cache_;
+  std::vector<TuneKPoint> cache_;
 };
 
 // The k step at the evaluator's f and nu0: grid, bracket, refinement, Ceres fit, plateau rule.
@@ -332,6 +347,147 @@ TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions:
   return pick;
 }
 
+// The typical step of a geometric grid in log units: the median log ratio of neighbours (log 3
+// for a grid of fewer than two values).
+double LogGridStep(std::vector<double> grid) {
+  std::sort(grid.begin(), grid.end());
+  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
+  std::vector<double> steps;
+  for (size_t i = 1; i < grid.size(); ++i) steps.push_back(std::log(grid[i] / grid[i - 1]));
+  if (steps.empty()) return std::log(3.0);
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  return steps[steps.size() / 2];
+}
+
+// The joint step (tune_k.h, 3.): a design around *chosen, a concave quadratic surrogate fitted to
+// the evaluations in its box and maximised there (Ceres), L evaluated at the maximiser, and the
+// acceptance and plateau rules. Updates *chosen and summary->joint.
+void JointStep(const TuneKOptions& options, bool tune_scale, bool tune_prior, Evaluator& evaluate,
+               TuneKPoint* chosen, TuneKSummary* summary) {
+  TuneJointStep& joint = summary->joint;
+  joint.run = true;
+  joint.start = *chosen;
+  const int before = summary->evaluations;
+  // Coordinates: which (0: k, 1: f, 2: nu0), step, and bounds in log units.
+  struct Axis {
+    int which;
+    double step, lo, hi;
+  };
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<Axis> axes = {{0, (std::log(options.k_max) - std::log(options.k_min)) /
+                                    (options.grid_points - 1),
+                             std::log(options.k_min), std::log(options.k_max)}};
+  joint.coordinates = {"log k"};
+  if (tune_scale) {
+    axes.push_back({1, LogGridStep(options.init_scales), -kInf, kInf});
+    joint.coordinates.push_back("log f");
+  }
+  if (tune_prior) {
+    axes.push_back({2, LogGridStep(options.prior_counts), -kInf, kInf});
+    joint.coordinates.push_back("log nu0");
+  }
+  const int dims = static_cast<int>(axes.size());
+  auto value = [](const TuneKPoint& p, int which) {
+    return std::log(which == 0 ? p.k : which == 1 ? p.init_scale : p.prior_count);
+  };
+  auto evaluate_at = [&](const Eigen::VectorXd& v, const char* role) {
+    double k = 0;
+    for (int i = 0; i < dims; ++i) {
+      if (axes[i].which == 0) k = std::exp(v[i]);
+      if (axes[i].which == 1) evaluate.dgmm().initial_covariance_fraction = std::exp(v[i]);
+      if (axes[i].which == 2) evaluate.dgmm().prior_pseudo_count = std::exp(v[i]);
+    }
+    return evaluate(k, role);
+  };
+  auto same_point = [](const TuneKPoint& p, const TuneKPoint& q) {
+    return p.k == q.k && p.init_scale == q.init_scale && p.prior_count == q.prior_count;
+  };
+  for (int round = 0; round < options.joint_rounds; ++round) {
+    joint.rounds = round + 1;
+    // Design centre m: the choice, moved inward so that m +- step stays within the bounds; the
+    // step halves in each round.
+    Eigen::VectorXd m(dims), step(dims);
+    for (int i = 0; i < dims; ++i) {
+      const Axis& a = axes[i];
+      step[i] = std::min(std::ldexp(a.step, -round), (a.hi - a.lo) / 2);
+      m[i] = std::clamp(value(*chosen, a.which), a.lo + step[i], a.hi - step[i]);
+    }
+    evaluate_at(m, "joint");
+    for (int i = 0; i < dims; ++i) {
+      for (int sign : {-1, 1}) {
+        evaluate_at(m + sign * step[i] * Eigen::VectorXd::Unit(dims, i), "joint");
+      }
+    }
+    for (int corner = 0; corner < (1 << dims); ++corner) {
+      Eigen::VectorXd v = m;
+      for (int i = 0; i < dims; ++i) v[i] += (corner >> i & 1 ? 1 : -1) * step[i];
+      evaluate_at(v, "joint");
+    }
+    // Every evaluation in the design's box (the f and nu0 not tuned are fixed throughout).
+    std::vector<TuneKPoint> in_box;
+    for (const TuneKPoint& p : evaluate.all()) {
+      bool inside = true;
+      for (int i = 0; i < dims; ++i) {
+        inside = inside && std::abs(value(p, axes[i].which) - m[i]) <= step[i] * (1 + 1e-9);
+      }
+      if (inside) in_box.push_back(p);
+    }
+    Eigen::MatrixXd V(in_box.size(), dims);
+    Eigen::VectorXd y(in_box.size());
+    for (size_t j = 0; j < in_box.size(); ++j) {
+      for (int i = 0; i < dims; ++i) V(j, i) = value(in_box[j], axes[i].which);
+      y[j] = in_box[j].log_likelihood;
+    }
+    const double scale = std::max(in_box[FindPlateau(in_box, 0.0).best].standard_error, 1e-6);
+    const SurrogateMaximum surrogate = FitAndMaximiseQuadratic(V, y, scale);
+    joint.fit_points = surrogate.fit_points;
+    joint.fit_report = surrogate.fit_report;
+    joint.maximise_report = surrogate.maximise_report;
+    joint.surrogate_maximum = surrogate.value;
+    const TuneKPoint at_max = evaluate_at(surrogate.v, "joint-max");
+    joint.surrogate_k = at_max.k;
+    joint.surrogate_init_scale = at_max.init_scale;
+    joint.surrogate_prior_count = at_max.prior_count;
+    joint.evaluated_log_likelihood = at_max.log_likelihood;
+    joint.evaluated_standard_error = at_max.standard_error;
+    in_box.push_back(at_max);
+    for (const TuneKPoint& p : in_box) {
+      if (std::none_of(joint.points.begin(), joint.points.end(),
+                       [&](const TuneKPoint& q) { return same_point(p, q); })) {
+        joint.points.push_back(p);
+      }
+    }
+
+    // Acceptance and the plateau rule over every evaluation of the step so far.
+    joint.tolerance = evaluate.Tolerance(joint.points);
+    joint.plateau = FindPlateau(joint.points, joint.tolerance);
+    const TuneKPoint& best = joint.points[joint.plateau.best];
+    const TuneKPoint& simplest = joint.points[joint.plateau.simplest];
+    std::string rule = "round " + std::to_string(round + 1) + " (step x " + Num(std::ldexp(1.0, -round)) +
+                       "): the surrogate's maximum " + Num(surrogate.value) + " at k = " +
+                       Num(at_max.k) + ", f = " + Num(at_max.init_scale) + ", nu0 = " +
+                       Num(at_max.prior_count) + " evaluates to " + Num(at_max.log_likelihood) +
+                       "; ";
+    if (best.log_likelihood > chosen->log_likelihood + joint.tolerance) {
+      joint.accepted = true;
+      *chosen = joint.plateau.flat ? simplest : best;
+      rule += "an evaluation beats the choice by more than " + Num(joint.tolerance) +
+              ": moved to " +
+              (joint.plateau.flat ? "the simplest model of the plateau" : "the best evaluation");
+    } else if (simplest.components < chosen->components - 1e-9) {
+      *chosen = simplest;
+      rule += "nothing beats the choice by more than " + Num(joint.tolerance) +
+              "; moved to a strictly simpler equivalent model (plateau rule)";
+    } else {
+      rule += "nothing beats the choice by more than " + Num(joint.tolerance) + ": kept it";
+    }
+    joint.rule += (round > 0 ? "; " : "") + rule;
+  }
+  joint.evaluations = summary->evaluations - before;
+  evaluate.dgmm().initial_covariance_fraction = chosen->init_scale;
+  evaluate.dgmm().prior_pseudo_count = chosen->prior_count;
+}
+
 }  // namespace
 
 TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
@@ -377,6 +533,7 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
       break;
     }
   }
+  if (options.joint) JointStep(options, tune_scale, tune_prior, evaluate, &chosen, &summary);
   summary.k = chosen.k;
   summary.init_scale = chosen.init_scale;
   summary.prior_count = chosen.prior_count;
@@ -402,6 +559,16 @@ std::string TuneKSummary::BriefReport() const {
   }
   if (prior_count_tuned) {
     out << "; nu0 " << prior_count << (prior_count_plateau ? " (simplest of a plateau)" : "");
+  }
+  if (joint.run) {
+    out << "; joint step over (" << joint.coordinates.size() << " coordinates, "
+        << joint.evaluations << " new cross-validations): " << joint.rule;
+    if (joint.plateau.flat) {
+      out << "; joint plateau of " << joint.plateau.members.size() << " evaluations, k in ["
+          << joint.plateau.k_lo << ", " << joint.plateau.k_hi << "], f in ["
+          << joint.plateau.init_scale_lo << ", " << joint.plateau.init_scale_hi << "], nu0 in ["
+          << joint.plateau.prior_count_lo << ", " << joint.plateau.prior_count_hi << "]";
+    }
   }
   return out.str();
 }
