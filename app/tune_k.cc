@@ -83,12 +83,18 @@ void PlotCurve(const TuneKSummary& s, const std::string& path) {
     fit.x.push_back(k);
     fit.y.push_back(s.Smoothed(k));
   }
-  // The chosen k as a vertical segment spanning its held-out log-likelihood +- one s.e.
-  ChartSeries chosen{"chosen k (+- s.e.)",
-                     {s.k, s.k},
-                     {s.log_likelihood - s.standard_error, s.log_likelihood + s.standard_error},
-                     {},
-                     {}};
+  // The chosen k as a vertical segment spanning its held-out log-likelihood +- one s.e. (at
+  // other f, nu0 than the curve's when the joint step moved them: the legend says so).
+  const bool moved = s.joint.run && (s.init_scale != s.joint.start.init_scale ||
+                                     s.prior_count != s.joint.start.prior_count);
+  ChartSeries chosen{
+      moved ? fmt::format("chosen k (+- s.e.) at f = {:.3g}, nu0 = {:.3g} (joint step)",
+                          s.init_scale, s.prior_count)
+            : std::string("chosen k (+- s.e.)"),
+      {s.k, s.k},
+      {s.log_likelihood - s.standard_error, s.log_likelihood + s.standard_error},
+      {},
+      {}};
   spec.series = {cv, fit, chosen};
   RenderLineChart(spec, path);
 }
@@ -135,15 +141,19 @@ nlohmann::json JointJson(const TuneJointStep& j) {
 }
 
 // The joint step as text.
-void PrintJoint(const TuneJointStep& j) {
+void PrintJoint(const TuneKSummary& s) {
+  const TuneJointStep& j = s.joint;
   if (!j.run) return;
+  const bool moved = s.k != j.start.k || s.init_scale != j.start.init_scale ||
+                     s.prior_count != j.start.prior_count;
   std::cout << fmt::format(
       "joint step in ({}): {} round(s), {} new cross-validations, last surrogate fitted to {} "
       "evaluations\n",
       fmt::join(j.coordinates, ", "), j.rounds, j.evaluations, j.fit_points);
   for (const auto& p : j.points) {
     std::cout << fmt::format(
-        "  k {:<10.4g} f {:<8.3g} nu0 {:<8.3g} log-likelihood {:.2f} +- {:.2f}, mean K {:.2f}  {}\n",
+        "  k {:<10.4g} f {:<8.3g} nu0 {:<8.3g} log-likelihood {:.2f} +- {:.2f}, mean K {:.2f}  "
+        "{}\n",
         p.k, p.init_scale, p.prior_count, p.log_likelihood, p.standard_error, p.components, p.role);
   }
   std::cout << fmt::format(
@@ -151,7 +161,11 @@ void PrintJoint(const TuneJointStep& j) {
       "{:.2f} +- {:.2f}\n",
       j.surrogate_maximum, j.surrogate_k, j.surrogate_init_scale, j.surrogate_prior_count,
       j.evaluated_log_likelihood, j.evaluated_standard_error);
-  std::cout << fmt::format("  {}: {}\n", j.accepted ? "ACCEPTED" : "NOT ACCEPTED", j.rule);
+  std::cout << fmt::format(
+      "  {}: {}\n",
+      j.accepted ? "ACCEPTED"
+                 : (moved ? "NOT ACCEPTED, SIMPLER EQUIVALENT CHOSEN" : "NOT ACCEPTED"),
+      j.rule);
   const Plateau& pl = j.plateau;
   if (pl.flat) {
     std::cout << fmt::format(
@@ -169,7 +183,8 @@ void RunTuneK(const TuneKArgs& args) {
     throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
   }
   // Unwritable output folders are reported before the long run, not after it.
-  for (const auto& [output, flag] : {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
+  for (const auto& [output, flag] :
+       {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
     if (output.empty()) continue;
     RefuseOutputThatIsAnInput(output, {args.path}, flag);
     AtomicFile probe(output);
@@ -210,11 +225,15 @@ void RunTuneK(const TuneKArgs& args) {
   std::string error;
   if (!options.IsValid(&error)) {
     throw OptionsError(args.path, error,
-                       {{"k_min", "--k-min/--k-max"}, {"grid_points", "--grid-points"},
+                       {{"k_min", "--k-min/--k-max"},
+                        {"grid_points", "--grid-points"},
                         {"refine_points", "--refine-points"},
                         {"plateau_tolerance", "--plateau-tolerance"},
-                        {"init_scales", "--init-scales"}, {"prior_counts", "--prior-counts"},
-                        {"threads", "--threads"}, {"folds", "--folds"}, {"repeats", "--repeats"}});
+                        {"init_scales", "--init-scales"},
+                        {"prior_counts", "--prior-counts"},
+                        {"threads", "--threads"},
+                        {"folds", "--folds"},
+                        {"repeats", "--repeats"}});
   }
   const TuneKSummary s = TuneK(set, options);
   const std::string folds_by = s.folds_by;
@@ -287,7 +306,14 @@ void RunTuneK(const TuneKArgs& args) {
       "({:.1f} s)\n",
       args.path, s.samples, s.repeats, s.folds, s.with_terrain ? "with" : "without", args.seed,
       s.evaluations, s.cycles, s.seconds);
-  std::cout << "last k step (at the final S0 scale and nu0):\n";
+  // The coordinate steps' choice (the joint step's start when it ran; the final choice below).
+  TuneKPoint cyclic = s.joint.start;
+  if (!s.joint.run) {
+    cyclic.k = s.k;
+    cyclic.init_scale = s.init_scale;
+    cyclic.prior_count = s.prior_count;
+  }
+  std::cout << "last k step (at the coordinate steps' S0 scale and nu0):\n";
   std::cout << "folds: " << folds_by << "\n";
   std::cout << fmt::format("{:>12}{:>16}{:>12}{:>14}{:>10}  {}\n", "k", "log-likelihood",
                            "std. error", "smoothed", "mean K", "");
@@ -303,7 +329,7 @@ void RunTuneK(const TuneKArgs& args) {
     std::cout << fmt::format(
         "PLATEAU: {} evaluations within {:.3g} of the best, k from {:.4g} to {:.4g} are "
         "equivalent; k = {:.5g} is the simplest model there, not a sharp optimum\n",
-        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, s.k);
+        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, cyclic.k);
   } else {
     std::cout << "k: " << s.k_rule << "\n";
   }
@@ -317,16 +343,16 @@ void RunTuneK(const TuneKArgs& args) {
   if (s.init_scale_tuned) {
     print_side("S0 scale", s.scale_curve, true);
     std::cout << fmt::format(
-        "S0 scale f = {:.3g}{}\n", s.init_scale,
+        "S0 scale f = {:.3g}{}\n", cyclic.init_scale,
         s.init_scale_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
   }
   if (s.prior_count_tuned) {
     print_side("nu0", s.prior_curve, false);
     std::cout << fmt::format(
-        "prior pseudo-count nu0 = {:.3g}{}\n", s.prior_count,
+        "prior pseudo-count nu0 = {:.3g}{}\n", cyclic.prior_count,
         s.prior_count_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
   }
-  PrintJoint(s.joint);
+  PrintJoint(s);
   std::cout << fmt::format(
       "chosen k = {:.5g}: held-out log-likelihood {:.2f} +- {:.2f} (s.e.), {:.2f} Gaussians per "
       "command\n",

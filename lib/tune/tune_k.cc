@@ -322,9 +322,9 @@ TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions:
       const double ratio = direction > 0 ? sorted[sorted.size() - 1] / sorted[sorted.size() - 2]
                                          : sorted[0] / sorted[1];
       for (int step = 0; step < kMaxExtension; ++step) {
-        const auto best = std::max_element(pts.begin(), pts.end(), [](const auto& a, const auto& b) {
-          return a.log_likelihood < b.log_likelihood;
-        });
+        const auto best = std::max_element(
+            pts.begin(), pts.end(),
+            [](const auto& a, const auto& b) { return a.log_likelihood < b.log_likelihood; });
         const auto extreme = std::minmax_element(
             pts.begin(), pts.end(),
             [&](const auto& a, const auto& b) { return value_of(a) < value_of(b); });
@@ -374,9 +374,9 @@ void JointStep(const TuneKOptions& options, bool tune_scale, bool tune_prior, Ev
     double step, lo, hi;
   };
   constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::vector<Axis> axes = {{0, (std::log(options.k_max) - std::log(options.k_min)) /
-                                    (options.grid_points - 1),
-                             std::log(options.k_min), std::log(options.k_max)}};
+  std::vector<Axis> axes = {
+      {0, (std::log(options.k_max) - std::log(options.k_min)) / (options.grid_points - 1),
+       std::log(options.k_min), std::log(options.k_max)}};
   joint.coordinates = {"log k"};
   if (tune_scale) {
     axes.push_back({1, LogGridStep(options.init_scales), -kInf, kInf});
@@ -463,11 +463,11 @@ void JointStep(const TuneKOptions& options, bool tune_scale, bool tune_prior, Ev
     joint.plateau = FindPlateau(joint.points, joint.tolerance);
     const TuneKPoint& best = joint.points[joint.plateau.best];
     const TuneKPoint& simplest = joint.points[joint.plateau.simplest];
-    std::string rule = "round " + std::to_string(round + 1) + " (step x " + Num(std::ldexp(1.0, -round)) +
-                       "): the surrogate's maximum " + Num(surrogate.value) + " at k = " +
-                       Num(at_max.k) + ", f = " + Num(at_max.init_scale) + ", nu0 = " +
-                       Num(at_max.prior_count) + " evaluates to " + Num(at_max.log_likelihood) +
-                       "; ";
+    std::string rule = "round " + std::to_string(round + 1) + " (step x " +
+                       Num(std::ldexp(1.0, -round)) + "): the surrogate's maximum " +
+                       Num(surrogate.value) + " at k = " + Num(at_max.k) +
+                       ", f = " + Num(at_max.init_scale) + ", nu0 = " + Num(at_max.prior_count) +
+                       " evaluates to " + Num(at_max.log_likelihood) + "; ";
     if (best.log_likelihood > chosen->log_likelihood + joint.tolerance) {
       joint.accepted = true;
       *chosen = joint.plateau.flat ? simplest : best;

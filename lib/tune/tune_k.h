@@ -53,8 +53,8 @@ struct TuneKOptions {
   // skips the step and keeps cv.dgmm's value.
   std::vector<double> init_scales = {0.03, 0.1, 0.3, 1.0, 3.0, 10.0};
   std::vector<double> prior_counts = {1.0, 4.0, 16.0, 64.0};
-  int cycles = 3;  // at most this many (k, f, nu0) cycles
-  bool joint = true;  // the joint Ceres step after the cycles (see above)
+  int cycles = 3;        // at most this many (k, f, nu0) cycles
+  bool joint = true;     // the joint Ceres step after the cycles (see above)
   int joint_rounds = 2;  // its rounds, each re-centred on the choice with half the step
   // Called before each cross-validation with (index, -1) (the total is not known in advance),
   // and once at the end with (total, total).
@@ -95,10 +95,10 @@ struct TuneJointStep {
   double surrogate_k = 0, surrogate_init_scale = 0, surrogate_prior_count = 0;
   double surrogate_maximum = 0;
   double evaluated_log_likelihood = 0, evaluated_standard_error = 0;
-  bool accepted = false;  // an evaluation beat the choice by more than the tolerance
-  std::string rule;       // what each round did, one sentence per round
-  int evaluations = 0;    // new cross-validations in this step
-  int fit_points = 0;     // evaluations the surrogate was fitted to
+  bool accepted = false;           // an evaluation beat the choice by more than the tolerance
+  std::string rule;                // what each round did, one sentence per round
+  int evaluations = 0;             // new cross-validations in this step
+  int fit_points = 0;              // evaluations the surrogate was fitted to
   std::vector<TuneKPoint> points;  // every evaluation in the rounds' boxes and the maximisers'
   // Plateau over `points`: ranges of k, f and nu0 over the equivalent set.
   Plateau plateau;

@@ -123,31 +123,8 @@ TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
   EXPECT_EQ(s.components, 1.0);
 }
 
-// A grid of S0 scales far below what the data want: the best is the grid's top, so the tuner
-// steps on beyond it (by the grid's ratio) instead of reporting the edge as the optimum.
-TEST(TuneK, StepsBeyondAGridWhoseEdgeIsBest) {
-  const SampleSet set = test::MakeTerrainSet(2, 30, 1.0, 5);
-  TuneKOptions options;
-  options.cv.folds = 4;
-  options.cv.repeats = 1;
-  options.k_min = 0.1;
-  options.k_max = 10;
-  options.grid_points = 3;
-  options.refine_points = 1;
-  options.cycles = 1;
-  options.init_scales = {1e-4, 3e-4};
-  options.cv.dgmm.initial_covariance_fraction = 1e-4;  // the start is on the grid too
-  options.prior_counts.clear();
-  const TuneKSummary s = TuneK(set, options);
-  ASSERT_TRUE(s.init_scale_tuned);
-  double largest = 0;
-  for (const auto& p : s.scale_curve) largest = std::max(largest, p.init_scale);
-  EXPECT_GT(largest, 3e-4 * 2);  // evaluated beyond the grid
-  EXPECT_GT(s.init_scale, 3e-4 * 2) << "chose the grid's edge";
-}
-
-// Options for the joint-step tests: small folds, coarse grids, one coordinate cycle.
-TuneKOptions JointOptions() {
+// Small folds, coarse grids, one coordinate cycle: fast TuneK runs.
+TuneKOptions SmallOptions() {
   TuneKOptions options;
   options.cv.folds = 4;
   options.cv.repeats = 2;
@@ -161,12 +138,30 @@ TuneKOptions JointOptions() {
   return options;
 }
 
+// A grid of S0 scales far below what the data want: the best is the grid's top, so the tuner
+// steps on beyond it (by the grid's ratio) instead of reporting the edge as the optimum.
+TEST(TuneK, StepsBeyondAGridWhoseEdgeIsBest) {
+  const SampleSet set = test::MakeTerrainSet(2, 30, 1.0, 5);
+  TuneKOptions options = SmallOptions();
+  options.cv.repeats = 1;
+  options.joint = false;  // the coordinate step alone
+  options.init_scales = {1e-4, 3e-4};
+  options.cv.dgmm.initial_covariance_fraction = 1e-4;  // the start is on the grid too
+  options.prior_counts.clear();
+  const TuneKSummary s = TuneK(set, options);
+  ASSERT_TRUE(s.init_scale_tuned);
+  double largest = 0;
+  for (const auto& p : s.scale_curve) largest = std::max(largest, p.init_scale);
+  EXPECT_GT(largest, 3e-4 * 2);  // evaluated beyond the grid
+  EXPECT_GT(s.init_scale, 3e-4 * 2) << "chose the grid's edge";
+}
+
 // The joint step starts from the cyclic choice, is never worse than it by more than the
 // tolerance (and better when it accepts), and reports its plateau's ranges over every evaluation.
 TEST(TuneK, JointStepIsNeverWorseThanTheCyclicChoice) {
   for (std::uint64_t seed : {3, 4}) {
     const SampleSet set = test::MakeTerrainSet(3, 24, 1.0, seed);
-    TuneKOptions options = JointOptions();
+    TuneKOptions options = SmallOptions();
     options.joint = false;
     const TuneKSummary cyclic = TuneK(set, options);
     EXPECT_FALSE(cyclic.joint.run);
@@ -208,7 +203,7 @@ TEST(TuneK, JointStepIsNeverWorseThanTheCyclicChoice) {
 // data want): the joint step moves f and nu0 on its own and is accepted.
 TEST(TuneK, JointStepLeavesAPoorCyclicChoice) {
   const SampleSet set = test::MakeTerrainSet(3, 24, 1.0, 3);
-  TuneKOptions options = JointOptions();
+  TuneKOptions options = SmallOptions();
   options.init_scales = {0.003};
   options.prior_counts = {64.0};
   options.cv.dgmm.initial_covariance_fraction = 0.003;
