@@ -6,11 +6,11 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <limits>
 #include <sstream>
 #include <tuple>
 
-#include "tune/quadratic_surrogate.h"
+#include "tune/joint_step.h"
+#include "tune/tune_evaluator.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -47,23 +47,6 @@ class NegatedQuadratic : public ceres::FirstOrderFunction {
  private:
   double b_, c_, u0_, lo_, hi_;
 };
-
-TuneKPoint ToPoint(const DgmmOptions& o, const CvScore& score, const char* role) {
-  return {o.k,
-          score.mean,
-          score.sd,
-          score.standard_error,
-          role,
-          score.mean_components,
-          o.initial_covariance_fraction,
-          o.prior_pseudo_count};
-}
-
-std::string Num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
 
 }  // namespace
 
@@ -196,51 +179,9 @@ void FitAndMaximise(const std::vector<TuneKPoint>& points, double bracket_lo, do
 
 namespace {
 
-// One evaluation per (k, f, nu0): CrossValidate with the same folds and random numbers.
-class Evaluator {
- public:
-  Evaluator(const SampleSet& set, CvOptions cv, const TuneKOptions& options, TuneKSummary* summary)
-      : set_(set), cv_(std::move(cv)), options_(options), summary_(summary) {}
-  DgmmOptions& dgmm() { return cv_.dgmm; }
-  // The cached evaluation at (k, f, nu0) (equal to within a relative 1e-9, so a design point
-  // computed as exp(log k + step) finds the grid's k), else a new cross-validation.
-  TuneKPoint operator()(double k, const char* role) {
-    cv_.dgmm.k = k;
-    const double f = cv_.dgmm.initial_covariance_fraction, nu = cv_.dgmm.prior_pseudo_count;
-    auto same = [](double a, double b) { return std::abs(a - b) <= 1e-9 * std::abs(b); };
-    for (const TuneKPoint& p : cache_) {
-      if (same(p.k, k) && same(p.init_scale, f) && same(p.prior_count, nu)) return p;
-    }
-    if (options_.progress) options_.progress(static_cast<int>(cache_.size()), -1);
-    const CvSummary result = CrossValidate(set_, cv_);
-    summary_->folds = result.folds;
-    summary_->repeats = result.repeats;
-    summary_->samples = result.samples;
-    summary_->folds_by = result.folds_by;
-    summary_->evaluations = static_cast<int>(cache_.size()) + 1;
-    cache_.push_back(ToPoint(
-        cv_.dgmm, summary_->with_terrain ? result.dgmm_with_terrain : result.dgmm_without_terrain,
-        role));
-    return cache_.back();
-  }
-  // Every evaluation so far, in order.
-  const std::vector<TuneKPoint>& all() const { return cache_; }
-  double Tolerance(const std::vector<TuneKPoint>& pts) const {
-    if (options_.plateau_tolerance > 0) return options_.plateau_tolerance;
-    return std::max(pts[FindPlateau(pts, 0.0).best].standard_error, 1e-9);
-  }
-
- private:
-  const SampleSet& set_;
-  CvOptions cv_;
-  const TuneKOptions& options_;
-  TuneKSummary* summary_;
-  std::vector<TuneKPoint> cache_;
-};
-
 // The k step at the evaluator's f and nu0: grid, bracket, refinement, Ceres fit, plateau rule.
 // Fills the k fields of *summary and returns the chosen point.
-TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummary* summary) {
+TuneKPoint ChooseK(const TuneKOptions& options, TuneEvaluator& evaluate, TuneKSummary* summary) {
   const double u_min = std::log(options.k_min), u_max = std::log(options.k_max);
   const double step = (u_max - u_min) / (options.grid_points - 1);
   std::vector<TuneKPoint> points;
@@ -274,13 +215,13 @@ TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummar
     chosen = points[plateau.simplest];
     summary->k = chosen.k;
     summary->k_rule = "plateau: " + std::to_string(plateau.members.size()) +
-                      " evaluations within " + Num(summary->plateau_tolerance) +
-                      " of the best, k in [" + Num(plateau.k_lo) + ", " + Num(plateau.k_hi) +
-                      "]; chose the simplest (fewest Gaussians, " + Num(chosen.components) +
-                      " per command)";
+                      " evaluations within " + ShortNumber(summary->plateau_tolerance) +
+                      " of the best, k in [" + ShortNumber(plateau.k_lo) + ", " +
+                      ShortNumber(plateau.k_hi) + "]; chose the simplest (fewest Gaussians, " +
+                      ShortNumber(chosen.components) + " per command)";
   } else {
     summary->k_rule = "maximum of the Ceres quadratic fit (no other evaluation within " +
-                      Num(summary->plateau_tolerance) + " of the best)";
+                      ShortNumber(summary->plateau_tolerance) + " of the best)";
     chosen = evaluate(summary->k, "chosen");
     points.push_back(chosen);
   }
@@ -297,7 +238,7 @@ TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummar
 // A coordinate step at the chosen k over `grid` for one option; same plateau rule.
 TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions::*field,
                             const char* role, const TuneKPoint& start, double k,
-                            Evaluator& evaluate, std::vector<TuneKPoint>* curve, bool* flat) {
+                            TuneEvaluator& evaluate, std::vector<TuneKPoint>* curve, bool* flat) {
   std::vector<TuneKPoint> pts = {start};
   const double kept = evaluate.dgmm().*field;
   auto value_of = [&](const TuneKPoint& t) {
@@ -347,147 +288,6 @@ TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions:
   return pick;
 }
 
-// The typical step of a geometric grid in log units: the median log ratio of neighbours (log 3
-// for a grid of fewer than two values).
-double LogGridStep(std::vector<double> grid) {
-  std::sort(grid.begin(), grid.end());
-  grid.erase(std::unique(grid.begin(), grid.end()), grid.end());
-  std::vector<double> steps;
-  for (size_t i = 1; i < grid.size(); ++i) steps.push_back(std::log(grid[i] / grid[i - 1]));
-  if (steps.empty()) return std::log(3.0);
-  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  return steps[steps.size() / 2];
-}
-
-// The joint step (tune_k.h, 3.): a design around *chosen, a concave quadratic surrogate fitted to
-// the evaluations in its box and maximised there (Ceres), L evaluated at the maximiser, and the
-// acceptance and plateau rules. Updates *chosen and summary->joint.
-void JointStep(const TuneKOptions& options, bool tune_scale, bool tune_prior, Evaluator& evaluate,
-               TuneKPoint* chosen, TuneKSummary* summary) {
-  TuneJointStep& joint = summary->joint;
-  joint.run = true;
-  joint.start = *chosen;
-  const int before = summary->evaluations;
-  // Coordinates: which (0: k, 1: f, 2: nu0), step, and bounds in log units.
-  struct Axis {
-    int which;
-    double step, lo, hi;
-  };
-  constexpr double kInf = std::numeric_limits<double>::infinity();
-  std::vector<Axis> axes = {
-      {0, (std::log(options.k_max) - std::log(options.k_min)) / (options.grid_points - 1),
-       std::log(options.k_min), std::log(options.k_max)}};
-  joint.coordinates = {"log k"};
-  if (tune_scale) {
-    axes.push_back({1, LogGridStep(options.init_scales), -kInf, kInf});
-    joint.coordinates.push_back("log f");
-  }
-  if (tune_prior) {
-    axes.push_back({2, LogGridStep(options.prior_counts), -kInf, kInf});
-    joint.coordinates.push_back("log nu0");
-  }
-  const int dims = static_cast<int>(axes.size());
-  auto value = [](const TuneKPoint& p, int which) {
-    return std::log(which == 0 ? p.k : which == 1 ? p.init_scale : p.prior_count);
-  };
-  auto evaluate_at = [&](const Eigen::VectorXd& v, const char* role) {
-    double k = 0;
-    for (int i = 0; i < dims; ++i) {
-      if (axes[i].which == 0) k = std::exp(v[i]);
-      if (axes[i].which == 1) evaluate.dgmm().initial_covariance_fraction = std::exp(v[i]);
-      if (axes[i].which == 2) evaluate.dgmm().prior_pseudo_count = std::exp(v[i]);
-    }
-    return evaluate(k, role);
-  };
-  auto same_point = [](const TuneKPoint& p, const TuneKPoint& q) {
-    return p.k == q.k && p.init_scale == q.init_scale && p.prior_count == q.prior_count;
-  };
-  for (int round = 0; round < options.joint_rounds; ++round) {
-    joint.rounds = round + 1;
-    // Design centre m: the choice, moved inward so that m +- step stays within the bounds; the
-    // step halves in each round.
-    Eigen::VectorXd m(dims), step(dims);
-    for (int i = 0; i < dims; ++i) {
-      const Axis& a = axes[i];
-      step[i] = std::min(std::ldexp(a.step, -round), (a.hi - a.lo) / 2);
-      m[i] = std::clamp(value(*chosen, a.which), a.lo + step[i], a.hi - step[i]);
-    }
-    evaluate_at(m, "joint");
-    for (int i = 0; i < dims; ++i) {
-      for (int sign : {-1, 1}) {
-        evaluate_at(m + sign * step[i] * Eigen::VectorXd::Unit(dims, i), "joint");
-      }
-    }
-    for (int corner = 0; corner < (1 << dims); ++corner) {
-      Eigen::VectorXd v = m;
-      for (int i = 0; i < dims; ++i) v[i] += (corner >> i & 1 ? 1 : -1) * step[i];
-      evaluate_at(v, "joint");
-    }
-    // Every evaluation in the design's box (the f and nu0 not tuned are fixed throughout).
-    std::vector<TuneKPoint> in_box;
-    for (const TuneKPoint& p : evaluate.all()) {
-      bool inside = true;
-      for (int i = 0; i < dims; ++i) {
-        inside = inside && std::abs(value(p, axes[i].which) - m[i]) <= step[i] * (1 + 1e-9);
-      }
-      if (inside) in_box.push_back(p);
-    }
-    Eigen::MatrixXd V(in_box.size(), dims);
-    Eigen::VectorXd y(in_box.size());
-    for (size_t j = 0; j < in_box.size(); ++j) {
-      for (int i = 0; i < dims; ++i) V(j, i) = value(in_box[j], axes[i].which);
-      y[j] = in_box[j].log_likelihood;
-    }
-    const double scale = std::max(in_box[FindPlateau(in_box, 0.0).best].standard_error, 1e-6);
-    const SurrogateMaximum surrogate = FitAndMaximiseQuadratic(V, y, scale);
-    joint.fit_points = surrogate.fit_points;
-    joint.fit_report = surrogate.fit_report;
-    joint.maximise_report = surrogate.maximise_report;
-    joint.surrogate_maximum = surrogate.value;
-    const TuneKPoint at_max = evaluate_at(surrogate.v, "joint-max");
-    joint.surrogate_k = at_max.k;
-    joint.surrogate_init_scale = at_max.init_scale;
-    joint.surrogate_prior_count = at_max.prior_count;
-    joint.evaluated_log_likelihood = at_max.log_likelihood;
-    joint.evaluated_standard_error = at_max.standard_error;
-    in_box.push_back(at_max);
-    for (const TuneKPoint& p : in_box) {
-      if (std::none_of(joint.points.begin(), joint.points.end(),
-                       [&](const TuneKPoint& q) { return same_point(p, q); })) {
-        joint.points.push_back(p);
-      }
-    }
-
-    // Acceptance and the plateau rule over every evaluation of the step so far.
-    joint.tolerance = evaluate.Tolerance(joint.points);
-    joint.plateau = FindPlateau(joint.points, joint.tolerance);
-    const TuneKPoint& best = joint.points[joint.plateau.best];
-    const TuneKPoint& simplest = joint.points[joint.plateau.simplest];
-    std::string rule = "round " + std::to_string(round + 1) + " (step x " +
-                       Num(std::ldexp(1.0, -round)) + "): the surrogate's maximum " +
-                       Num(surrogate.value) + " at k = " + Num(at_max.k) +
-                       ", f = " + Num(at_max.init_scale) + ", nu0 = " + Num(at_max.prior_count) +
-                       " evaluates to " + Num(at_max.log_likelihood) + "; ";
-    if (best.log_likelihood > chosen->log_likelihood + joint.tolerance) {
-      joint.accepted = true;
-      *chosen = joint.plateau.flat ? simplest : best;
-      rule += "an evaluation beats the choice by more than " + Num(joint.tolerance) +
-              ": moved to " +
-              (joint.plateau.flat ? "the simplest model of the plateau" : "the best evaluation");
-    } else if (simplest.components < chosen->components - 1e-9) {
-      *chosen = simplest;
-      rule += "nothing beats the choice by more than " + Num(joint.tolerance) +
-              "; moved to a strictly simpler equivalent model (plateau rule)";
-    } else {
-      rule += "nothing beats the choice by more than " + Num(joint.tolerance) + ": kept it";
-    }
-    joint.rule += (round > 0 ? "; " : "") + rule;
-  }
-  joint.evaluations = summary->evaluations - before;
-  evaluate.dgmm().initial_covariance_fraction = chosen->init_scale;
-  evaluate.dgmm().prior_pseudo_count = chosen->prior_count;
-}
-
 }  // namespace
 
 TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
@@ -506,7 +306,7 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
       cv.dgmm.initial_covariance_rule == DgmmOptions::InitialCovarianceRule::kData;
   const bool tune_prior = !options.prior_counts.empty() &&
                           cv.dgmm.covariance_rule == DgmmOptions::CovarianceRule::kPrior;
-  Evaluator evaluate(set, cv, options, &summary);
+  TuneEvaluator evaluate(set, cv, options, &summary);
 
   // Cyclic coordinate ascent: k (Ceres + plateau rule), then f, then nu0, repeated until a
   // cycle changes nothing (at most options.cycles).
