@@ -1,8 +1,10 @@
-// `dgmm tune` (alias `tune-k`): the DGMM merge rate k that maximises the cross-validated held-out
-// log-likelihood, found with Ceres on a smooth fit of the curve (lib/tune/tune_k.h).
+// `dgmm tune` (alias `tune-k`): the DGMM merge rate k, S0 scale f and prior pseudo-count nu0 that
+// maximise the cross-validated held-out log-likelihood: coordinate steps, then a joint Ceres
+// quadratic step, with the plateau rule (lib/tune/tune_k.h).
 #include "tune/tune_k.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <cmath>
 #include <cstdio>
@@ -41,6 +43,7 @@ struct TuneKArgs {
   std::string plot, curve_csv;
   std::vector<std::string> pose_dims, terrain_dims;
   bool json = false;
+  bool no_joint = false;
 };
 
 void WriteCurveCsv(const TuneKSummary& s, const std::string& path) {
@@ -80,14 +83,99 @@ void PlotCurve(const TuneKSummary& s, const std::string& path) {
     fit.x.push_back(k);
     fit.y.push_back(s.Smoothed(k));
   }
-  // The chosen k as a vertical segment spanning its held-out log-likelihood +- one s.e.
-  ChartSeries chosen{"chosen k (+- s.e.)",
-                     {s.k, s.k},
-                     {s.log_likelihood - s.standard_error, s.log_likelihood + s.standard_error},
-                     {},
-                     {}};
+  // The chosen k as a vertical segment spanning its held-out log-likelihood +- one s.e. (at
+  // other f, nu0 than the curve's when the joint step moved them: the legend says so).
+  const bool moved = s.joint.run && (s.init_scale != s.joint.start.init_scale ||
+                                     s.prior_count != s.joint.start.prior_count);
+  ChartSeries chosen{
+      moved ? fmt::format("chosen k (+- s.e.) at f = {:.3g}, nu0 = {:.3g} (joint step)",
+                          s.init_scale, s.prior_count)
+            : std::string("chosen k (+- s.e.)"),
+      {s.k, s.k},
+      {s.log_likelihood - s.standard_error, s.log_likelihood + s.standard_error},
+      {},
+      {}};
   spec.series = {cv, fit, chosen};
   RenderLineChart(spec, path);
+}
+
+// The joint step (lib/tune/tune_k.h, 3.) as JSON; null when it did not run.
+nlohmann::json JointJson(const TuneJointStep& j) {
+  if (!j.run) return nullptr;
+  auto point = [](const TuneKPoint& p) {
+    return nlohmann::json{{"k", p.k},
+                          {"init_scale", p.init_scale},
+                          {"prior_count", p.prior_count},
+                          {"log_likelihood", p.log_likelihood},
+                          {"standard_error", p.standard_error},
+                          {"components", p.components},
+                          {"role", p.role}};
+  };
+  nlohmann::json points = nlohmann::json::array();
+  for (const auto& p : j.points) points.push_back(point(p));
+  const Plateau& pl = j.plateau;
+  return {{"coordinates", j.coordinates},
+          {"start", point(j.start)},
+          {"surrogate",
+           {{"k", j.surrogate_k},
+            {"init_scale", j.surrogate_init_scale},
+            {"prior_count", j.surrogate_prior_count},
+            {"maximum", j.surrogate_maximum},
+            {"evaluated_log_likelihood", j.evaluated_log_likelihood},
+            {"evaluated_standard_error", j.evaluated_standard_error}}},
+          {"rounds", j.rounds},
+          {"accepted", j.accepted},
+          {"rule", j.rule},
+          {"evaluations", j.evaluations},
+          {"fit_points", j.fit_points},
+          {"tolerance", j.tolerance},
+          {"plateau",
+           {{"flat", pl.flat},
+            {"points", pl.members.size()},
+            {"k_range", {pl.k_lo, pl.k_hi}},
+            {"init_scale_range", {pl.init_scale_lo, pl.init_scale_hi}},
+            {"prior_count_range", {pl.prior_count_lo, pl.prior_count_hi}}}},
+          {"points", points},
+          {"fit_report", j.fit_report},
+          {"maximise_report", j.maximise_report}};
+}
+
+// The joint step as text.
+void PrintJoint(const TuneKSummary& s) {
+  const TuneJointStep& j = s.joint;
+  if (!j.run) return;
+  const bool moved = s.k != j.start.k || s.init_scale != j.start.init_scale ||
+                     s.prior_count != j.start.prior_count;
+  std::cout << fmt::format(
+      "joint step in ({}): {} round(s), {} new cross-validations, last surrogate fitted to {} "
+      "evaluations\n",
+      fmt::join(j.coordinates, ", "), j.rounds, j.evaluations, j.fit_points);
+  for (const auto& p : j.points) {
+    std::cout << fmt::format(
+        "  k {:<10.4g} f {:<8.3g} nu0 {:<8.3g} log-likelihood {:.2f} +- {:.2f}, mean K {:.2f}  "
+        "{}\n",
+        p.k, p.init_scale, p.prior_count, p.log_likelihood, p.standard_error, p.components, p.role);
+  }
+  std::cout << fmt::format(
+      "  surrogate maximum {:.2f} at k = {:.4g}, f = {:.3g}, nu0 = {:.3g}; cross-validated there "
+      "{:.2f} +- {:.2f}\n",
+      j.surrogate_maximum, j.surrogate_k, j.surrogate_init_scale, j.surrogate_prior_count,
+      j.evaluated_log_likelihood, j.evaluated_standard_error);
+  std::cout << fmt::format(
+      "  {}: {}\n",
+      j.accepted ? "ACCEPTED"
+                 : (moved ? "NOT ACCEPTED, SIMPLER EQUIVALENT CHOSEN" : "NOT ACCEPTED"),
+      j.rule);
+  const Plateau& pl = j.plateau;
+  if (pl.flat) {
+    std::cout << fmt::format(
+        "  PLATEAU (joint): {} evaluations within {:.3g} of the best: k from {:.4g} to {:.4g}, f "
+        "from {:.3g} to {:.3g}, nu0 from {:.3g} to {:.3g}\n",
+        pl.members.size(), j.tolerance, pl.k_lo, pl.k_hi, pl.init_scale_lo, pl.init_scale_hi,
+        pl.prior_count_lo, pl.prior_count_hi);
+  }
+  std::cout << "  Ceres fit: " << j.fit_report << "\n  Ceres maximisation: " << j.maximise_report
+            << "\n";
 }
 
 void RunTuneK(const TuneKArgs& args) {
@@ -95,7 +183,8 @@ void RunTuneK(const TuneKArgs& args) {
     throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
   }
   // Unwritable output folders are reported before the long run, not after it.
-  for (const auto& [output, flag] : {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
+  for (const auto& [output, flag] :
+       {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
     if (output.empty()) continue;
     RefuseOutputThatIsAnInput(output, {args.path}, flag);
     AtomicFile probe(output);
@@ -125,6 +214,7 @@ void RunTuneK(const TuneKArgs& args) {
   options.k_max = args.k_max;
   options.grid_points = args.grid_points;
   options.refine_points = args.refine_points;
+  options.joint = !args.no_joint;
   options.progress = [](int done, int total) {
     if (total >= 0) {
       ReportProgress("tune cross-validations", done, total);
@@ -135,11 +225,15 @@ void RunTuneK(const TuneKArgs& args) {
   std::string error;
   if (!options.IsValid(&error)) {
     throw OptionsError(args.path, error,
-                       {{"k_min", "--k-min/--k-max"}, {"grid_points", "--grid-points"},
+                       {{"k_min", "--k-min/--k-max"},
+                        {"grid_points", "--grid-points"},
                         {"refine_points", "--refine-points"},
                         {"plateau_tolerance", "--plateau-tolerance"},
-                        {"init_scales", "--init-scales"}, {"prior_counts", "--prior-counts"},
-                        {"threads", "--threads"}, {"folds", "--folds"}, {"repeats", "--repeats"}});
+                        {"init_scales", "--init-scales"},
+                        {"prior_counts", "--prior-counts"},
+                        {"threads", "--threads"},
+                        {"folds", "--folds"},
+                        {"repeats", "--repeats"}});
   }
   const TuneKSummary s = TuneK(set, options);
   const std::string folds_by = s.folds_by;
@@ -201,6 +295,7 @@ void RunTuneK(const TuneKArgs& args) {
         {"prior_curve", side(s.prior_curve)},
         {"evaluations", s.evaluations},
         {"cycles", s.cycles},
+        {"joint", JointJson(s.joint)},
         {"start_dgmm_options", DgmmOptionsJson(options.cv.dgmm)},
         {"seconds", s.seconds}};
     std::cout << out.dump(2) << "\n";
@@ -211,7 +306,14 @@ void RunTuneK(const TuneKArgs& args) {
       "({:.1f} s)\n",
       args.path, s.samples, s.repeats, s.folds, s.with_terrain ? "with" : "without", args.seed,
       s.evaluations, s.cycles, s.seconds);
-  std::cout << "last k step (at the final S0 scale and nu0):\n";
+  // The coordinate steps' choice (the joint step's start when it ran; the final choice below).
+  TuneKPoint cyclic = s.joint.start;
+  if (!s.joint.run) {
+    cyclic.k = s.k;
+    cyclic.init_scale = s.init_scale;
+    cyclic.prior_count = s.prior_count;
+  }
+  std::cout << "last k step (at the coordinate steps' S0 scale and nu0):\n";
   std::cout << "folds: " << folds_by << "\n";
   std::cout << fmt::format("{:>12}{:>16}{:>12}{:>14}{:>10}  {}\n", "k", "log-likelihood",
                            "std. error", "smoothed", "mean K", "");
@@ -227,7 +329,7 @@ void RunTuneK(const TuneKArgs& args) {
     std::cout << fmt::format(
         "PLATEAU: {} evaluations within {:.3g} of the best, k from {:.4g} to {:.4g} are "
         "equivalent; k = {:.5g} is the simplest model there, not a sharp optimum\n",
-        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, s.k);
+        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, cyclic.k);
   } else {
     std::cout << "k: " << s.k_rule << "\n";
   }
@@ -241,15 +343,16 @@ void RunTuneK(const TuneKArgs& args) {
   if (s.init_scale_tuned) {
     print_side("S0 scale", s.scale_curve, true);
     std::cout << fmt::format(
-        "S0 scale f = {:.3g}{}\n", s.init_scale,
+        "S0 scale f = {:.3g}{}\n", cyclic.init_scale,
         s.init_scale_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
   }
   if (s.prior_count_tuned) {
     print_side("nu0", s.prior_curve, false);
     std::cout << fmt::format(
-        "prior pseudo-count nu0 = {:.3g}{}\n", s.prior_count,
+        "prior pseudo-count nu0 = {:.3g}{}\n", cyclic.prior_count,
         s.prior_count_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
   }
+  PrintJoint(s);
   std::cout << fmt::format(
       "chosen k = {:.5g}: held-out log-likelihood {:.2f} +- {:.2f} (s.e.), {:.2f} Gaussians per "
       "command\n",
@@ -265,8 +368,8 @@ void SetupTuneK(CLI::App& root) {
   auto args = std::make_shared<TuneKArgs>();
   CLI::App* cmd = root.add_subcommand(
       "tune",
-      "Choose the DGMM merge rate k (Ceres), then the S0 scale and prior strength, by "
-      "cross-validated log-likelihood; reports plateaus");
+      "Choose the DGMM merge rate k, the S0 scale and the prior strength by cross-validated "
+      "log-likelihood (coordinate steps, then a joint Ceres quadratic step); reports plateaus");
   cmd->alias("tune-k");
   cmd->add_option("set", args->path, "Sample set (.h5)")->required();
   cmd->add_flag("--with-terrain", args->with_terrain, "Maximise p(x | c, z) (the default)");
@@ -306,6 +409,8 @@ void SetupTuneK(CLI::App& root) {
   cmd->add_option("--terrain-dims", args->terrain_dims,
                   "Terrain dimensions to condition on, by name (default: all)")
       ->delimiter(',');
+  cmd->add_flag("--no-joint", args->no_joint,
+                "Skip the joint Ceres step after the coordinate cycles");
   cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([args] { RunTuneK(*args); });
 }

@@ -258,6 +258,25 @@ def seen_sentence(sweep):
   return text + ". "
 
 
+def joint_sentence(joint, pd):
+  """What the joint (k, f, nu0) search of `dgmm tune` without terrain found, in words."""
+  j = joint.get("without")
+  if not j:
+    return ""
+  r = j["richest"]
+  return (f"The joint search of `dgmm tune` without terrain ({j['evaluations']} cross-validations in "
+          f"log k, log f, log ν0 around the coordinate steps' choice, {j['points']} evaluations in its "
+          f"boxes; {'it moved the choice' if j['accepted'] else 'it kept the choice'}) finds "
+          f"{j['equivalent']} settings within {j['tolerance']:.1f} nats (one s.e.) of its best, with "
+          f"{two(j['components_range'][0])}–{two(j['components_range'][1])} mean Gaussians per command; the "
+          f"richest of them (k = {g(r['k'])}, f = {g(r['init_scale'])}, ν0 = {g(r['prior_count'])}, "
+          f"L = {r['log_likelihood']:.1f}) gives {two(j['richest_multimodal'])} Gaussians on the commands "
+          f"multimodal in {pd} and {two(j['richest_others'])} on the others (`dgmm fit`, same seeds)"
+          + (": the joint search finds no setting that both scores as well and splits the modes. "
+             if j["richest_multimodal"] < 1.5 else
+             ": a setting as good as the best gives the multimodal commands more than one Gaussian. "))
+
+
 def report(res):
   """Markdown of the results (from a fresh run or from --from-json)."""
   rows, sweep, n_cmd = res["rows"], res["sweep"], len(res["rows"])
@@ -369,6 +388,7 @@ def report(res):
     f"ask; so cross-validation by episode cannot reward a mixture over the placements' modes, and "
     f"`dgmm tune` keeping one Gaussian there is the estimator answering the question it was asked, not a "
     f"tie-break artefact. " if n_marg else "") +
+    joint_sentence(res.get("joint", {}), pd) +
     seen_sentence(sweep) +
     f"In the recorded order the paper's rule could not split placements anyway "
     f"unless k is small: the last column bounds the Gaussians that later placements can start, and "
@@ -506,7 +526,30 @@ def compute(a):
                     "multimodal": mean_of(comps, mask), "others": mean_of(comps, ~mask),
                     "folds_by": cv["folds_by"], "repeats": cv["repeats"], "folds": cv["folds"]})
 
+  # The joint step of `dgmm tune` (without terrain, where the modes are): its equivalent
+  # evaluations, and the Gaussians per command at the richest of them.
+  joint = {}
+  for terrain, t in (("without", tune_without), ("with", tune_with)):
+    j = t.get("joint")
+    if not j:
+      continue
+    best = max(p["log_likelihood"] for p in j["points"])
+    eq = [p for p in j["points"] if p["log_likelihood"] >= best - j["tolerance"]]
+    richest = max(eq, key=lambda p: p["components"])
+    joint[terrain] = {"accepted": j["accepted"], "evaluations": j["evaluations"],
+                      "points": len(j["points"]), "equivalent": len(eq), "tolerance": j["tolerance"],
+                      "components_range": [min(p["components"] for p in eq), max(p["components"] for p in eq)],
+                      "richest": richest, "plateau": j["plateau"], "start": j["start"],
+                      "surrogate": j["surrogate"]}
+    if terrain == "without":
+      flags = ["--k", repr(richest["k"]), "--init-scale", repr(richest["init_scale"]),
+               "--prior-count", repr(richest["prior_count"]), "--without-terrain"]
+      comps = mean_components(a.dgmm, a.set, flags, a.fit_seeds, labels)
+      joint[terrain]["richest_multimodal"] = mean_of(comps, marg)
+      joint[terrain]["richest_others"] = mean_of(comps, ~marg)
+
   res = {"set": os.path.relpath(os.path.abspath(a.set), ROOT), "samples": len(x), "names": names,
+         "joint": joint,
          "planar": planar, "check": check, "with_flags": with_flags, "without_flags": without_flags,
          "components": {k: v.tolist() for k, v in components.items()}, "rows": rows, "sweep": sweep,
          "args": {k: v for k, v in vars(a).items() if k in ("bootstrap", "restarts", "fit_seeds", "alpha",

@@ -6,10 +6,11 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <map>
 #include <sstream>
 #include <tuple>
 
+#include "tune/joint_step.h"
+#include "tune/tune_evaluator.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -47,23 +48,6 @@ class NegatedQuadratic : public ceres::FirstOrderFunction {
   double b_, c_, u0_, lo_, hi_;
 };
 
-TuneKPoint ToPoint(const DgmmOptions& o, const CvScore& score, const char* role) {
-  return {o.k,
-          score.mean,
-          score.sd,
-          score.standard_error,
-          role,
-          score.mean_components,
-          o.initial_covariance_fraction,
-          o.prior_pseudo_count};
-}
-
-std::string Num(double v) {
-  std::ostringstream out;
-  out << v;
-  return out.str();
-}
-
 }  // namespace
 
 bool TuneKOptions::IsValid(std::string* error) const {
@@ -79,6 +63,7 @@ bool TuneKOptions::IsValid(std::string* error) const {
   }
   if (grid_points < 3) return fail("grid_points must be >= 3");
   if (cycles < 1) return fail("cycles must be >= 1");
+  if (joint && joint_rounds < 1) return fail("joint_rounds must be >= 1");
   if (refine_points < 0) return fail("refine_points must be >= 0");
   if (!(plateau_tolerance >= 0) || !std::isfinite(plateau_tolerance)) {
     return fail("plateau_tolerance must be finite and >= 0");
@@ -110,10 +95,17 @@ Plateau FindPlateau(const std::vector<TuneKPoint>& points, double tolerance) {
     }
   }
   p.flat = p.members.size() > 1;
-  p.k_lo = p.k_hi = points[p.best].k;
+  const TuneKPoint& top = points[p.best];
+  p.k_lo = p.k_hi = top.k;
+  p.init_scale_lo = p.init_scale_hi = top.init_scale;
+  p.prior_count_lo = p.prior_count_hi = top.prior_count;
   for (int i : p.members) {
     p.k_lo = std::min(p.k_lo, points[i].k);
     p.k_hi = std::max(p.k_hi, points[i].k);
+    p.init_scale_lo = std::min(p.init_scale_lo, points[i].init_scale);
+    p.init_scale_hi = std::max(p.init_scale_hi, points[i].init_scale);
+    p.prior_count_lo = std::min(p.prior_count_lo, points[i].prior_count);
+    p.prior_count_hi = std::max(p.prior_count_hi, points[i].prior_count);
   }
   return p;
 }
@@ -187,45 +179,9 @@ void FitAndMaximise(const std::vector<TuneKPoint>& points, double bracket_lo, do
 
 namespace {
 
-// One evaluation per (k, f, nu0): CrossValidate with the same folds and random numbers.
-class Evaluator {
- public:
-  Evaluator(const SampleSet& set, CvOptions cv, const TuneKOptions& options, TuneKSummary* summary)
-      : set_(set), cv_(std::move(cv)), options_(options), summary_(summary) {}
-  DgmmOptions& dgmm() { return cv_.dgmm; }
-  TuneKPoint operator()(double k, const char* role) {
-    cv_.dgmm.k = k;
-    const auto key =
-        std::make_tuple(k, cv_.dgmm.initial_covariance_fraction, cv_.dgmm.prior_pseudo_count);
-    if (auto it = cache_.find(key); it != cache_.end()) return it->second;
-    if (options_.progress) options_.progress(static_cast<int>(cache_.size()), -1);
-    const CvSummary result = CrossValidate(set_, cv_);
-    summary_->folds = result.folds;
-    summary_->repeats = result.repeats;
-    summary_->samples = result.samples;
-    summary_->folds_by = result.folds_by;
-    summary_->evaluations = static_cast<int>(cache_.size()) + 1;
-    return cache_[key] = ToPoint(
-               cv_.dgmm,
-               summary_->with_terrain ? result.dgmm_with_terrain : result.dgmm_without_terrain,
-               role);
-  }
-  double Tolerance(const std::vector<TuneKPoint>& pts) const {
-    if (options_.plateau_tolerance > 0) return options_.plateau_tolerance;
-    return std::max(pts[FindPlateau(pts, 0.0).best].standard_error, 1e-9);
-  }
-
- private:
-  const SampleSet& set_;
-  CvOptions cv_;
-  const TuneKOptions& options_;
-  TuneKSummary* summary_;
-  std::map<std::tuple<double, double, double>, TuneKPoint> cache_;
-};
-
 // The k step at the evaluator's f and nu0: grid, bracket, refinement, Ceres fit, plateau rule.
 // Fills the k fields of *summary and returns the chosen point.
-TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummary* summary) {
+TuneKPoint ChooseK(const TuneKOptions& options, TuneEvaluator& evaluate, TuneKSummary* summary) {
   const double u_min = std::log(options.k_min), u_max = std::log(options.k_max);
   const double step = (u_max - u_min) / (options.grid_points - 1);
   std::vector<TuneKPoint> points;
@@ -259,13 +215,13 @@ TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummar
     chosen = points[plateau.simplest];
     summary->k = chosen.k;
     summary->k_rule = "plateau: " + std::to_string(plateau.members.size()) +
-                      " evaluations within " + Num(summary->plateau_tolerance) +
-                      " of the best, k in [" + Num(plateau.k_lo) + ", " + Num(plateau.k_hi) +
-                      "]; chose the simplest (fewest Gaussians, " + Num(chosen.components) +
-                      " per command)";
+                      " evaluations within " + ShortNumber(summary->plateau_tolerance) +
+                      " of the best, k in [" + ShortNumber(plateau.k_lo) + ", " +
+                      ShortNumber(plateau.k_hi) + "]; chose the simplest (fewest Gaussians, " +
+                      ShortNumber(chosen.components) + " per command)";
   } else {
     summary->k_rule = "maximum of the Ceres quadratic fit (no other evaluation within " +
-                      Num(summary->plateau_tolerance) + " of the best)";
+                      ShortNumber(summary->plateau_tolerance) + " of the best)";
     chosen = evaluate(summary->k, "chosen");
     points.push_back(chosen);
   }
@@ -282,7 +238,7 @@ TuneKPoint ChooseK(const TuneKOptions& options, Evaluator& evaluate, TuneKSummar
 // A coordinate step at the chosen k over `grid` for one option; same plateau rule.
 TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions::*field,
                             const char* role, const TuneKPoint& start, double k,
-                            Evaluator& evaluate, std::vector<TuneKPoint>* curve, bool* flat) {
+                            TuneEvaluator& evaluate, std::vector<TuneKPoint>* curve, bool* flat) {
   std::vector<TuneKPoint> pts = {start};
   const double kept = evaluate.dgmm().*field;
   auto value_of = [&](const TuneKPoint& t) {
@@ -307,9 +263,9 @@ TuneKPoint ChooseCoordinate(const std::vector<double>& grid, double DgmmOptions:
       const double ratio = direction > 0 ? sorted[sorted.size() - 1] / sorted[sorted.size() - 2]
                                          : sorted[0] / sorted[1];
       for (int step = 0; step < kMaxExtension; ++step) {
-        const auto best = std::max_element(pts.begin(), pts.end(), [](const auto& a, const auto& b) {
-          return a.log_likelihood < b.log_likelihood;
-        });
+        const auto best = std::max_element(
+            pts.begin(), pts.end(),
+            [](const auto& a, const auto& b) { return a.log_likelihood < b.log_likelihood; });
         const auto extreme = std::minmax_element(
             pts.begin(), pts.end(),
             [&](const auto& a, const auto& b) { return value_of(a) < value_of(b); });
@@ -350,7 +306,7 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
       cv.dgmm.initial_covariance_rule == DgmmOptions::InitialCovarianceRule::kData;
   const bool tune_prior = !options.prior_counts.empty() &&
                           cv.dgmm.covariance_rule == DgmmOptions::CovarianceRule::kPrior;
-  Evaluator evaluate(set, cv, options, &summary);
+  TuneEvaluator evaluate(set, cv, options, &summary);
 
   // Cyclic coordinate ascent: k (Ceres + plateau rule), then f, then nu0, repeated until a
   // cycle changes nothing (at most options.cycles).
@@ -377,6 +333,7 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
       break;
     }
   }
+  if (options.joint) JointStep(options, tune_scale, tune_prior, evaluate, &chosen, &summary);
   summary.k = chosen.k;
   summary.init_scale = chosen.init_scale;
   summary.prior_count = chosen.prior_count;
@@ -402,6 +359,16 @@ std::string TuneKSummary::BriefReport() const {
   }
   if (prior_count_tuned) {
     out << "; nu0 " << prior_count << (prior_count_plateau ? " (simplest of a plateau)" : "");
+  }
+  if (joint.run) {
+    out << "; joint step over (" << joint.coordinates.size() << " coordinates, "
+        << joint.evaluations << " new cross-validations): " << joint.rule;
+    if (joint.plateau.flat) {
+      out << "; joint plateau of " << joint.plateau.members.size() << " evaluations, k in ["
+          << joint.plateau.k_lo << ", " << joint.plateau.k_hi << "], f in ["
+          << joint.plateau.init_scale_lo << ", " << joint.plateau.init_scale_hi << "], nu0 in ["
+          << joint.plateau.prior_count_lo << ", " << joint.plateau.prior_count_hi << "]";
+    }
   }
   return out.str();
 }

@@ -1,28 +1,35 @@
 #pragma once
-// `dgmm tune` (alias tune-k): choice of the DGMM merge rate k, initial scale and prior strength (t
-// = 1 - (1 - d) exp(-k n)) by cross-validated held-out log-likelihood L(k)
-// (tune/cross_validation.h), with Ceres.
+// `dgmm tune` (alias tune-k): choice of the DGMM merge rate k (t = 1 - (1 - d) exp(-k n)), the
+// initial covariance scale f (S0 = f v, --init-cov data) and the prior pseudo-count nu0
+// (--covariance prior) by cross-validated held-out log-likelihood L (tune/cross_validation.h),
+// with Ceres. Every evaluation is a full cross-validation with the same folds and random numbers
+// (common random numbers: the CvOptions seed does not depend on the settings), cached, so
+// L(a) - L(b) is a low-noise comparison. L is noisy and piecewise constant in k (a merge decision
+// r < t flips only when k crosses a threshold) and often flat.
 //
-// L(k) is noisy and piecewise constant in k: a merge decision r < t flips only when k crosses a
-// threshold. So (1) every k sees the same folds and random numbers (common random numbers: the
-// CvOptions seed does not depend on k), which makes L(k) - L(k') a low-noise comparison;
-// (2) L is evaluated on a coarse grid in u = log k and the best grid point brackets the optimum
-// [u_{i-1}, u_{i+1}]; the bracket gets a few more evaluations; (3) Ceres fits a smooth concave
-// quadratic q(u) = a + b (u - u0) - exp(g) (u - u0)^2 to the evaluations near the best by robust
-// (Cauchy) least squares, scaled by the standard error; (4) Ceres' line-search solver maximises
-// q over the bracket (u = lo + (hi - lo) sigmoid(s), unconstrained in s). L is then evaluated at
-// the chosen k and reported with its standard error.
+// 1. k step (at the current f, nu0): L on a coarse grid in u = log k; the best grid point
+//    brackets the optimum [u_{i-1}, u_{i+1}], which gets `refine_points` more evaluations; Ceres
+//    fits q(u) = a + b (u - u0) - exp(g) (u - u0)^2 to the evaluations near the best by robust
+//    (Cauchy) least squares scaled by the best's standard error and maximises it over the
+//    bracket (u = lo + (hi - lo) sigmoid(s)); L is evaluated there.
+// 2. f step, then nu0 step (at the chosen k): grids, extended geometrically beyond a best edge.
+//    Steps 1-2 repeat (cyclic coordinate ascent) until a cycle changes nothing, at most `cycles`.
+// 3. Joint step (`joint`): in v = (log k, log f, log nu0) (the coordinates tuned for the rules in
+//    use), a design around the cyclic choice (centre, star and 2-level factorial at one grid step
+//    per coordinate, moved inward so k stays in [k_min, k_max]; halved in each of
+//    `joint_rounds` rounds, each re-centred on the current choice) is evaluated; Ceres fits a full
+//    concave quadratic q(v) (Hessian -L L^T, tune/quadratic_surrogate.h) to every cached
+//    evaluation in the design's box, scaled by the best's standard error, and maximises it inside
+//    that box; L is evaluated at the maximiser. The choice moves only when an evaluation of the
+//    joint step beats the cyclic choice by more than the plateau tolerance; otherwise the cyclic
+//    choice is kept (unless the plateau holds a strictly simpler equivalent model), and the report
+//    says which.
 //
-// Plateaus (issue #10): L(k) is often flat over a range of k (e.g. every k giving one Gaussian
-// per command). The evaluations within `plateau_tolerance` (default: one standard error of the
-// best) of the best are equivalent; when there are several, the curve has a plateau: its k
-// range is reported and the simplest model there (fewest mean Gaussians per command; ties: the
-// higher L) is chosen instead of the quadratic's maximum. The report always says so.
-//
-// Jointly with k, by cyclic coordinate ascent: after the k step, at the chosen k, grids over the
-// initial covariance scale f (S0 = f v, for --init-cov data) and then the prior pseudo-count nu0
-// (for the prior covariance rule), same plateau rule; the cycle (k, f, nu0) repeats until it
-// changes nothing, at most `cycles` times. Each evaluation is a full cross-validation, cached.
+// Plateaus (issue #10): in every step the evaluations within `plateau_tolerance` (default: one
+// standard error of the best) of the best are equivalent; when there are several, L has a
+// plateau: its range (of k, and in the joint step of f and nu0 too) is reported and the simplest
+// model there (fewest mean Gaussians per command; ties: the higher L) is chosen instead of the
+// maximum. The report always says so.
 #include <functional>
 #include <string>
 #include <vector>
@@ -46,7 +53,9 @@ struct TuneKOptions {
   // skips the step and keeps cv.dgmm's value.
   std::vector<double> init_scales = {0.03, 0.1, 0.3, 1.0, 3.0, 10.0};
   std::vector<double> prior_counts = {1.0, 4.0, 16.0, 64.0};
-  int cycles = 3;  // at most this many (k, f, nu0) cycles
+  int cycles = 3;        // at most this many (k, f, nu0) cycles
+  bool joint = true;     // the joint Ceres step after the cycles (see above)
+  int joint_rounds = 2;  // its rounds, each re-centred on the choice with half the step
   // Called before each cross-validation with (index, -1) (the total is not known in advance),
   // and once at the end with (total, total).
   std::function<void(int, int)> progress;
@@ -72,8 +81,30 @@ struct Plateau {
   int simplest = -1;          // fewest components among members (ties: higher L)
   bool flat = false;          // more than one member
   double k_lo = 0, k_hi = 0;  // range of k over the members
+  double init_scale_lo = 0, init_scale_hi = 0, prior_count_lo = 0, prior_count_hi = 0;
 };
 Plateau FindPlateau(const std::vector<TuneKPoint>& points, double tolerance);
+
+// The joint step (3. above): where it started, what the surrogate predicted, what was evaluated.
+struct TuneJointStep {
+  bool run = false;
+  std::vector<std::string> coordinates;  // "log k", "log f", "log nu0": those tuned jointly
+  TuneKPoint start;                      // the cyclic choice
+  int rounds = 0;
+  // The last round's surrogate maximiser in its box, its value q(v*), and L cross-validated there.
+  double surrogate_k = 0, surrogate_init_scale = 0, surrogate_prior_count = 0;
+  double surrogate_maximum = 0;
+  double evaluated_log_likelihood = 0, evaluated_standard_error = 0;
+  bool accepted = false;           // an evaluation beat the choice by more than the tolerance
+  std::string rule;                // what each round did, one sentence per round
+  int evaluations = 0;             // new cross-validations in this step
+  int fit_points = 0;              // evaluations the surrogate was fitted to
+  std::vector<TuneKPoint> points;  // every evaluation in the rounds' boxes and the maximisers'
+  // Plateau over `points`: ranges of k, f and nu0 over the equivalent set.
+  Plateau plateau;
+  double tolerance = 0;
+  std::string fit_report, maximise_report;  // Ceres BriefReport()s
+};
 
 struct TuneKSummary {
   double k = 0;               // the chosen merge rate
@@ -102,6 +133,7 @@ struct TuneKSummary {
   double components = 0;  // mean Gaussians per command at the chosen settings
   std::vector<TuneKPoint> scale_curve, prior_curve;
   std::vector<TuneKPoint> curve;            // the last k step's evaluations, ascending k
+  TuneJointStep joint;                      // run when options.joint
   std::string fit_report, maximise_report;  // Ceres BriefReport()s
   int folds = 0, repeats = 0, samples = 0;
   int evaluations = 0, cycles = 0;  // distinct cross-validations; coordinate cycles run

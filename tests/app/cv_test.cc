@@ -93,7 +93,18 @@ TEST(TuneKCommand, ChoosesKInsideTheBracketAndWritesTheCurve) {
   const auto j = nlohmann::json::parse(r.out);
   const double k = j["k"];
   const bool plateau = j["plateau"]["flat"];
-  if (plateau) {  // k is the simplest member of the plateau, which is stated with its range
+  // The joint step's record; when it moved the choice, k is a member of its plateau.
+  const auto& joint = j["joint"];
+  ASSERT_TRUE(joint.is_object()) << r.out;
+  for (const char* field : {"surrogate", "accepted", "evaluations", "fit_report", "plateau"}) {
+    EXPECT_TRUE(joint.contains(field)) << field;
+  }
+  EXPECT_LE(joint["start"]["log_likelihood"].get<double>(),
+            j["log_likelihood"].get<double>() + joint["tolerance"].get<double>());
+  if (joint["start"]["k"].get<double>() != k) {
+    EXPECT_GE(k, joint["plateau"]["k_range"][0].get<double>());
+    EXPECT_LE(k, joint["plateau"]["k_range"][1].get<double>());
+  } else if (plateau) {  // k is the simplest member of the plateau, which is stated with its range
     EXPECT_GE(k, j["plateau"]["k_range"][0].get<double>());
     EXPECT_LE(k, j["plateau"]["k_range"][1].get<double>());
     EXPECT_NE(j["k_rule"].get<std::string>().find("plateau"), std::string::npos);

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "tests/tune/synthetic.h"
+#include "tune/quadratic_surrogate.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -122,18 +123,28 @@ TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
   EXPECT_EQ(s.components, 1.0);
 }
 
-// A grid of S0 scales far below what the data want: the best is the grid's top, so the tuner
-// steps on beyond it (by the grid's ratio) instead of reporting the edge as the optimum.
-TEST(TuneK, StepsBeyondAGridWhoseEdgeIsBest) {
-  const SampleSet set = test::MakeTerrainSet(2, 30, 1.0, 5);
+// Small folds, coarse grids, one coordinate cycle: fast TuneK runs.
+TuneKOptions SmallOptions() {
   TuneKOptions options;
   options.cv.folds = 4;
-  options.cv.repeats = 1;
+  options.cv.repeats = 2;
   options.k_min = 0.1;
   options.k_max = 10;
   options.grid_points = 3;
   options.refine_points = 1;
   options.cycles = 1;
+  options.init_scales = {0.1, 1.0, 10.0};
+  options.prior_counts = {1.0, 16.0};
+  return options;
+}
+
+// A grid of S0 scales far below what the data want: the best is the grid's top, so the tuner
+// steps on beyond it (by the grid's ratio) instead of reporting the edge as the optimum.
+TEST(TuneK, StepsBeyondAGridWhoseEdgeIsBest) {
+  const SampleSet set = test::MakeTerrainSet(2, 30, 1.0, 5);
+  TuneKOptions options = SmallOptions();
+  options.cv.repeats = 1;
+  options.joint = false;  // the coordinate step alone
   options.init_scales = {1e-4, 3e-4};
   options.cv.dgmm.initial_covariance_fraction = 1e-4;  // the start is on the grid too
   options.prior_counts.clear();
@@ -143,6 +154,65 @@ TEST(TuneK, StepsBeyondAGridWhoseEdgeIsBest) {
   for (const auto& p : s.scale_curve) largest = std::max(largest, p.init_scale);
   EXPECT_GT(largest, 3e-4 * 2);  // evaluated beyond the grid
   EXPECT_GT(s.init_scale, 3e-4 * 2) << "chose the grid's edge";
+}
+
+// The joint step starts from the cyclic choice, is never worse than it by more than the
+// tolerance (and better when it accepts), and reports its plateau's ranges over every evaluation.
+TEST(TuneK, JointStepIsNeverWorseThanTheCyclicChoice) {
+  for (std::uint64_t seed : {3, 4}) {
+    const SampleSet set = test::MakeTerrainSet(3, 24, 1.0, seed);
+    TuneKOptions options = SmallOptions();
+    options.joint = false;
+    const TuneKSummary cyclic = TuneK(set, options);
+    EXPECT_FALSE(cyclic.joint.run);
+    options.joint = true;
+    const TuneKSummary s = TuneK(set, options);
+    const TuneJointStep& j = s.joint;
+    ASSERT_TRUE(j.run);
+    EXPECT_EQ(j.coordinates.size(), 3u);
+    EXPECT_EQ(j.rounds, options.joint_rounds);
+    EXPECT_EQ(j.start.k, cyclic.k);
+    EXPECT_EQ(j.start.init_scale, cyclic.init_scale);
+    EXPECT_EQ(j.start.prior_count, cyclic.prior_count);
+    EXPECT_EQ(s.evaluations, cyclic.evaluations + j.evaluations);
+    EXPECT_GT(j.evaluations, 0);
+    EXPECT_GE(j.fit_points, QuadraticSurrogateParameters(3));
+    EXPECT_GE(s.log_likelihood, cyclic.log_likelihood - j.tolerance);
+    if (j.accepted) EXPECT_GT(s.log_likelihood, cyclic.log_likelihood);
+    EXPECT_GE(s.k, options.k_min * (1 - kBoundSlack));
+    EXPECT_LE(s.k, options.k_max * (1 + kBoundSlack));
+    // The plateau: every member within the tolerance of the best, ranges spanning the members.
+    ASSERT_FALSE(j.plateau.members.empty());
+    const double best = j.points[j.plateau.best].log_likelihood;
+    for (int i : j.plateau.members) {
+      const TuneKPoint& p = j.points[i];
+      EXPECT_GE(p.log_likelihood, best - j.tolerance);
+      EXPECT_GE(p.k, j.plateau.k_lo);
+      EXPECT_LE(p.k, j.plateau.k_hi);
+      EXPECT_GE(p.init_scale, j.plateau.init_scale_lo);
+      EXPECT_LE(p.init_scale, j.plateau.init_scale_hi);
+      EXPECT_GE(p.prior_count, j.plateau.prior_count_lo);
+      EXPECT_LE(p.prior_count, j.plateau.prior_count_hi);
+    }
+    EXPECT_NE(s.BriefReport().find("joint step"), std::string::npos);
+    if (j.plateau.flat) EXPECT_NE(s.BriefReport().find("joint plateau"), std::string::npos);
+  }
+}
+
+// A start the coordinate steps cannot leave (one-value grids for f and nu0, far from what the
+// data want): the joint step moves f and nu0 on its own and is accepted.
+TEST(TuneK, JointStepLeavesAPoorCyclicChoice) {
+  const SampleSet set = test::MakeTerrainSet(3, 24, 1.0, 3);
+  TuneKOptions options = SmallOptions();
+  options.init_scales = {0.003};
+  options.prior_counts = {64.0};
+  options.cv.dgmm.initial_covariance_fraction = 0.003;
+  options.cv.dgmm.prior_pseudo_count = 64.0;
+  const TuneKSummary s = TuneK(set, options);
+  ASSERT_TRUE(s.joint.run);
+  EXPECT_TRUE(s.joint.accepted) << s.joint.rule;
+  EXPECT_GT(s.log_likelihood, s.joint.start.log_likelihood + s.joint.tolerance);
+  EXPECT_TRUE(s.init_scale != 0.003 || s.prior_count != 64.0);
 }
 
 TEST(TuneK, RejectsBadOptions) {
@@ -158,6 +228,9 @@ TEST(TuneK, RejectsBadOptions) {
   EXPECT_THROW(TuneK(set, options), InputError);
   options = TuneKOptions();
   options.grid_points = 2;
+  EXPECT_THROW(TuneK(set, options), InputError);
+  options = TuneKOptions();
+  options.joint_rounds = 0;
   EXPECT_THROW(TuneK(set, options), InputError);
   EXPECT_THROW(TuneK(set.Subset({}), TuneKOptions()), InputError);
 }
