@@ -138,7 +138,7 @@ void JointStep(const TuneKOptions& options, bool tune_scale, bool tune_prior,
       rule += "an evaluation beats the choice by more than " + ShortNumber(joint.tolerance) +
               ": moved to " +
               (joint.plateau.flat ? "the simplest model of the plateau" : "the best evaluation");
-    } else if (simplest.components < chosen->components - 1e-9) {
+    } else if (simplest.components < chosen->components - kSameModelSize) {
       *chosen = simplest;
       rule += "nothing beats the choice by more than " + ShortNumber(joint.tolerance) +
               "; moved to a strictly simpler equivalent model (plateau rule)";

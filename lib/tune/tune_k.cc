@@ -84,15 +84,15 @@ Plateau FindPlateau(const std::vector<TuneKPoint>& points, double tolerance) {
   }
   if (p.best < 0) return p;
   const double floor = points[p.best].log_likelihood - tolerance;
+  double fewest = INFINITY;
   for (int i = 0; i < static_cast<int>(points.size()); ++i) {
     if (points[i].log_likelihood < floor) continue;
     p.members.push_back(i);
-    const TuneKPoint& q = points[i];
-    if (p.simplest < 0 || q.components < points[p.simplest].components ||
-        (q.components == points[p.simplest].components &&
-         q.log_likelihood > points[p.simplest].log_likelihood)) {
-      p.simplest = i;
-    }
+    fewest = std::min(fewest, points[i].components);
+  }
+  for (int i : p.members) {
+    if (points[i].components > fewest + kSameModelSize) continue;
+    if (p.simplest < 0 || points[i].log_likelihood > points[p.simplest].log_likelihood) p.simplest = i;
   }
   p.flat = p.members.size() > 1;
   const TuneKPoint& top = points[p.best];

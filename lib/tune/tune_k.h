@@ -74,11 +74,16 @@ struct TuneKPoint {
   double prior_count = 0;     // nu0 of this evaluation
 };
 
+// Mean Gaussians per command closer than this count as the same model size in the plateau rule
+// (a size is a mean over commands and folds; 0.01 is one Gaussian in a hundred command-folds).
+constexpr double kSameModelSize = 0.01;
+
 // The evaluations equivalent to the best (L >= L_best - tolerance) among `points`.
 struct Plateau {
   std::vector<int> members;   // indices into points
   int best = -1;              // highest L
-  int simplest = -1;          // fewest components among members (ties: higher L)
+  // Among members within kSameModelSize of the fewest mean Gaussians per command, the highest L.
+  int simplest = -1;
   bool flat = false;          // more than one member
   double k_lo = 0, k_hi = 0;  // range of k over the members
   double init_scale_lo = 0, init_scale_hi = 0, prior_count_lo = 0, prior_count_hi = 0;

@@ -102,6 +102,13 @@ TEST(FindPlateau, FlatObjectiveGivesTheRangeAndTheSimplestModel) {
   const Plateau sharp = FindPlateau(points, 0.1);
   EXPECT_FALSE(sharp.flat);
   EXPECT_EQ(sharp.simplest, 3);
+  // Sizes closer than kSameModelSize are the same size: the higher L among them is chosen, not
+  // a lower one that saves a thousandth of a Gaussian per command.
+  std::vector<TuneKPoint> near = {{1, -5.0, 0, 1.0, "grid", 1.0008}, {3, -5.4, 0, 1.0, "grid", 1.0},
+                                  {10, -5.3, 0, 1.0, "grid", 1.2}};
+  const Plateau same = FindPlateau(near, 0.5);
+  EXPECT_EQ(same.members.size(), 3u);
+  EXPECT_EQ(same.simplest, 0);
 }
 
 TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
