@@ -4,13 +4,13 @@
 #include <chrono>
 #include <cmath>
 #include <map>
-#include <nlohmann/json.hpp>
 #include <random>
 #include <set>
 
 #include "sim/knobs.h"
 #include "sim/protocol.h"
 #include "sim2real/effect_fit.h"
+#include "sim2real/knob_design.h"
 #include "sim2real/locate.h"
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
@@ -21,66 +21,6 @@ namespace {
 using sim::Knob;
 using sim::KnobKind;
 using sim::KnobValue;
-
-// One external candidate: how its design is made for a sample.
-struct External {
-  enum Kind { kShift, kPayload, kImuBias, kHeading, kTrackerBias } kind = kShift;
-  std::vector<int> shifts;  // indices into the PairedShift list (payload: centre, x, y)
-};
-
-// Design (dx x p) of an external candidate at command c, terrain z, flag f.
-Eigen::MatrixXd ExternalDesign(const External& e, const std::vector<PairedShift>& shifts,
-                               const LinearGaussianModel& model, const PoseLayout& layout, int dx, int c,
-                               const Eigen::VectorXd& z, double f) {
-  switch (e.kind) {
-    case External::kShift: return shifts[e.shifts[0]].Shift(c, z, f);
-    case External::kPayload: {
-      Eigen::MatrixXd d(dx, 3);
-      const Eigen::VectorXd centre = shifts[e.shifts[0]].Shift(c, z, f);
-      d.col(0) = centre;
-      d.col(1) = shifts[e.shifts[1]].Shift(c, z, f) - centre;
-      d.col(2) = shifts[e.shifts[2]].Shift(c, z, f) - centre;
-      return d;
-    }
-    case External::kImuBias: {
-      // Recorded z = true z + b: the mean at the true z is u(z - b) ~ u(z) - J b.
-      Eigen::MatrixXd d = Eigen::MatrixXd::Zero(dx, 2);  // pitch and roll (the first two columns)
-      const double h = 1e-3;
-      for (int j = 0; j < std::min<int>(2, z.size()); ++j) {
-        Eigen::VectorXd zp = z, zm = z;
-        zp(j) += h;
-        zm(j) -= h;
-        d.col(j) = -(model.Predict(c, zp, f).mean - model.Predict(c, zm, f).mean) / (2 * h);
-      }
-      return d;
-    }
-    case External::kHeading: {
-      Eigen::MatrixXd d = Eigen::MatrixXd::Zero(dx, 1);
-      d(layout.dyaw, 0) = 1.0;
-      return d;
-    }
-    case External::kTrackerBias: {
-      // A constant offset on every pose axis but yaw: a yaw offset per execution is heading drift,
-      // its own candidate (with yaw here the bias would nest the drift and absorb it).
-      Eigen::MatrixXd d = Eigen::MatrixXd::Zero(dx, layout.dyaw >= 0 ? dx - 1 : dx);
-      for (int j = 0, col = 0; j < dx; ++j) {
-        if (j != layout.dyaw) d(j, col++) = 1.0;
-      }
-      return d;
-    }
-  }
-  return Eigen::MatrixXd::Zero(dx, 1);
-}
-
-EffectSpec ExternalSpec(const std::string& key, const std::string& title, int params, const std::string& unit) {
-  EffectSpec s;
-  s.id = EffectId::kExternal;
-  s.key = key;
-  s.title = title;
-  s.physics = title;
-  for (int p = 0; p < params; ++p) s.parameters.push_back({"t" + std::to_string(p), unit});
-  return s;
-}
 
 // Level below which residual means by command or terrain keep tracker noise from being named.
 constexpr double kNoiseStructureP = 0.01;
@@ -193,12 +133,12 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
 
   // 3. Candidates: knob probes, the payload, and the measurement effects.
   std::vector<EffectSpec> library;
-  std::vector<External> externals;  // parallel to library (unused entries for built-ins)
+  std::vector<ExternalCandidate> externals;  // parallel to library (unused entries for built-ins)
   for (const auto& e : EffectLibrary(layout, dx, terrain, real.has_sequence)) {
     if (e.id != EffectId::kBias && e.id != EffectId::kNoise) continue;
     if (e.id == EffectId::kBias) {
       library.push_back(ExternalSpec("tracker_bias", e.title, layout.dyaw >= 0 ? dx - 1 : dx, "x units"));
-      externals.push_back({External::kTrackerBias, {}});
+      externals.push_back({ExternalCandidate::kTrackerBias, {}});
     } else {
       library.push_back(e);
       externals.emplace_back();
@@ -230,7 +170,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     c.physical = true;
     out.candidates.push_back(c);
     library.push_back(ExternalSpec(c.key, k.name + " (simulated)", 1, "fraction of the probe's change"));
-    External e;
+    ExternalCandidate e;
     e.shifts = {static_cast<int>(r)};
     externals.push_back(e);
   }
@@ -250,8 +190,8 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     c.physical = true;
     out.candidates.push_back(c);
     library.push_back(ExternalSpec("payload", "payload on the torso (simulated)", 3, "fraction of the probe"));
-    External e;
-    e.kind = External::kPayload;
+    ExternalCandidate e;
+    e.kind = ExternalCandidate::kPayload;
     e.shifts = {payload_shift[0], payload_shift[1], payload_shift[2]};
     externals.push_back(e);
   }
@@ -259,23 +199,23 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     KnobCandidate c{"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad", 0, 0, 0, 0, false, 0};
     out.candidates.push_back(c);
     library.push_back(ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"));
-    External e;
-    e.kind = External::kImuBias;
+    ExternalCandidate e;
+    e.kind = ExternalCandidate::kImuBias;
     externals.push_back(e);
   }
   if (layout.dyaw >= 0) {
     KnobCandidate c{"heading_drift", "heading_drift", "tracker.yaw_drift", "rad per execution", 0, 0, 0, 0, false, 0};
     out.candidates.push_back(c);
     library.push_back(ExternalSpec("heading_drift", "heading drift per execution", 1, "rad per execution"));
-    External e;
-    e.kind = External::kHeading;
+    ExternalCandidate e;
+    e.kind = ExternalCandidate::kHeading;
     externals.push_back(e);
   }
   // The knob of each one-parameter simulated candidate (its probe's), before refinement moves
   // the shifts.
   std::vector<int> knob_of(library.size(), -1);
   for (size_t k = 0; k < library.size(); ++k) {
-    if (out.candidates[k].physical && externals[k].kind == External::kShift) {
+    if (out.candidates[k].physical && externals[k].kind == ExternalCandidate::kShift) {
       knob_of[k] = probe_of[externals[k].shifts[0]].first;
     }
   }
@@ -604,51 +544,6 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
   v.sentence = s;
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
-}
-
-std::string KnobAnalysisJson(const KnobAnalysis& a) {
-  using json = nlohmann::json;
-  json cands = json::array();
-  for (const auto& c : a.candidates) {
-    cands.push_back({{"key", c.key}, {"family", c.family}, {"knob", c.knob}, {"nominal", c.nominal},
-                     {"probe", c.probe}, {"range", {c.lo, c.hi}}, {"simulated", c.physical}});
-  }
-  json steps = json::array();
-  for (const auto& s : a.steps) {
-    json cs = json::array();
-    for (const auto& c : s.candidates) {
-      cs.push_back({{"key", a.candidates[c.effect].key}, {"gain", c.gain}, {"se", c.se}, {"z", c.z}});
-    }
-    steps.push_back({{"chosen", s.chosen >= 0 ? json(a.candidates[s.chosen].key) : json(nullptr)},
-                     {"threshold_z", s.threshold_z}, {"candidates", cs}});
-  }
-  json tests = json::array();
-  for (const auto& t : a.residual.tests) {
-    tests.push_back({{"where", t.where}, {"statistic", t.statistic}, {"p_value", t.p_value}, {"significant", t.significant}});
-  }
-  json trace = json::array();
-  for (const auto& r : a.refine_trace) trace.push_back({{"knob", r.knob}, {"value", r.value}, {"coefficient", r.coefficient}});
-  json removed = json::array();
-  for (int k : a.removed) removed.push_back(a.candidates[k].key);
-  json out = {{"candidates", cands},
-              {"selection_steps", steps},
-              {"refinement", trace},
-              {"removed_by_backward_pass", removed},
-              {"residual_tests", tests},
-              {"simulations", a.simulations},
-              {"from_cache", a.from_cache},
-              {"signature_simulations", a.signature_simulations},
-              {"signature_requests", a.signature_requests},
-              {"placements_per_simulation", a.placements},
-              {"cache_dir", a.cache_dir},
-              {"signature_seconds", a.signature_seconds},
-              {"refine_seconds", a.refine_seconds},
-              {"experiment_checks", a.experiment_checks},
-              {"experiment_check_seconds", a.experiment_seconds},
-              {"seconds", a.seconds},
-              {"heldout_ll", {{"sim", a.ll_sim}, {"corrected", a.ll_corrected}, {"ceiling", a.ll_ceiling}}},
-              {"note", a.note}};
-  return out.dump();
 }
 
 }  // namespace dgmm::sim2real

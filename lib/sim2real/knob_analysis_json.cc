@@ -1,0 +1,52 @@
+#include <nlohmann/json.hpp>
+
+#include "sim2real/knob_analysis.h"
+
+namespace dgmm::sim2real {
+
+std::string KnobAnalysisJson(const KnobAnalysis& a) {
+  using json = nlohmann::json;
+  json cands = json::array();
+  for (const auto& c : a.candidates) {
+    cands.push_back({{"key", c.key}, {"family", c.family}, {"knob", c.knob}, {"nominal", c.nominal},
+                     {"probe", c.probe}, {"range", {c.lo, c.hi}}, {"simulated", c.physical}});
+  }
+  json steps = json::array();
+  for (const auto& s : a.steps) {
+    json cs = json::array();
+    for (const auto& c : s.candidates) {
+      cs.push_back({{"key", a.candidates[c.effect].key}, {"gain", c.gain}, {"se", c.se}, {"z", c.z}});
+    }
+    steps.push_back({{"chosen", s.chosen >= 0 ? json(a.candidates[s.chosen].key) : json(nullptr)},
+                     {"threshold_z", s.threshold_z}, {"candidates", cs}});
+  }
+  json tests = json::array();
+  for (const auto& t : a.residual.tests) {
+    tests.push_back({{"where", t.where}, {"statistic", t.statistic}, {"p_value", t.p_value}, {"significant", t.significant}});
+  }
+  json trace = json::array();
+  for (const auto& r : a.refine_trace) trace.push_back({{"knob", r.knob}, {"value", r.value}, {"coefficient", r.coefficient}});
+  json removed = json::array();
+  for (int k : a.removed) removed.push_back(a.candidates[k].key);
+  json out = {{"candidates", cands},
+              {"selection_steps", steps},
+              {"refinement", trace},
+              {"removed_by_backward_pass", removed},
+              {"residual_tests", tests},
+              {"simulations", a.simulations},
+              {"from_cache", a.from_cache},
+              {"signature_simulations", a.signature_simulations},
+              {"signature_requests", a.signature_requests},
+              {"placements_per_simulation", a.placements},
+              {"cache_dir", a.cache_dir},
+              {"signature_seconds", a.signature_seconds},
+              {"refine_seconds", a.refine_seconds},
+              {"experiment_checks", a.experiment_checks},
+              {"experiment_check_seconds", a.experiment_seconds},
+              {"seconds", a.seconds},
+              {"heldout_ll", {{"sim", a.ll_sim}, {"corrected", a.ll_corrected}, {"ceiling", a.ll_ceiling}}},
+              {"note", a.note}};
+  return out.dump();
+}
+
+}  // namespace dgmm::sim2real
