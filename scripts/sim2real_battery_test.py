@@ -55,6 +55,11 @@ class DrawTest(unittest.TestCase):
         families = {e["family"] for p in pairs for e in p["effects"]}
         self.assertEqual(families, set(draw.FAMILIES) | {"out_of_library"})
 
+    def test_seed_lists_and_ranges(self):
+        self.assertEqual(battery.parse_seeds("1000-1003"), [1000, 1001, 1002, 1003])
+        self.assertEqual(battery.parse_seeds("7"), [7])
+        self.assertEqual(battery.parse_seeds("1019,1020,1030-1032"), [1019, 1020, 1030, 1031, 1032])
+
     def test_values_inside_their_ranges(self):
         n = nominals()
         for s in range(3000, 3400):
