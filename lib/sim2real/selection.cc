@@ -200,36 +200,42 @@ SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows
     remaining.erase(std::find(remaining.begin(), remaining.end(), best.effect));
     result.steps.push_back(step);
   }
-  // Backward pass: drop the effect whose removal costs least while that cost is insignificant.
-  while (options.backward && result.selected.size() > 1) {
-    const double threshold = UpperQuantile(options.alpha / result.selected.size());
-    size_t weakest = 0;
-    double weakest_z = INFINITY, weakest_gain = 0;
-    Eigen::VectorXd weakest_ll;
+  // Held-out log-likelihood of the selection without its k-th effect, per k: the backward pass and
+  // the importance ranking both need it for the final selection, so it is computed once there.
+  auto heldout_without_each = [&]() {
+    std::vector<Eigen::VectorXd> out;
     for (size_t k = 0; k < result.selected.size(); ++k) {
       std::vector<int> without = result.selected;
       without.erase(without.begin() + k);
-      Eigen::VectorXd ll = CrossValidate(fp, without, rows, fold, options.fit);
+      out.push_back(CrossValidate(fp, without, rows, fold, options.fit));
+    }
+    return out;
+  };
+  std::vector<Eigen::VectorXd> without_ll;  // of result.selected as it stands (empty: not computed)
+  // Backward pass: drop the effect whose removal costs least while that cost is insignificant.
+  while (options.backward && result.selected.size() > 1) {
+    const double threshold = UpperQuantile(options.alpha / result.selected.size());
+    without_ll = heldout_without_each();
+    size_t weakest = 0;
+    double weakest_z = INFINITY, weakest_gain = 0;
+    for (size_t k = 0; k < result.selected.size(); ++k) {
       double gain, se;
-      ClusteredMean(current - ll, cluster, &gain, &se);
+      ClusteredMean(current - without_ll[k], cluster, &gain, &se);
       const double z = se > 0 ? gain / se : (gain > 0 ? INFINITY : 0.0);
-      if (z < weakest_z) weakest = k, weakest_z = z, weakest_gain = gain, weakest_ll = ll;
+      if (z < weakest_z) weakest = k, weakest_z = z, weakest_gain = gain;
     }
     if (weakest_z > threshold && weakest_gain > options.min_gain_nats) break;
     result.removed.push_back(result.selected[weakest]);
     result.selected.erase(result.selected.begin() + weakest);
-    current = weakest_ll;
+    current = without_ll[weakest];
+    without_ll.clear();
   }
   result.heldout_corrected = current;
   result.fit = FitEffects(fp, result.selected, rows, options.fit);
+  if (result.selected.size() > 1 && without_ll.empty()) without_ll = heldout_without_each();
   for (size_t k = 0; k < result.selected.size(); ++k) {
-    if (result.selected.size() == 1) {
-      result.importance.push_back((current - result.heldout_sim).mean());
-      continue;
-    }
-    std::vector<int> without = result.selected;
-    without.erase(without.begin() + k);
-    result.importance.push_back((current - CrossValidate(fp, without, rows, fold, options.fit)).mean());
+    const Eigen::VectorXd& reference = result.selected.size() == 1 ? result.heldout_sim : without_ll[k];
+    result.importance.push_back((current - reference).mean());
   }
   return result;
 }
