@@ -111,25 +111,6 @@ TEST(FindPlateau, FlatObjectiveGivesTheRangeAndTheSimplestModel) {
   EXPECT_EQ(same.simplest, 0);
 }
 
-TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
-  // Large k everywhere: one Gaussian per command at every grid point, the curve is flat.
-  const SampleSet set = test::MakeTerrainSet(2, 20, 1.0, 3);
-  TuneKOptions options;
-  options.cv.folds = 4;
-  options.cv.repeats = 1;
-  options.k_min = 50;
-  options.k_max = 500;
-  options.grid_points = 3;
-  options.refine_points = 1;
-  options.init_scales.clear();
-  options.prior_counts.clear();
-  const TuneKSummary s = TuneK(set, options);
-  EXPECT_TRUE(s.plateau);
-  EXPECT_EQ(s.plateau_points, 4);
-  EXPECT_NE(s.BriefReport().find("plateau"), std::string::npos) << s.BriefReport();
-  EXPECT_EQ(s.components, 1.0);
-}
-
 // Small folds, coarse grids, one coordinate cycle: fast TuneK runs.
 TuneKOptions SmallOptions() {
   TuneKOptions options;
@@ -143,6 +124,22 @@ TuneKOptions SmallOptions() {
   options.init_scales = {0.1, 1.0, 10.0};
   options.prior_counts = {1.0, 16.0};
   return options;
+}
+
+TEST(TuneK, ReportsAPlateauOnAFlatCurve) {
+  // Large k everywhere: one Gaussian per command at every grid point, the curve is flat.
+  const SampleSet set = test::MakeTerrainSet(2, 20, 1.0, 3);
+  TuneKOptions options = SmallOptions();
+  options.cv.repeats = 1;
+  options.k_min = 50;
+  options.k_max = 500;
+  options.init_scales.clear();  // k alone: one cycle, as with the default cycles
+  options.prior_counts.clear();
+  const TuneKSummary s = TuneK(set, options);
+  EXPECT_TRUE(s.plateau);
+  EXPECT_EQ(s.plateau_points, 4);
+  EXPECT_NE(s.BriefReport().find("plateau"), std::string::npos) << s.BriefReport();
+  EXPECT_EQ(s.components, 1.0);
 }
 
 // A grid of S0 scales far below what the data want: the best is the grid's top, so the tuner
