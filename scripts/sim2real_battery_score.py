@@ -113,6 +113,7 @@ def score_pair(pair, report):
                     n.get("tie_group")] for n in named],
          "ties": [t.get("families") for t in verdict.get("ties") or []],
          "structured_in": (verdict.get("unexplained") or {}).get("structured_in"),
+         "drifting": [d.get("family") for d in verdict.get("drifting") or []],
          "gap_closed": verdict.get("gap_closed"), "column": column_of(verdict, truth)}
     kind = pair["kind"]
     if kind == "null":

@@ -89,6 +89,8 @@ def pair_table(results):
         s = r["score"]
         named = ", ".join(f"{n[0]} ({'n/c' if n[3] is None else f'{100 * n[3]:.0f}%'})"
                           for n in s["named"][:3]) or "none"
+        if s.get("drifting"):
+            named += "; drifting: " + ", ".join(s["drifting"])
         ties = "; ".join("/".join(t) for t in s["ties"]) or "-"
         verdict = ("clean" if s.get("clean") else "correct" if s.get("correct") else
                    "both" if s.get("both_found") else "one" if s.get("one_found") else

@@ -39,7 +39,7 @@ bool KnobAnalysisOptions::IsValid(std::string* error) const {
     return false;
   }
   return signatures.IsValid(error) && selection.IsValid(error) && residual.IsValid(error) &&
-         experiment.IsValid(error);
+         drift.IsValid(error) && experiment.IsValid(error);
 }
 
 std::vector<int> TiedCandidates(const FitProblem& fp, const SelectionStep& step, int chosen,
@@ -158,6 +158,19 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
       payload_shift[k.kind == KnobKind::kPayloadMass ? 0 : k.kind == KnobKind::kPayloadX ? 1 : 2] = static_cast<int>(r);
       continue;
     }
+    // A probe that changes nothing in simulation (common random numbers: a bit-identical
+    // recording) is a parameter this model ignores, e.g. torsional friction when every contact
+    // has condim 3: not a candidate.
+    const SampleSet& probe_set = batch.sets[r + 1];
+    const SampleSet& nominal_set = batch.sets[0];
+    if (probe_set.x.rows() == nominal_set.x.rows() && probe_set.x.cols() == nominal_set.x.cols() &&
+        probe_set.z.rows() == nominal_set.z.rows() && probe_set.z.cols() == nominal_set.z.cols() &&
+        probe_set.x == nominal_set.x && probe_set.z == nominal_set.z) {
+      if (std::find(out.inert_knobs.begin(), out.inert_knobs.end(), k.name) == out.inert_knobs.end()) {
+        out.inert_knobs.push_back(k.name);
+      }
+      continue;
+    }
     KnobCandidate c;
     c.key = k.name + Fmt("@%.4g", probe_of[r].second);
     c.family = k.family;
@@ -173,6 +186,9 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     ExternalCandidate e;
     e.shifts = {static_cast<int>(r)};
     externals.push_back(e);
+  }
+  for (const auto& name : out.inert_knobs) {
+    out.note += name + " changed nothing when simulated at its probe (this model ignores it): not a candidate. ";
   }
   double payload_probe = 0;
   if (payload_shift[0] >= 0 && payload_shift[1] >= 0 && payload_shift[2] >= 0) {
@@ -333,12 +349,32 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     Eigen::VectorXd s = WhitenedShift(problem, final_fit, static_cast<int>(k));
     resid -= Eigen::Map<Eigen::MatrixXd>(s.data(), dx, real.size()).transpose();
   }
-  resid *= std::exp(-final_fit.log_tau);
+  // 6a. Is each selected mean-shift effect constant over the session (drift.h)? Tested on the
+  // residual before the noise scale (the same whitened units as the effects' shifts).
+  // The same for the execution index within a placement (a step-dependent effect).
   std::vector<int> terrain_id(real.size(), -1), step(real.size(), -1);
   if (real.terrain_dim() > 0 && base.terrain_centres.rows() > 0) terrain_id = NearestCentre(real.z, base.terrain_centres);
   if (real.has_sequence && real_set.has_sequence()) {
     for (int i = 0; i < real.size(); ++i) step[i] = real_set.step(source_row[i]);
   }
+  std::vector<EffectDrift> drifts, step_drifts;
+  std::vector<int> drift_effect;  // library index of each entry of `drifts`
+  Eigen::MatrixXd total = Eigen::MatrixXd::Zero(real.size(), dx);
+  for (size_t k = 0; k < final_fit.effects.size(); ++k) {
+    if (library[final_fit.effects[k]].is_noise) continue;
+    Eigen::VectorXd s = WhitenedShift(problem, final_fit, static_cast<int>(k));
+    const Eigen::MatrixXd shift = Eigen::Map<Eigen::MatrixXd>(s.data(), dx, real.size()).transpose();
+    total += shift;
+    drifts.push_back(TestEffectDrift(resid, shift, real.command, real.episode, options.drift, options.seed + 1 + k));
+    step_drifts.push_back(TestEffectStepVariation(resid, shift, real.episode, step, options.drift, options.seed + 101 + k));
+    drift_effect.push_back(final_fit.effects[k]);
+  }
+  out.total_drift = TestEffectDrift(resid, total, real.command, real.episode, options.drift, options.seed);
+  out.total_step_variation = TestEffectStepVariation(resid, total, real.episode, step, options.drift, options.seed + 100);
+  MarkDrifting(&out.total_drift, &drifts, options.drift);
+  MarkDrifting(&out.total_step_variation, &step_drifts, options.drift);
+  for (size_t q = 0; q < drifts.size(); ++q) out.drift_tests.push_back({drift_effect[q], drifts[q], step_drifts[q]});
+  resid *= std::exp(-final_fit.log_tau);
   const double sim_kurt = ExcessKurtosis(model.WhitenedResiduals(sim));
   out.residual = TestResidualStructure(resid, real.command, terrain_id, real.episode, step, sim_kurt,
                                        options.residual, options.seed);
@@ -372,22 +408,44 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
       noise_withheld = true;
       continue;
     }
-    families.insert(c.family);
     const int pos = static_cast<int>(std::find(final_fit.effects.begin(), final_fit.effects.end(), k) -
                                      final_fit.effects.begin());
     const Eigen::VectorXd& t = final_fit.theta[pos];
+    // The value in the knob's unit of the effect at coefficient(s) t.
+    auto value_at = [&](const Eigen::VectorXd& t) {
+      if (c.key == "payload") return c.nominal + t(0) * payload_probe;
+      if (c.physical) return value_of(k, t(0));
+      if (c.family == "tracker_noise") return std::exp(final_fit.log_tau);
+      return t.cwiseAbs().maxCoeff() * (c.family == "heading_drift" ? (t(0) < 0 ? -1 : 1) : 1);
+    };
+    out.candidates[k].theta = t(0);
+    const auto d = std::find(drift_effect.begin(), drift_effect.end(), k);
+    const int q = static_cast<int>(d - drift_effect.begin());
+    if (d != drift_effect.end() && (drifts[q].drifting || step_drifts[q].drifting)) {
+      // Not a constant: listed with how it varies, not named.
+      VerdictDrifting w;
+      w.family = c.family, w.knob = c.knob, w.unit = c.unit, w.value = value_at(t), w.nominal = c.nominal;
+      w.inclusion = inclusion[k];
+      const EffectDrift& e = drifts[q].drifting ? drifts[q] : step_drifts[q];
+      w.along = drifts[q].drifting ? "session order" : "execution index";
+      w.gamma = e.gamma, w.p_value = e.p_value;
+      if (drifts[q].drifting) {
+        w.first = value_at(t * (1 - e.gamma / 2)), w.last = value_at(t * (1 + e.gamma / 2));
+      } else {
+        w.first = value_at(t * e.low), w.last = value_at(t * e.high);
+        w.first_step = e.low_step, w.last_step = e.high_step;
+      }
+      v.drifting.push_back(w);
+      continue;
+    }
+    families.insert(c.family);
     VerdictNamed n;
     n.family = c.family;
     n.knob = c.knob;
     n.unit = c.unit;
     n.nominal = c.nominal;
     n.inclusion = inclusion[k];
-    if (c.key == "payload") n.value = c.nominal + t(0) * payload_probe;
-    else if (c.physical) {
-      n.value = value_of(k, t(0));
-    } else if (c.family == "tracker_noise") n.value = std::exp(final_fit.log_tau);
-    else n.value = t.cwiseAbs().maxCoeff() * (c.family == "heading_drift" ? (t(0) < 0 ? -1 : 1) : 1);
-    out.candidates[k].theta = t(0);
+    n.value = value_at(t);
     v.named.push_back(n);
   }
   const auto experiment_start = std::chrono::steady_clock::now();
@@ -495,10 +553,18 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
   }
   out.experiment_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - experiment_start).count();
   v.structured_in = out.residual.structured_in;
-  v.unexplained_present = structured || noise_withheld || (!v.structured_in.empty() && !base.unexplained.empty());
+  const bool session_drift = out.total_drift.drifting;
+  if (session_drift) v.structured_in.push_back("session order");
+  if (out.total_step_variation.drifting &&
+      std::find(v.structured_in.begin(), v.structured_in.end(), "step") == v.structured_in.end()) {
+    v.structured_in.push_back("step");
+  }
+  const bool step_varies = out.total_step_variation.drifting;
+  v.unexplained_present = structured || noise_withheld || session_drift || step_varies ||
+                          (!v.structured_in.empty() && !base.unexplained.empty());
   if (noise_withheld && v.structured_in.empty()) v.structured_in = {"command or terrain means"};
   if (v.named.empty()) {
-    v.status = (base.significant_mismatch || structured) ? "unexplained" : "clean";
+    v.status = (base.significant_mismatch || structured || session_drift || step_varies) ? "unexplained" : "clean";
     v.unexplained_present = v.status == "unexplained";
     if (v.unexplained_present && v.structured_in.empty()) v.structured_in = {"located regions"};
   } else {
@@ -536,6 +602,27 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
       s += (w == 0 ? " " : ", ") + v.structured_in[w];
     }
     s += ".";
+  }
+  for (const auto& d : v.drifting) {
+    s += " " + d.family + " fits on average (" + d.knob + Fmt(" = %.4g", d.value) + (d.unit.empty() ? "" : " " + d.unit) +
+         Fmt(", nominal %.4g", d.nominal) + ") but is not named: ";
+    if (d.along == "session order") {
+      s += Fmt("it drifts over the session, from %.4g in the first episodes to ", d.first) +
+           Fmt("%.4g in the last (p %.3g)", d.last, d.p_value) +
+           "; no constant simulator setting explains a drift (wear, heating, a tracker drifting over the day?).";
+    } else {
+      s += Fmt("its size varies with the execution index, from %.4g at step %.0f to ", d.first, d.first_step) +
+           Fmt("%.4g at step %.0f", d.last, d.last_step) + Fmt(" (p %.3g)", d.p_value) +
+           "; a constant setting only matches it on average (a step-periodic or step-dependent effect?).";
+    }
+  }
+  if (step_varies && v.drifting.empty()) {
+    s += Fmt(" The correction as a whole varies with the execution index (RMS %.0f%% of its size, p %.3g); no "
+             "single effect carries it.", 100 * out.total_step_variation.gamma, out.total_step_variation.p_value);
+  }
+  if (session_drift && v.drifting.empty()) {
+    s += Fmt(" The correction as a whole changes over the session (by %.0f%% of its size from the first to the last "
+             "episode, p %.3g); no single effect carries the drift.", 100 * out.total_drift.gamma, out.total_drift.p_value);
   }
   if (noise_withheld) {
     s += " A wider variance (tracker noise) also fits better, but is not named: what remains is not a pure "

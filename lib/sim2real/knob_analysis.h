@@ -13,6 +13,7 @@
 
 #include "core/sample_set.h"
 #include "sim/sim_config.h"
+#include "sim2real/drift.h"
 #include "sim2real/experiment_check.h"
 #include "sim2real/pipeline.h"
 #include "sim2real/residual_structure.h"
@@ -26,6 +27,7 @@ struct KnobAnalysisOptions {
   SignatureOptions signatures;
   SelectionOptions selection;      // bootstrap_selection 0: inclusion not computed
   ResidualStructureOptions residual;
+  DriftOptions drift;              // is each named effect constant over the session?
   double tie_correlation = 0.9;    // |corr| of whitened signatures on the real samples
   int refine_iterations = 3;       // re-simulations per refined knob (0: no refinement)
   int refine_knobs = 2;            // knobs refined at most (most important first), each followed by a new selection
@@ -50,6 +52,14 @@ struct KnobAnalysis {
   std::vector<SelectionStep> steps;
   std::vector<int> selected;              // candidate indices, by importance
   ResidualStructure residual;
+  struct DriftTest {
+    int candidate = -1;   // index into candidates
+    EffectDrift drift;           // over the session
+    EffectDrift step_variation;  // with the execution index
+  };
+  std::vector<DriftTest> drift_tests;     // per selected mean-shift effect
+  EffectDrift total_drift;                // of the sum of their shifts (the whole correction)
+  EffectDrift total_step_variation;
   int simulations = 0, from_cache = 0, placements = 0;
   // Of those, the signature stage's (nominal + probes): 0 simulated = "signatures cached".
   int signature_simulations = 0, signature_requests = 0;
@@ -58,6 +68,7 @@ struct KnobAnalysis {
   double experiment_seconds = 0;    // wall time of those checks
   std::string cache_dir;
   std::vector<int> removed;               // candidate indices dropped by the selection's backward pass
+  std::vector<std::string> inert_knobs;   // knobs whose probe changed nothing in simulation (not candidates)
   struct RefineStep {
     std::string knob;
     double value = 0, coefficient = 0;  // value simulated, fitted coefficient of its signature

@@ -24,6 +24,13 @@ std::string KnobAnalysisJson(const KnobAnalysis& a) {
   for (const auto& t : a.residual.tests) {
     tests.push_back({{"where", t.where}, {"statistic", t.statistic}, {"p_value", t.p_value}, {"significant", t.significant}});
   }
+  json drift = json::array();
+  for (const auto& d : a.drift_tests) {
+    const EffectDrift& v = d.step_variation;
+    drift.push_back({{"key", a.candidates[d.candidate].key}, {"relative_change", d.drift.gamma},
+                     {"p_value", d.drift.p_value}, {"z", d.drift.z}, {"episodes", d.drift.episodes}, {"drifting", d.drift.drifting},
+                     {"step_variation", {{"relative_rms", v.gamma}, {"p_value", v.p_value}, {"z", v.z}, {"varies", v.drifting}}}});
+  }
   json trace = json::array();
   for (const auto& r : a.refine_trace) trace.push_back({{"knob", r.knob}, {"value", r.value}, {"coefficient", r.coefficient}});
   json removed = json::array();
@@ -32,7 +39,14 @@ std::string KnobAnalysisJson(const KnobAnalysis& a) {
               {"selection_steps", steps},
               {"refinement", trace},
               {"removed_by_backward_pass", removed},
+              {"inert_knobs", a.inert_knobs},
               {"residual_tests", tests},
+              {"drift_tests", drift},
+              {"total_drift", {{"relative_change", a.total_drift.gamma}, {"p_value", a.total_drift.p_value},
+                               {"z", a.total_drift.z}, {"drifting", a.total_drift.drifting}}},
+              {"total_step_variation", {{"relative_rms", a.total_step_variation.gamma},
+                                        {"p_value", a.total_step_variation.p_value},
+                                        {"z", a.total_step_variation.z}, {"varies", a.total_step_variation.drifting}}},
               {"simulations", a.simulations},
               {"from_cache", a.from_cache},
               {"signature_simulations", a.signature_simulations},

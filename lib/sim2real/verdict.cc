@@ -73,9 +73,24 @@ std::string VerdictJson(const Verdict& v) {
     }
     ties.push_back({{"families", t.families}, {"why", t.why}, {"experiment", experiment}});
   }
+  json drifting = json::array();
+  for (const auto& d : v.drifting) {
+    json e = {{"family", d.family}, {"knob", d.knob}, {"unit", d.unit}, {"along", d.along},
+              {"value", Number(d.value)}, {"nominal", Number(d.nominal)},
+              {"relative_change", Number(d.gamma)}, {"p_value", Number(d.p_value)},
+              {"inclusion", d.inclusion < 0 ? json(nullptr) : json(d.inclusion)}};
+    if (d.along == "session order") {
+      e["first"] = Number(d.first), e["last"] = Number(d.last);
+    } else {
+      e["lowest"] = Number(d.first), e["lowest_step"] = d.first_step;
+      e["highest"] = Number(d.last), e["highest_step"] = d.last_step;
+    }
+    drifting.push_back(e);
+  }
   json out = {{"status", v.status},
               {"named", named},
               {"ties", ties},
+              {"drifting", drifting},
               {"unexplained", {{"present", v.unexplained_present}, {"structured_in", v.structured_in}}},
               {"gap_closed", Number(v.gap_closed)}};
   return out.dump();

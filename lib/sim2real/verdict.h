@@ -42,10 +42,22 @@ struct VerdictNamed {
   int tie_group = -1;     // index into ties, -1: null
 };
 
+// A named effect that is not a constant (drift.h): over the session (`first`/`last`: its value in
+// the first and the last episodes, `gamma` the relative change between them) or with the
+// execution index (`first`/`last`: its value at the steps where it is smallest and largest,
+// `gamma` the relative RMS spread over steps). `value` is its fitted value over the whole set.
+struct VerdictDrifting {
+  std::string family, knob, unit;
+  std::string along = "session order";  // or "execution index" (first/last: the lowest/highest step)
+  double value = 0, nominal = 0, first = 0, last = 0, gamma = 0, p_value = 1;
+  int first_step = -1, last_step = -1;  // execution index only
+  double inclusion = -1;  // < 0: not computed
+};
 struct Verdict {
   std::string status = "clean";  // clean, explained, partly_explained, unexplained, cannot_compare
   std::vector<VerdictNamed> named;
   std::vector<VerdictTie> ties;
+  std::vector<VerdictDrifting> drifting;  // effects that fit on average but drift (not named)
   bool unexplained_present = false;
   std::vector<std::string> structured_in;
   double gap_closed = 0;  // NaN: no gap (null)
