@@ -422,7 +422,11 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     const auto d = std::find(drift_effect.begin(), drift_effect.end(), k);
     const int q = static_cast<int>(d - drift_effect.begin());
     if (d != drift_effect.end() && (drifts[q].drifting || step_drifts[q].drifting)) {
-      // Not a constant: listed with how it varies, not named.
+      // Not a constant: listed with how it varies, not named (once per knob: two probes of one
+      // knob may both be selected).
+      if (std::any_of(v.drifting.begin(), v.drifting.end(), [&](const VerdictDrifting& w) { return w.knob == c.knob; })) {
+        continue;
+      }
       VerdictDrifting w;
       w.family = c.family, w.knob = c.knob, w.unit = c.unit, w.value = value_at(t), w.nominal = c.nominal;
       w.inclusion = inclusion[k];
@@ -607,12 +611,13 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     s += " " + d.family + " fits on average (" + d.knob + Fmt(" = %.4g", d.value) + (d.unit.empty() ? "" : " " + d.unit) +
          Fmt(", nominal %.4g", d.nominal) + ") but is not named: ";
     if (d.along == "session order") {
-      s += Fmt("it drifts over the session, from %.4g in the first episodes to ", d.first) +
-           Fmt("%.4g in the last (p %.3g)", d.last, d.p_value) +
+      s += Fmt("it drifts over the session, its size changing by %+.0f%% from the first episodes to the last ", 100 * d.gamma) +
+           Fmt("(value %.4g to %.4g, within the knob's range; p %.2g)", d.first, d.last, d.p_value) +
            "; no constant simulator setting explains a drift (wear, heating, a tracker drifting over the day?).";
     } else {
-      s += Fmt("its size varies with the execution index, from %.4g at step %.0f to ", d.first, d.first_step) +
-           Fmt("%.4g at step %.0f", d.last, d.last_step) + Fmt(" (p %.3g)", d.p_value) +
+      s += Fmt("its size varies with the execution index (RMS %.0f%% of its size; ", 100 * d.gamma) +
+           Fmt("value %.4g at step %.0f to ", d.first, d.first_step) +
+           Fmt("%.4g at step %.0f, within the knob's range; p %.2g)", d.last, d.last_step, d.p_value) +
            "; a constant setting only matches it on average (a step-periodic or step-dependent effect?).";
     }
   }
