@@ -322,6 +322,68 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     fill_design(&problem, top);
     sel = ForwardSelect(problem, rows, fold, select_options);
   }
+  // 5b. The payload (three parameters: mass at the centre, x and y directions): re-simulated at
+  // the mass and position its fit implies, the mass refined along that position until the
+  // simulated payload's coefficient is about 1 (secant from the nominal, regula falsi inside a
+  // bracket), then select again with that signature in column 0.
+  const int pay = static_cast<int>(std::find_if(out.candidates.begin(), out.candidates.end(),
+                                                [](const KnobCandidate& c) { return c.key == "payload"; }) -
+                                   out.candidates.begin());
+  double payload_signature_mass = NAN;  // the mass of column 0's simulation (NaN: the probe's)
+  const auto pay_it = std::find(sel.selected.begin(), sel.selected.end(), pay);
+  if (pay < static_cast<int>(out.candidates.size()) && pay_it != sel.selected.end() && options.refine_iterations > 0 &&
+      options.refine_knobs > 0) {
+    const KnobCandidate& c = out.candidates[pay];
+    const int pos = static_cast<int>(pay_it - sel.selected.begin());
+    const Eigen::VectorXd t = sel.fit.theta[pos];
+    const int mass_knob = probe_of[payload_shift[0]].first, x_knob = probe_of[payload_shift[1]].first,
+              y_knob = probe_of[payload_shift[2]].first;
+    const Knob& kx = knobs[x_knob];
+    const Knob& ky = knobs[y_knob];
+    if (t(0) > 0.05) {  // a payload heavier than nominal (a lighter one has no position to fit)
+      const double px = std::clamp(kx.nominal + t(1) / t(0) * (probe_of[payload_shift[1]].second - kx.nominal), kx.lo, kx.hi);
+      const double py = std::clamp(ky.nominal + t(2) / t(0) * (probe_of[payload_shift[2]].second - ky.nominal), ky.lo, ky.hi);
+      double mass = std::clamp(c.nominal + t(0) * payload_probe, c.lo, c.hi);
+      std::vector<std::pair<double, double>> trace = {{c.probe, t(0)}};
+      double best_err = INFINITY;
+      std::vector<int> best_shifts = externals[pay].shifts;
+      const std::vector<int> probes = {payload_shift[0], payload_shift[1], payload_shift[2]};
+      FitProblem trial = problem;
+      for (int it = 0; it < options.refine_iterations && best_err >= 0.1; ++it) {
+        if (std::abs(mass - c.nominal) < 1e-9 * (1 + std::abs(c.nominal))) break;
+        SimulationBatch one = SimulateBatch(config, protocol, seed, knobs,
+                                            {{{KnobValue{mass_knob, mass}, KnobValue{x_knob, px}, KnobValue{y_knob, py}}}},
+                                            options.signatures);
+        out.simulations += one.simulated;
+        out.from_cache += one.from_cache;
+        shifts.push_back(PairedShift::Fit(batch.sets[0], one.sets[0], sim_set, options.signatures.slope_ridge));
+        externals[pay].shifts = {static_cast<int>(shifts.size()) - 1, probes[0], probes[1], probes[2]};
+        fill_design(&trial, pay);
+        const double a = FitEffects(trial, sel.selected, {}, options.selection.fit).theta[pos](0);
+        trace.emplace_back(mass, a);
+        out.refine_trace.push_back({c.knob + Fmt(" at (x %.3g, ", px) + Fmt("y %.3g) m", py), mass, a});
+        if (std::abs(a - 1) < best_err) {
+          best_err = std::abs(a - 1);
+          best_shifts = externals[pay].shifts;
+          payload_signature_mass = mass;
+        }
+        double lo_v = NAN, lo_a = 0, hi_v = NAN, hi_a = 0;
+        for (size_t q = 1; q < trace.size(); ++q) {  // simulated values only (the probe is at the centre)
+          const auto& [tv, ta] = trace[q];
+          if (ta > 1 && (!std::isfinite(lo_v) || ta < lo_a)) lo_v = tv, lo_a = ta;
+          if (ta < 1 && (!std::isfinite(hi_v) || ta > hi_a)) hi_v = tv, hi_a = ta;
+        }
+        mass = std::isfinite(lo_v) && std::isfinite(hi_v) ? lo_v + (1 - lo_a) * (hi_v - lo_v) / (hi_a - lo_a)
+                                                          : c.nominal + a * (mass - c.nominal);
+        mass = std::clamp(mass, c.lo, c.hi);
+      }
+      externals[pay].shifts = best_shifts;
+      if (std::isfinite(payload_signature_mass)) {
+        fill_design(&problem, pay);
+        sel = ForwardSelect(problem, rows, fold, select_options);
+      }
+    }
+  }
   out.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_start).count();
   std::vector<double> inclusion(library.size(), -1.0);
   if (options.selection.bootstrap_selection > 0) {
@@ -413,7 +475,10 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     const Eigen::VectorXd& t = final_fit.theta[pos];
     // The value in the knob's unit of the effect at coefficient(s) t.
     auto value_at = [&](const Eigen::VectorXd& t) {
-      if (c.key == "payload") return c.nominal + t(0) * payload_probe;
+      if (c.key == "payload") {
+        return std::isfinite(payload_signature_mass) ? c.nominal + t(0) * (payload_signature_mass - c.nominal)
+                                                     : c.nominal + t(0) * payload_probe;
+      }
       if (c.physical) return value_of(k, t(0));
       if (c.family == "tracker_noise") return std::exp(final_fit.log_tau);
       return t.cwiseAbs().maxCoeff() * (c.family == "heading_drift" ? (t(0) < 0 ? -1 : 1) : 1);

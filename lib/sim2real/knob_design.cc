@@ -11,10 +11,11 @@ Eigen::MatrixXd ExternalDesign(const ExternalCandidate& e, const std::vector<Pai
     case ExternalCandidate::kShift: return shifts[e.shifts[0]].Shift(c, z, f);
     case ExternalCandidate::kPayload: {
       Eigen::MatrixXd d(dx, 3);
-      const Eigen::VectorXd centre = shifts[e.shifts[0]].Shift(c, z, f);
-      d.col(0) = centre;
-      d.col(1) = shifts[e.shifts[1]].Shift(c, z, f) - centre;
-      d.col(2) = shifts[e.shifts[2]].Shift(c, z, f) - centre;
+      const size_t o = e.shifts.size() == 4 ? 1 : 0;  // refined: the probes follow the refined shift
+      const Eigen::VectorXd centre = shifts[e.shifts[o]].Shift(c, z, f);
+      d.col(0) = o == 1 ? shifts[e.shifts[0]].Shift(c, z, f) : centre;
+      d.col(1) = shifts[e.shifts[o + 1]].Shift(c, z, f) - centre;
+      d.col(2) = shifts[e.shifts[o + 2]].Shift(c, z, f) - centre;
       return d;
     }
     case ExternalCandidate::kImuBias: {

@@ -17,7 +17,10 @@ namespace dgmm::sim2real {
 // One candidate of the knob analysis: which design it has and which paired shifts it uses.
 struct ExternalCandidate {
   enum Kind { kShift, kPayload, kImuBias, kHeading, kTrackerBias } kind = kShift;
-  std::vector<int> shifts;  // indices into the PairedShift list (payload: centre, x, y)
+  // Indices into the PairedShift list. Payload: (centre, x, y) probes, or after refinement
+  // (refined, centre, x, y): column 0 is then the payload simulated at the refined mass and
+  // position, columns 1-2 stay the probes' position directions (x - centre, y - centre).
+  std::vector<int> shifts;
 };
 
 // Mean-shift design D (dx x p) of candidate e for command c, terrain z (terrain_dim), first-execution
