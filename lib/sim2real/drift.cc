@@ -6,6 +6,19 @@
 #include <random>
 
 namespace dgmm::sim2real {
+namespace {
+
+// p (add-one) and z of `observed` against the permutation values' running sums: `ge` of them at
+// least as extreme, `sum` and `sum2` their sum and sum of squares over `n`. Returns the null mean.
+double SummariseNull(double observed, int ge, double sum, double sum2, int n, EffectDrift* out) {
+  const double m = sum / n;
+  const double sd = std::sqrt(std::max(0.0, sum2 / n - m * m));
+  out->p_value = (ge + 1.0) / (n + 1.0);
+  out->z = sd > 0 ? (observed - m) / sd : 0.0;
+  return m;
+}
+
+}  // namespace
 
 bool DriftOptions::IsValid(std::string* error) const {
   if (permutations < 20 || !(alpha > 0 && alpha < 1) || !(min_relative_change >= 0)) {
@@ -86,10 +99,7 @@ EffectDrift TestEffectDrift(const Eigen::MatrixXd& r, const Eigen::MatrixXd& s, 
     sum += v, sum2 += v * v;
     ge += std::abs(v) >= std::abs(observed) * (1 - 1e-12);
   }
-  const double m = sum / options.permutations;
-  const double sd = std::sqrt(std::max(0.0, sum2 / options.permutations - m * m));
-  out.z = sd > 0 ? (observed - m) / sd : 0.0;
-  out.p_value = (ge + 1.0) / (options.permutations + 1.0);
+  SummariseNull(observed, ge, sum, sum2, options.permutations, &out);
   return out;
 }
 
@@ -144,10 +154,7 @@ EffectDrift TestEffectStepVariation(const Eigen::MatrixXd& r, const Eigen::Matri
     sum += q, sum2 += q * q;
     ge += q >= observed * (1 - 1e-12);
   }
-  const double m = sum / options.permutations;
-  const double sd = std::sqrt(std::max(0.0, sum2 / options.permutations - m * m));
-  out.p_value = (ge + 1.0) / (options.permutations + 1.0);
-  out.z = sd > 0 ? (observed - m) / sd : 0.0;
+  const double m = SummariseNull(observed, ge, sum, sum2, options.permutations, &out);
   out.gamma = std::sqrt(std::max(0.0, observed - m) / total_b);
   for (int k = 0; k <= max_step; ++k) {
     if (!(b[k] > 0)) continue;

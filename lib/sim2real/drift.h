@@ -41,7 +41,7 @@ struct EffectDrift {
 };
 
 // `residual` and `shift` n x dx (whitened, same units); `command`, `episode` per sample. Returns
-// gamma 0, p 1 when fewer than 2 episodes of one command exist or the shift is zero.
+// gamma 0, p 1 when there are fewer than 2 episodes or the shift is zero.
 EffectDrift TestEffectDrift(const Eigen::MatrixXd& residual, const Eigen::MatrixXd& shift,
                             const std::vector<int>& command, const std::vector<int>& episode,
                             const DriftOptions& options, std::uint64_t seed);

@@ -25,6 +25,22 @@ using sim::KnobValue;
 // Level below which residual means by command or terrain keep tracker noise from being named.
 constexpr double kNoiseStructureP = 0.01;
 
+// The next value to simulate when refining a knob towards coefficient 1, from the (value,
+// coefficient) pairs simulated so far and the last one (`value`, coefficient `a`): inside a
+// bracket (one coefficient above 1, one below) the linear interpolation of the coefficient to 1
+// (regula falsi); otherwise the secant step nominal + a (value - nominal). Clamped to [lo, hi].
+double NextRefineValue(const std::vector<std::pair<double, double>>& trace, double nominal, double value, double a,
+                       double lo, double hi) {
+  double lo_v = NAN, lo_a = 0, hi_v = NAN, hi_a = 0;
+  for (const auto& [tv, ta] : trace) {
+    if (ta > 1 && (!std::isfinite(lo_v) || ta < lo_a)) lo_v = tv, lo_a = ta;
+    if (ta < 1 && (!std::isfinite(hi_v) || ta > hi_a)) hi_v = tv, hi_a = ta;
+  }
+  const double next = std::isfinite(lo_v) && std::isfinite(hi_v) ? lo_v + (1 - lo_a) * (hi_v - lo_v) / (hi_a - lo_a)
+                                                                 : nominal + a * (value - nominal);
+  return std::clamp(next, lo, hi);
+}
+
 double Cosine(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const double d = a.norm() * b.norm();
   return d > 0 ? a.dot(b) / d : 0.0;
@@ -304,17 +320,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
         best_shift = externals[top].shifts[0];
         signature_at[top] = value;
       }
-      // Next value: inside a bracket (a value whose coefficient is above 1 and one below 1),
-      // the linear interpolation of the coefficient to 1 (regula falsi); otherwise the secant
-      // step from this value.
-      double lo_v = NAN, lo_a = 0, hi_v = NAN, hi_a = 0;
-      for (const auto& [tv, ta] : trace) {
-        if (ta > 1 && (!std::isfinite(lo_v) || ta < lo_a)) lo_v = tv, lo_a = ta;
-        if (ta < 1 && (!std::isfinite(hi_v) || ta > hi_a)) hi_v = tv, hi_a = ta;
-      }
-      value = std::isfinite(lo_v) && std::isfinite(hi_v) ? lo_v + (1 - lo_a) * (hi_v - lo_v) / (hi_a - lo_a)
-                                                         : c.nominal + a * (value - c.nominal);
-      value = std::clamp(value, c.lo, c.hi);
+      value = NextRefineValue(trace, c.nominal, value, a, c.lo, c.hi);
     }
     for (const auto& [v, a] : trace) out.refine_trace.push_back({c.knob, v, a});
     externals[top].shifts = {best_shift};
@@ -344,7 +350,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
       const double px = std::clamp(kx.nominal + t(1) / t(0) * (probe_of[payload_shift[1]].second - kx.nominal), kx.lo, kx.hi);
       const double py = std::clamp(ky.nominal + t(2) / t(0) * (probe_of[payload_shift[2]].second - ky.nominal), ky.lo, ky.hi);
       double mass = std::clamp(c.nominal + t(0) * payload_probe, c.lo, c.hi);
-      std::vector<std::pair<double, double>> trace = {{c.probe, t(0)}};
+      std::vector<std::pair<double, double>> trace;  // simulated (mass, coefficient); the probe sits at the centre
       double best_err = INFINITY;
       std::vector<int> best_shifts = externals[pay].shifts;
       const std::vector<int> probes = {payload_shift[0], payload_shift[1], payload_shift[2]};
@@ -367,15 +373,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
           best_shifts = externals[pay].shifts;
           payload_signature_mass = mass;
         }
-        double lo_v = NAN, lo_a = 0, hi_v = NAN, hi_a = 0;
-        for (size_t q = 1; q < trace.size(); ++q) {  // simulated values only (the probe is at the centre)
-          const auto& [tv, ta] = trace[q];
-          if (ta > 1 && (!std::isfinite(lo_v) || ta < lo_a)) lo_v = tv, lo_a = ta;
-          if (ta < 1 && (!std::isfinite(hi_v) || ta > hi_a)) hi_v = tv, hi_a = ta;
-        }
-        mass = std::isfinite(lo_v) && std::isfinite(hi_v) ? lo_v + (1 - lo_a) * (hi_v - lo_v) / (hi_a - lo_a)
-                                                          : c.nominal + a * (mass - c.nominal);
-        mass = std::clamp(mass, c.lo, c.hi);
+        mass = NextRefineValue(trace, c.nominal, mass, a, c.lo, c.hi);
       }
       externals[pay].shifts = best_shifts;
       if (std::isfinite(payload_signature_mass)) {
@@ -411,9 +409,9 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     Eigen::VectorXd s = WhitenedShift(problem, final_fit, static_cast<int>(k));
     resid -= Eigen::Map<Eigen::MatrixXd>(s.data(), dx, real.size()).transpose();
   }
-  // 6a. Is each selected mean-shift effect constant over the session (drift.h)? Tested on the
-  // residual before the noise scale (the same whitened units as the effects' shifts).
-  // The same for the execution index within a placement (a step-dependent effect).
+  // 6a. Is each selected mean-shift effect constant over the session and over the execution index
+  // within a placement (drift.h)? Tested on the residual before the noise scale (the same
+  // whitened units as the effects' shifts).
   std::vector<int> terrain_id(real.size(), -1), step(real.size(), -1);
   if (real.terrain_dim() > 0 && base.terrain_centres.rows() > 0) terrain_id = NearestCentre(real.z, base.terrain_centres);
   if (real.has_sequence && real_set.has_sequence()) {
