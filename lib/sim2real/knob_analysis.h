@@ -7,6 +7,7 @@
 // correlation on the observed samples with a discriminating experiment, the most important knobs
 // refined by re-simulation (each followed by a new selection), the residual tested for structure,
 // and the verdict.
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "sim2real/pipeline.h"
 #include "sim2real/residual_structure.h"
 #include "sim2real/signatures.h"
+#include "sim2real/spread.h"
 #include "sim2real/verdict.h"
 
 namespace dgmm::sim2real {
@@ -28,6 +30,7 @@ struct KnobAnalysisOptions {
   SelectionOptions selection;      // bootstrap_selection 0: inclusion not computed
   ResidualStructureOptions residual;
   DriftOptions drift;              // is each named effect constant over the session?
+  SpreadOptions spread;            // is a wider spread the tracker's or the named knobs'?
   double tie_correlation = 0.9;    // |corr| of whitened signatures on the real samples
   int refine_iterations = 3;       // re-simulations per refined knob (0: no refinement)
   int refine_knobs = 2;            // knobs refined at most (most important first), each followed by a new selection
@@ -60,6 +63,8 @@ struct KnobAnalysis {
   std::vector<DriftTest> drift_tests;     // per selected mean-shift effect
   EffectDrift total_drift;                // of the sum of their shifts (the whole correction)
   EffectDrift total_step_variation;
+  SpreadTest spread;                      // run when the noise scale was selected and a tracker knob exists
+  double tracker_scale = NAN;             // the tracker-noise scale refined by re-simulation (NaN: not needed)
   int simulations = 0, from_cache = 0, placements = 0;
   // Of those, the signature stage's (nominal + probes): 0 simulated = "signatures cached".
   int signature_simulations = 0, signature_requests = 0;

@@ -1,5 +1,8 @@
 #include <nlohmann/json.hpp>
 
+#include <cmath>
+#include <vector>
+
 #include "sim2real/knob_analysis.h"
 
 namespace dgmm::sim2real {
@@ -33,6 +36,13 @@ std::string KnobAnalysisJson(const KnobAnalysis& a) {
   }
   json trace = json::array();
   for (const auto& r : a.refine_trace) trace.push_back({{"knob", r.knob}, {"value", r.value}, {"coefficient", r.coefficient}});
+  json spread = nullptr;
+  if (a.spread.tested) {
+    std::vector<double> log_k(a.spread.knob_log_ratio.data(), a.spread.knob_log_ratio.data() + a.spread.knob_log_ratio.size());
+    spread = {{"knob_log_variance_ratio", log_k}, {"tracker_coefficient", a.spread.a}, {"gain", a.spread.gain},
+              {"se", a.spread.se}, {"z", a.spread.z}, {"tracker_needed", a.spread.tracker_needed},
+              {"tracker_scale", std::isfinite(a.tracker_scale) ? json(a.tracker_scale) : json(nullptr)}};
+  }
   json removed = json::array();
   for (int k : a.removed) removed.push_back(a.candidates[k].key);
   json out = {{"candidates", cands},
@@ -42,6 +52,7 @@ std::string KnobAnalysisJson(const KnobAnalysis& a) {
               {"inert_knobs", a.inert_knobs},
               {"residual_tests", tests},
               {"drift_tests", drift},
+              {"spread", spread},
               {"total_drift", {{"relative_change", a.total_drift.gamma}, {"p_value", a.total_drift.p_value},
                                {"z", a.total_drift.z}, {"drifting", a.total_drift.drifting}}},
               {"total_step_variation", {{"relative_rms", a.total_step_variation.gamma},

@@ -213,15 +213,23 @@ PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbe
     lam(0, 0) = 0;
     out.b_[c] = (g[c] + lam + 1e-9 * Eigen::Matrix4d::Identity()).ldlt().solve(r[c] + lam * out.pooled_);
   }
-  // Spread change: residual variance of x about each command's mean, nominal vs perturbed.
-  std::vector<Eigen::VectorXd> mn(commands, Eigen::VectorXd::Zero(dx)), mp(commands, Eigen::VectorXd::Zero(dx));
+  // Spread change: residual variance of x about each command's own linear fit in phi (the
+  // spread the sim model's covariance describes), nominal vs perturbed, pooled over commands.
+  std::vector<Eigen::MatrixXd> rn(commands, Eigen::MatrixXd::Zero(4, dx)), rp(commands, Eigen::MatrixXd::Zero(4, dx));
   for (int i = 0; i < n; ++i) {
-    mn[cmd[i]] += xn[i] / count[cmd[i]];
-    mp[cmd[i]] += xp[i] / count[cmd[i]];
+    rn[cmd[i]] += phis[i] * xn[i].transpose();
+    rp[cmd[i]] += phis[i] * xp[i].transpose();
+  }
+  std::vector<Eigen::MatrixXd> bn(commands), bp(commands);
+  for (int c = 0; c < commands; ++c) {
+    if (count[c] == 0) continue;
+    const auto solver = (g[c] + lambda + 1e-9 * Eigen::Matrix4d::Identity()).ldlt();
+    bn[c] = solver.solve(rn[c]);
+    bp[c] = solver.solve(rp[c]);
   }
   for (int i = 0; i < n; ++i) {
-    ss_n += (xn[i] - mn[cmd[i]]).cwiseAbs2();
-    ss_p += (xp[i] - mp[cmd[i]]).cwiseAbs2();
+    ss_n += (xn[i] - bn[cmd[i]].transpose() * phis[i]).cwiseAbs2();
+    ss_p += (xp[i] - bp[cmd[i]].transpose() * phis[i]).cwiseAbs2();
   }
   out.log_var_ = (ss_p.array() + 1e-30).log() - (ss_n.array() + 1e-30).log();
   return out;

@@ -55,7 +55,8 @@ class PairedShift {
                          double slope_ridge);
   // Mean shift (dx) at command c (row of the sim table), terrain z (pitch, roll), first flag.
   Eigen::VectorXd Shift(int command, const Eigen::Ref<const Eigen::VectorXd>& z, double first) const;
-  // log(var_perturbed / var_nominal) per dimension of x, pooled over commands (residuals).
+  // log(var_perturbed / var_nominal) per dimension of x: residuals about each command's linear
+  // fit in phi (the spread the sim model's covariance describes), pooled over commands.
   const Eigen::VectorXd& log_variance_ratio() const { return log_var_; }
   int pairs() const { return pairs_; }
 
