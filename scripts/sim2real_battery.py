@@ -19,9 +19,12 @@ confusion matrix and the targets table) and with --write-doc the section `sim2re
 docs/sim2real.md.
 
 Seed ranges: DEV 1000-1999 (what the method may be developed on), REPORT 5000-5039 (run once).
+Draw version 2 (default; from seed range 11000) adds the solimp contact option and the backlash
+family and plants tracker noise through the config; --draw-version 1 redraws the ranges up to
+10000-10039 exactly as they were.
 
 Usage: scripts/sim2real_battery.py --seeds 1000-1009 [--jobs 2] [--build build] [--out DIR]
-       [--keep] [--smoke] [--generate-only] [--write-doc]
+       [--keep] [--smoke] [--generate-only] [--write-doc] [--draw-version {1,2}]
 """
 import argparse
 import concurrent.futures as cf
@@ -167,6 +170,11 @@ def generate(args, pair, nominals):
     pdir, tdir = os.path.join(args.out, "pairs", str(seed)), os.path.join(args.out, "truth", str(seed))
     real = os.path.join(pdir, "real.h5")
     if os.path.exists(real) and os.path.exists(os.path.join(tdir, "truth.json")):
+        with open(os.path.join(tdir, "truth.json")) as f:
+            recorded = json.load(f).get("draw_version", 1)
+        if recorded != pair.get("draw_version", 1):
+            raise RuntimeError(f"pair {seed}: OUT holds draw version {recorded}, asked for "
+                               f"{pair.get('draw_version', 1)}: use another --out")
         return
     os.makedirs(pdir, exist_ok=True)
     os.makedirs(tdir, exist_ok=True)
@@ -419,6 +427,10 @@ def main():
     ap.add_argument("--kinds", default=None, metavar="K[,K]",
                     help="keep only pairs of these kinds (null, single, two, out_of_library): "
                          "for development on one kind; a report runs every pair of its range")
+    ap.add_argument("--draw-version", type=int, choices=draw.DRAW_VERSIONS,
+                    default=draw.DEFAULT_DRAW_VERSION,
+                    help="pair generator: 1 = seed ranges up to 10000-10039 as drawn then; 2 "
+                         "(default) adds solimp and backlash, tracker noise through the config")
     ap.add_argument("--write-doc", action="store_true",
                     help="write the tables into docs/sim2real.md (section sim2real-battery)")
     args = ap.parse_args()
@@ -438,7 +450,7 @@ def main():
     if args.realism:
         realism(args, nominals)
         return 0
-    pairs = [draw.draw_pair(s, nominals) for s in seeds]
+    pairs = [draw.draw_pair(s, nominals, args.draw_version) for s in seeds]
     if args.kinds:
         kinds = set(args.kinds.split(","))
         pairs = [p for p in pairs if p["kind"] in kinds]
@@ -466,6 +478,7 @@ def main():
         with open(os.path.join(args.out, "truth", str(p["seed"]), "truth.json")) as f:
             truth = json.load(f)
         r = {"seed": p["seed"], "robot": p["robot"], "kind": p["kind"],
+             "draw_version": truth.get("draw_version", 1),
              "effects": [{k: e.get(k) for k in ("family", "kind", "knob", "value", "unit", "what")}
                          for e in truth["effects"]],
              "analysis_wall_s": wall, "first_of_robot": firsts[p["robot"]] == p["seed"],
@@ -497,7 +510,8 @@ def main():
         shown.append(a)
     command = "scripts/sim2real_battery.py " + " ".join(shown)
     doc = tables.markdown(ordered, summary, command, smoke=args.smoke)
-    out = {"seeds": args.seeds, "smoke": args.smoke, "summary": summary, "pairs": ordered}
+    out = {"seeds": args.seeds, "smoke": args.smoke, "draw_version": args.draw_version,
+           "summary": summary, "pairs": ordered}
     tmp = os.path.join(args.out, "results.json.tmp")
     with open(tmp, "w") as f:
         json.dump(out, f, indent=2)

@@ -2,18 +2,29 @@
 planted (issue #9, "Proof, blinded"). Ranges are physical and fixed before any result was seen;
 docs/sim2real.md ("Blinded battery") lists them. Nothing here looks at an analysis.
 
-A pair is drawn from numpy's default_rng(seed) alone: same seed, same pair. Each planted effect is
-a dict {family, knob, value, unit, nominal, what, config, mjcf, data}: `config` edits the sim
-config JSON of the "real" robot, `mjcf` edits a copy of its MJCF, `data` edits the recorded set.
+A pair is drawn from numpy's default_rng(seed) and the draw version alone: same seed and version,
+same pair. Each planted effect is a dict {family, knob, value, unit, nominal, what, config, mjcf,
+data}: `config` edits the sim config JSON of the "real" robot, `mjcf` edits a copy of its MJCF,
+`data` edits the recorded set.
+
+Draw versions: 1 is the generator of seed ranges up to 10000-10039 (kept bit for bit); 2 (the
+default, from seed range 11000) adds the contact family's floor solimp option, the physics family
+"backlash", and plants tracker noise through the config (the simulator's own tracker noise scaled
+by s) instead of adding noise to the recorded set.
 """
 import re
 
 import numpy as np
 
 # Families of the report.json verdict contract (docs/sim2real.md, "report.json verdict").
-PHYSICS = ["friction", "contact", "mass", "payload", "actuator_gain", "joint_damping", "latency"]
+# Version 1 drew from the first list; version 2 adds "backlash" (FAMILIES: every version's).
+PHYSICS_V1 = ["friction", "contact", "mass", "payload", "actuator_gain", "joint_damping", "latency"]
+PHYSICS = PHYSICS_V1 + ["backlash"]
 MEASUREMENT = ["imu_bias", "tracker_bias", "tracker_noise", "heading_drift"]
+FAMILIES_V1 = PHYSICS_V1 + MEASUREMENT
 FAMILIES = PHYSICS + MEASUREMENT
+DRAW_VERSIONS = (1, 2)
+DEFAULT_DRAW_VERSION = 2
 OUT_OF_LIBRARY = ["periodic_pitch", "fatigue"]
 
 # Shares of the pair kinds (issue #9: ~20% nulls, ~20% two effects, ~10% outside every library);
@@ -37,6 +48,8 @@ RANGES = {
     "kp.scale": [(0.6, (0.5, 0.8)), (0.4, (1.3, 2.0))],
     "joint_damping.scale": [(0.75, (2.5, 8.0)), (0.25, (0.2, 0.4))],
     "latency_s": (0.04, 0.1),
+    "floor.solimp.dmax": (0.55, 0.8),           # version 2; nominal 0.95 (MuJoCo default)
+    "backlash_rad": (0.03, 0.1),                # version 2; nominal 0
     "imu_bias_rad": (0.02, 0.07),               # per biased axis, random sign
     "tracker_bias_m": (0.004, 0.015),           # per biased axis, random sign
     "tracker_noise.scale": (1.6, 3.0),
@@ -61,10 +74,12 @@ def _log_uniform(rng, lo, hi):
     return float(np.exp(rng.uniform(np.log(lo), np.log(hi))))
 
 
-def draw_effect(family, rng, nominal, robot):
+def draw_effect(family, rng, nominal, robot, version=DEFAULT_DRAW_VERSION):
     """One planted effect of `family` for a robot whose nominal sim config is `nominal` (dict)."""
     act = nominal["actuators"]
     e = {"family": family, "config": {}, "mjcf": None, "data": None}
+    if version >= 2 and family in ("contact", "backlash", "tracker_noise"):
+        return _draw_effect_v2(family, rng, nominal, e)
     if family == "friction":
         # Sliding friction only: both robots use condim-3 contacts, for which MuJoCo ignores the
         # torsional coefficient (a torsional change would be a null in disguise).
@@ -161,6 +176,44 @@ def draw_effect(family, rng, nominal, robot):
     return e
 
 
+def _draw_effect_v2(family, rng, nominal, e):
+    """Version 2's draws of the families it changed (contact, backlash, tracker_noise)."""
+    if family == "contact":
+        option = int(rng.integers(0, 3))  # solref time constant, damping ratio, solimp dmax
+        if option == 0:
+            tc = _log_uniform(rng, *RANGES["floor.solref.timeconst"])
+            e.update(knob="floor.solref.timeconst", value=tc, unit="s", nominal=0.02,
+                     what=f"floor solref time constant {tc:.3f} s (nominal 0.02)")
+            e["mjcf"] = {"floor_solref": [tc, 1.0]}
+        elif option == 1:
+            dr = _range(rng, "floor.solref.dampratio")
+            e.update(knob="floor.solref.dampratio", value=dr, unit="", nominal=1.0,
+                     what=f"floor solref damping ratio {dr:.2f} (nominal 1)")
+            e["mjcf"] = {"floor_solref": [0.02, dr]}
+        else:  # softer contact impedance at depth; MuJoCo's defaults for the rest
+            dmax = round(_range(rng, "floor.solimp.dmax"), 4)  # as written into the MJCF
+            dmin = min(0.9, dmax)
+            e.update(knob="floor.solimp.dmax", value=dmax, unit="", nominal=0.95,
+                     what=f"floor solimp dmax {dmax:.3f} (dmin {dmin:.3f}; nominal 0.9, 0.95)")
+            e["mjcf"] = {"floor_solimp": [dmin, dmax, 0.001, 0.5, 2.0]}
+    elif family == "backlash":
+        b = _range(rng, "backlash_rad")
+        e.update(knob="actuators.backlash_rad", value=b, unit="rad", nominal=0.0,
+                 what=f"backlash {b:.3f} rad per leg joint")
+        e["config"] = {"actuators": {"backlash_rad": b}}
+    elif family == "tracker_noise":
+        # The simulator's tracker noise x s: each pose delta's noise is scaled by exactly s.
+        s = _range(rng, "tracker_noise.scale")
+        keys = ("tracker_position_sd_m", "tracker_yaw_sd_rad", "tracker_roll_sd_rad",
+                "tracker_pitch_sd_rad")
+        e.update(knob="tracker.noise_scale", value=s, unit="", nominal=1.0,
+                 what=f"tracker noise x{s:.2f}")
+        e["config"] = {"noise": {k: nominal["noise"][k] * s for k in keys}}
+    else:
+        raise ValueError(family)
+    return e
+
+
 def draw_out_of_library(rng):
     """An effect no library has: a step-periodic pitch oscillation or a fatigue drift."""
     kind = OUT_OF_LIBRARY[int(rng.integers(0, 2))]
@@ -176,8 +229,11 @@ def draw_out_of_library(rng):
             "config": {}, "mjcf": None, "data": {"fatigue": {"rate": rate}}}
 
 
-def draw_pair(seed, nominals):
-    """The concealed pair of `seed`: robot, kind and planted effects (list, empty for a null)."""
+def draw_pair(seed, nominals, version=DEFAULT_DRAW_VERSION):
+    """The concealed pair of `seed` under draw `version`: robot, kind and planted effects (list,
+    empty for a null)."""
+    if version not in DRAW_VERSIONS:
+        raise ValueError(f"draw version {version}: expected one of {DRAW_VERSIONS}")
     rng = np.random.default_rng(seed)
     robot = "harvestman" if rng.random() < P_SECOND_ROBOT else "scorpion"
     u = rng.random()
@@ -190,10 +246,11 @@ def draw_pair(seed, nominals):
     elif kind == "out_of_library":
         effects = [draw_out_of_library(rng)]
     else:
-        families = list(rng.choice(FAMILIES, size=2 if kind == "two" else 1, replace=False))
-        effects = [draw_effect(str(f), rng, nominals[robot], robot) for f in families]
+        choices = FAMILIES_V1 if version == 1 else FAMILIES
+        families = list(rng.choice(choices, size=2 if kind == "two" else 1, replace=False))
+        effects = [draw_effect(str(f), rng, nominals[robot], robot, version) for f in families]
     return {"seed": seed, "robot": robot, "kind": kind, "effects": effects,
-            "real_seed": 100000 + seed}
+            "real_seed": 100000 + seed, "draw_version": version}
 
 
 def merge(base, edit):
@@ -205,9 +262,15 @@ def merge(base, edit):
 
 
 def edit_mjcf(xml, edit):
-    """Applies an `mjcf` edit to MJCF text; the floor geom must be named "floor"."""
-    tc, dr = edit["floor_solref"]
-    new, n = re.subn(r'<geom name="floor"', f'<geom name="floor" solref="{tc:.5f} {dr:.4f}"', xml)
+    """Applies an `mjcf` edit (floor_solref [tc, dr] and/or floor_solimp [dmin, dmax, width,
+    midpoint, power]) to MJCF text; the floor geom must be named "floor"."""
+    attrs = ""
+    if "floor_solref" in edit:
+        tc, dr = edit["floor_solref"]
+        attrs += f' solref="{tc:.5f} {dr:.4f}"'
+    if "floor_solimp" in edit:
+        attrs += ' solimp="' + " ".join(f"{v:.5g}" for v in edit["floor_solimp"]) + '"'
+    new, n = re.subn(r'<geom name="floor"', f'<geom name="floor"{attrs}', xml)
     if n != 1:
         raise ValueError("MJCF: expected one geom named floor")
     return new

@@ -23,7 +23,8 @@ KNOB_WORDS = {
     "friction.sliding": ["slid"], "floor.solref.timeconst": ["time"],
     "floor.solref.dampratio": ["damp"], "masses.scale": ["mass"], "payload.mass_kg": ["mass"],
     "actuators.kp_nm_per_rad": ["kp"], "actuators.joint_damping_nms_per_rad": ["damp"],
-    "actuators.latency_s": ["laten", "delay"],
+    "actuators.latency_s": ["laten", "delay"], "floor.solimp.dmax": ["dmax"],
+    "actuators.backlash_rad": ["backlash"], "tracker.noise_scale": ["noise"],
 }
 
 
@@ -67,9 +68,11 @@ def knob_matches(truth_knob, named_knob):
     if truth_knob.startswith("actuators.leg_gain["):
         which = truth_knob[len("actuators.leg_gain["):-1]
         return (f"leg{which}" in named) if which.isdigit() else which in named
+    if truth_knob in KNOB_WORDS:
+        return any(w in named for w in KNOB_WORDS[truth_knob])
     if truth_knob.startswith("imu") or truth_knob.startswith("tracker"):
         return True  # measurement effects: one knob per family
-    return any(w in named for w in KNOB_WORDS.get(truth_knob, []))
+    return False
 
 
 def value_error(effect, verdict):

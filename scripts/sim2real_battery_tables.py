@@ -1,5 +1,5 @@
 """Markdown tables of scripts/sim2real_battery.py: targets, confusion matrix, every pair."""
-from sim2real_battery_draw import FAMILIES
+from sim2real_battery_draw import FAMILIES, FAMILIES_V1
 
 TARGETS = [  # key, what, target (text), test on the measured value
     ("null_clean", "nulls clean (status clean, nothing named)", "100%", lambda r: r >= 1.0),
@@ -49,8 +49,13 @@ def targets_table(summary):
 
 
 def confusion_matrix(results):
-    cols = FAMILIES + ["tie", "unexplained", "none"]
-    rows = FAMILIES + ["null", "out_of_library"]
+    # Families only draw version 2 plants (backlash) get a column only when a pair has them, so
+    # version-1 tables keep their layout.
+    used = {e["family"] for r in results for e in r.get("effects", [])} | \
+        {r["score"]["column"] for r in results if "score" in r}
+    families = [f for f in FAMILIES if f in FAMILIES_V1 or f in used]
+    cols = families + ["tie", "unexplained", "none"]
+    rows = families + ["null", "out_of_library"]
     counts = {r: {c: 0 for c in cols} for r in rows}
     for r in results:
         if "score" not in r or r["kind"] == "two":

@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """Unit tests of the blinded battery's drawing, planting and scoring (no dgmm needed; ctest
 `sim2real_battery_scorer`). The battery itself is a script: scripts/sim2real_battery.py."""
+import importlib.util
 import json
 import os
+import subprocess
 import sys
 import tempfile
 import unittest
@@ -80,6 +82,92 @@ class DrawTest(unittest.TestCase):
             draw.edit_mjcf("<mujoco/>", {"floor_solref": [0.05, 1.0]})
 
 
+# The draw generator before draw versions existed (commit 32e2dee); version 1 must equal it.
+GENERATOR_V1_COMMIT = "32e2dee"
+# Fingerprints of version-1 draws by that generator: (seed, robot, kind, [(family, knob, value)]).
+V1_FINGERPRINTS = [
+    (1020, "scorpion", "two", [("payload", "payload.mass_kg", 1.7219253054796524),
+                               ("friction", "friction.sliding", 0.7311098108730703)]),
+    (5028, "scorpion", "single", [("latency", "actuators.latency_s", 0.076)]),
+    (10017, "scorpion", "two", [("latency", "actuators.latency_s", 0.059),
+                                ("tracker_noise", "tracker.noise_scale", 2.1400791675332487)]),
+]
+
+
+def generator_v1():
+    """The draw module as of GENERATOR_V1_COMMIT (None outside a git checkout)."""
+    try:
+        text = subprocess.run(["git", "-C", HERE, "show",
+                               f"{GENERATOR_V1_COMMIT}:scripts/sim2real_battery_draw.py"],
+                              capture_output=True, text=True, check=True).stdout
+    except (OSError, subprocess.CalledProcessError):
+        return None
+    tmp = tempfile.NamedTemporaryFile("w", suffix=".py", delete=False)
+    with tmp:
+        tmp.write(text)
+    spec = importlib.util.spec_from_file_location("draw_v1_generator", tmp.name)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    os.remove(tmp.name)
+    return module
+
+
+class DrawVersionTest(unittest.TestCase):
+    def test_version_1_reproduces_the_old_draws(self):
+        n = nominals()
+        for seed, robot, kind, effects in V1_FINGERPRINTS:
+            p = draw.draw_pair(seed, n, version=1)
+            self.assertEqual((p["robot"], p["kind"], p["draw_version"]), (robot, kind, 1))
+            self.assertEqual([(e["family"], e["knob"], e["value"]) for e in p["effects"]], effects)
+        old = generator_v1()
+        if old is None:
+            self.skipTest("not a git checkout: only the fingerprints were compared")
+        seeds = list(range(1000, 1300)) + list(range(5000, 5040)) + list(range(10000, 10040))
+        for s in seeds:
+            p = draw.draw_pair(s, n, version=1)
+            self.assertEqual(p.pop("draw_version"), 1)
+            self.assertEqual(json.dumps(p), json.dumps(old.draw_pair(s, n)), s)
+            for e in p["effects"]:
+                if e.get("mjcf"):
+                    xml = '<geom name="floor" type="plane"/>'
+                    self.assertEqual(draw.edit_mjcf(xml, e["mjcf"]), old.edit_mjcf(xml, e["mjcf"]))
+
+    def test_version_2_is_the_default_and_draws_the_new_options(self):
+        n = nominals()
+        self.assertEqual(draw.draw_pair(11000, n), draw.draw_pair(11000, n, version=2))
+        with self.assertRaises(ValueError):
+            draw.draw_pair(11000, n, version=3)
+        pairs = [draw.draw_pair(s, n) for s in range(11000, 11400)]
+        effects = [dict(e, robot=p["robot"]) for p in pairs for e in p["effects"]]
+        knobs = {e["knob"] for e in effects}
+        for k in ("floor.solimp.dmax", "floor.solref.timeconst", "floor.solref.dampratio",
+                  "actuators.backlash_rad", "tracker.noise_scale"):
+            self.assertIn(k, knobs)
+        for e in effects:
+            if e["knob"] == "floor.solimp.dmax":
+                self.assertTrue(0.55 <= e["value"] <= 0.8)
+                dmin, dmax = e["mjcf"]["floor_solimp"][:2]
+                self.assertEqual((dmin, dmax), (min(0.9, e["value"]), e["value"]))
+            if e["family"] == "backlash":
+                self.assertTrue(0.03 <= e["value"] <= 0.1)
+                self.assertEqual(e["config"], {"actuators": {"backlash_rad": e["value"]}})
+                self.assertEqual((e["unit"], e["nominal"]), ("rad", 0.0))
+            if e["family"] == "tracker_noise":  # planted in the simulator, not in the data
+                self.assertTrue(1.6 <= e["value"] <= 3.0)
+                self.assertIsNone(e["data"])
+                self.assertEqual(set(e["config"]["noise"]),
+                                 {"tracker_position_sd_m", "tracker_yaw_sd_rad",
+                                  "tracker_roll_sd_rad", "tracker_pitch_sd_rad"})
+                for k, v in e["config"]["noise"].items():
+                    self.assertAlmostEqual(v, n[e["robot"]]["noise"][k] * e["value"])
+
+    def test_solimp_edit_sets_the_floor_solimp(self):
+        with open(os.path.join(battery.ROOT, "datasets/robots/scorpion.xml")) as f:
+            xml = f.read()
+        out = draw.edit_mjcf(xml, {"floor_solimp": [0.7, 0.7, 0.001, 0.5, 2.0]})
+        self.assertIn('<geom name="floor" solimp="0.7 0.7 0.001 0.5 2"', out)
+
+
 class PlantTest(unittest.TestCase):
     def test_data_edits_change_only_their_columns(self):
         with tempfile.TemporaryDirectory() as d:
@@ -146,6 +234,23 @@ class ScoreTest(unittest.TestCase):
                                      name("payload", "payload.mass_kg", 2.2)])
         v = score.score_pair(pair("single", PAYLOAD), both)["values"]["payload"]
         self.assertAlmostEqual(v["error"], 0.1)
+
+    def test_backlash_and_tracker_noise_values(self):
+        backlash = {"family": "backlash", "knob": "actuators.backlash_rad", "value": 0.05}
+        got = verdict("explained", [name("backlash", "actuators.backlash_rad", 0.06)])
+        s = score.score_pair(pair("single", backlash), got)
+        self.assertTrue(s["correct"])
+        self.assertAlmostEqual(s["values"]["backlash"]["error"], 0.2)
+        latency = verdict("explained", [name("latency", "actuators.latency_s", 0.05)])
+        self.assertFalse(score.score_pair(pair("single", backlash), latency)["correct"])
+        noise = {"family": "tracker_noise", "knob": "tracker.noise_scale", "value": 2.0}
+        for knob in ("tracker.noise_scale", "noise"):  # the knob path's and the data level's
+            got = verdict("explained", [name("tracker_noise", knob, 1.8)])
+            v = score.score_pair(pair("single", noise), got)["values"]["tracker_noise"]
+            self.assertAlmostEqual(v["error"], -0.1)
+        solimp = {"family": "contact", "knob": "floor.solimp.dmax", "value": 0.7}
+        other = verdict("explained", [name("contact", "floor.solref.timeconst", 0.05)])
+        self.assertIsNone(score.score_pair(pair("single", solimp), other)["values"]["contact"]["error"])
 
     def test_two_effects_and_out_of_library(self):
         both = verdict("explained", [name("payload"), name("friction")])

@@ -73,6 +73,16 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
       knobs.push_back(MakeKnob(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "",
                                dr, 0.1 * dr, 4 * dr, {0.3 * dr}));
     }
+    // solimp (dmin, dmax, width, midpoint, power); ranges widened to hold an unusual nominal.
+    const double dmax = m->geom_solimp[mjNIMP * parts.floor_geom + 1];
+    const double width = m->geom_solimp[mjNIMP * parts.floor_geom + 2];
+    const double dmax_probe = std::abs(dmax - 0.7) > 0.05 ? 0.7 : 0.9;
+    knobs.push_back(MakeKnob(KnobKind::kFloorSolimpDmax, -1, "floor.solimp.dmax", "contact", "", dmax,
+                             std::min(0.5, dmax), std::max(0.99, dmax), {dmax_probe}));
+    const double width_hi = std::max(0.02, width);
+    const double width_probe = width < 0.01 ? 0.01 : 2 * width <= width_hi ? 2 * width : 0.5 * width;
+    knobs.push_back(MakeKnob(KnobKind::kFloorSolimpWidth, -1, "floor.solimp.width", "contact", "m", width,
+                             std::min(0.0002, width), width_hi, {width_probe}));
   }
   knobs.push_back(MakeKnob(KnobKind::kMassScale, -1, "bodies.mass_scale", "mass", "", 1.0, 0.4, 2.5, {0.7, 1.4}));
   if (mj_name2id(m, mjOBJ_BODY, "payload") >= 0) {
@@ -109,6 +119,16 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
   const double lat = config.actuators.latency_s;
   knobs.push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, 0.2,
                            {lat + 0.04}));
+  const double bl = config.actuators.backlash_rad;
+  knobs.push_back(MakeKnob(KnobKind::kBacklash, -1, "actuators.backlash_rad", "backlash", "rad", bl, 0.0, 0.2,
+                           {bl + 0.03 <= 0.2 ? bl + 0.03 : bl - 0.03}));
+  // Last: a measurement-side knob of the simulator (the tracker's noise), config-level.
+  const auto& n = config.noise;
+  if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
+      n.tracker_pitch_sd_rad > 0) {
+    knobs.push_back(MakeKnob(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0,
+                             0.5, 5.0, {2.0}));
+  }
   return knobs;
 }
 
@@ -116,7 +136,7 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
                      const std::vector<KnobValue>& values, ModelEdit* edit) {
   SimConfig c = config;
   double mass_scale = 1, damping_scale = 1;
-  double solref_time = NAN, solref_damp = NAN;
+  double solref_time = NAN, solref_damp = NAN, solimp_dmax = NAN, solimp_width = NAN;
   bool payload = false;
   double payload_mass = NAN;
   Eigen::Vector3d payload_pos = config.payload.position_body_m;
@@ -153,7 +173,18 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
         break;
       case KnobKind::kKpScale: c.actuators.kp_nm_per_rad = config.actuators.kp_nm_per_rad * v.value; break;
       case KnobKind::kDampingScale: damping_scale = v.value; break;
+      case KnobKind::kFloorSolimpDmax: solimp_dmax = v.value; break;
+      case KnobKind::kFloorSolimpWidth: solimp_width = v.value; break;
       case KnobKind::kLatency: c.actuators.latency_s = v.value; break;
+      case KnobKind::kBacklash: c.actuators.backlash_rad = v.value; break;
+      case KnobKind::kTrackerNoiseScale: {
+        const auto& n = config.noise;
+        c.noise.tracker_position_sd_m = n.tracker_position_sd_m * v.value;
+        c.noise.tracker_yaw_sd_rad = n.tracker_yaw_sd_rad * v.value;
+        c.noise.tracker_roll_sd_rad = n.tracker_roll_sd_rad * v.value;
+        c.noise.tracker_pitch_sd_rad = n.tracker_pitch_sd_rad * v.value;
+        break;
+      }
     }
   }
   if (payload) {
@@ -163,7 +194,8 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
   }
   c.actuators.joint_damping_nms_per_rad = config.actuators.joint_damping_nms_per_rad * damping_scale;
   const std::string floor = config.names.floor_geom;
-  const bool model_edit = mass_scale != 1 || std::isfinite(solref_time) || std::isfinite(solref_damp);
+  const bool model_edit = mass_scale != 1 || std::isfinite(solref_time) || std::isfinite(solref_damp) ||
+                          std::isfinite(solimp_dmax) || std::isfinite(solimp_width);
   if (edit) {
     *edit = {};
     if (model_edit) {
@@ -177,6 +209,11 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
         const int g = mj_name2id(m, mjOBJ_GEOM, floor.c_str());
         if (g >= 0 && std::isfinite(solref_time)) m->geom_solref[mjNREF * g + 0] = solref_time;
         if (g >= 0 && std::isfinite(solref_damp)) m->geom_solref[mjNREF * g + 1] = solref_damp;
+        if (g >= 0 && std::isfinite(solimp_dmax)) {
+          m->geom_solimp[mjNIMP * g + 1] = solimp_dmax;
+          m->geom_solimp[mjNIMP * g + 0] = std::min(m->geom_solimp[mjNIMP * g + 0], solimp_dmax);
+        }
+        if (g >= 0 && std::isfinite(solimp_width)) m->geom_solimp[mjNIMP * g + 2] = solimp_width;
       };
     }
   }

@@ -1,11 +1,13 @@
 #pragma once
 // The physical parameters ("knobs") of a simulation a user can get wrong, enumerated from the
 // loaded robot model and its SimConfig (not from hard-coded body names): floor friction, floor
-// contact softness (solref), all-body mass scale, a payload on the torso, actuator gain per leg
-// (legs = the torso's child subtrees that carry actuators), per side (sign of the leg root's y),
-// of all legs (kp), joint damping, actuation latency. Each knob knows its nominal value, a physical range, the
-// probe values simulated for its signature (docs/sim2real.md, "Signatures from the simulator")
-// and how to apply a value (to the SimConfig, or to the compiled mjModel through a ModelEdit).
+// contact softness (solref) and impedance (solimp dmax, width), all-body mass scale, a payload on
+// the torso, actuator gain per leg (legs = the torso's child subtrees that carry actuators), per
+// side (sign of the leg root's y), of all legs (kp), joint damping, actuation latency, backlash,
+// and last the tracker's noise scale (when the config has tracker noise). Each knob knows its
+// nominal value, a physical range, the probe values simulated for its signature (docs/sim2real.md,
+// "Signatures from the simulator") and how to apply a value (to the SimConfig, or to the compiled
+// mjModel through a ModelEdit).
 #include <string>
 #include <vector>
 
@@ -21,6 +23,8 @@ enum class KnobKind {
   kFrictionTorsional,  // every geom's torsional friction [m]
   kFloorSolrefTime,    // floor geom solref[0], contact time constant [s]
   kFloorSolrefDamping, // floor geom solref[1], damping ratio
+  kFloorSolimpDmax,    // floor geom solimp[1], impedance at depth (solimp[0] lowered to it if larger)
+  kFloorSolimpWidth,   // floor geom solimp[2], penetration over which impedance goes dmin -> dmax [m]
   kMassScale,          // every body's mass and inertia scaled
   kPayloadMass,        // payload mass [kg] at the payload's position
   kPayloadX,           // payload x offset [m] (torso frame, forward)
@@ -30,6 +34,8 @@ enum class KnobKind {
   kKpScale,            // kp scale of every leg actuator
   kDampingScale,       // joint damping scale of every leg hinge
   kLatency,            // actuation latency [s] (actuators.latency_s)
+  kBacklash,           // gear-train free play of every leg joint [rad] (actuators.backlash_rad)
+  kTrackerNoiseScale,  // factor on the four tracker sd's of config.noise (not the IMU's)
 };
 
 // Confusion-matrix family of a knob (docs/sim2real.md, "report.json verdict").
@@ -37,7 +43,8 @@ struct Knob {
   KnobKind kind;
   int index = -1;            // leg or side for kLegGain / kSideGain
   std::string name;          // e.g. "floor.friction.sliding", "actuators.leg3.gain"
-  std::string family;        // friction, contact, mass, payload, actuator_gain, joint_damping, latency
+  std::string family;        // friction, contact, mass, payload, actuator_gain, joint_damping, latency,
+                             // backlash, tracker_noise
   std::string unit;          // "" for factors
   double nominal = 0;        // value in the nominal config / model
   double lo = 0, hi = 0;     // physical range searched

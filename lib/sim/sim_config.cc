@@ -108,7 +108,9 @@ bool SimConfig::IsValid(std::string* error) const {
                  a.joint_damping_nms_per_rad >= 0,
              "actuators: expected positive kp and torque limit, non-negative damping", error) ||
       !Check(Finite(a.latency_s) && a.latency_s >= 0 && a.latency_s <= 0.2,
-             "actuators.latency_s: expected a value in [0, 0.2] s", error))
+             "actuators.latency_s: expected a value in [0, 0.2] s", error) ||
+      !Check(Finite(a.backlash_rad) && a.backlash_rad >= 0 && a.backlash_rad <= 0.2,
+             "actuators.backlash_rad: expected a value in [0, 0.2] rad", error))
     return false;
   for (int i = 0; i < kNumLegs; ++i) {
     if (!Check(Finite(a.leg_gain[i]) && a.leg_gain[i] > 0 && a.leg_gain[i] <= 10,
@@ -186,6 +188,7 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
     a.Number("joint_damping_nms_per_rad", &c.actuators.joint_damping_nms_per_rad);
     a.Number("torque_limit_nm", &c.actuators.torque_limit_nm);
     a.Number("latency_s", &c.actuators.latency_s);
+    a.Number("backlash_rad", &c.actuators.backlash_rad);
     a.CheckNoUnknownKeys();
   }
   {
@@ -258,7 +261,8 @@ std::string SimConfigToJson(const SimConfig& c) {
                     {"leg_gain", c.actuators.leg_gain},
                     {"joint_damping_nms_per_rad", c.actuators.joint_damping_nms_per_rad},
                     {"torque_limit_nm", c.actuators.torque_limit_nm},
-                    {"latency_s", c.actuators.latency_s}};
+                    {"latency_s", c.actuators.latency_s},
+                    {"backlash_rad", c.actuators.backlash_rad}};
   j["gait"] = {{"period_s", c.gait.period_s},
                {"stride_m", c.gait.stride_m},
                {"turn_rad", c.gait.turn_rad},

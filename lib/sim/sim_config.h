@@ -32,15 +32,17 @@ struct PayloadConfig {
   Eigen::Vector3d position_body_m = Eigen::Vector3d::Zero();  // torso frame: x fwd, y left, z up
 };
 
-// Position servos: torque = kp * leg_gain[i] * (q_target(t - latency) - q) - damping * dq,
-// clamped. Leg i: 0..3 left side front to back, 4..7 right side front to back. The latency is
-// applied in whole integrator steps: round(latency_s / timestep_s) steps.
+// Position servos: torque = kp * leg_gain[i] * db(q_target(t - latency) - q) - damping * dq,
+// clamped, with the backlash dead band db(e) = sign(e) max(0, |e| - backlash_rad / 2) (identity
+// at backlash 0). Leg i: 0..3 left side front to back, 4..7 right side front to back. The latency
+// is applied in whole integrator steps: round(latency_s / timestep_s) steps.
 struct ActuatorConfig {
   double kp_nm_per_rad = 60.0;
   std::array<double, kNumLegs> leg_gain{1, 1, 1, 1, 1, 1, 1, 1};  // kp scale per leg
   double joint_damping_nms_per_rad = 0.5;
   double torque_limit_nm = 12.0;
   double latency_s = 0.0;  // delay between a target's computation and the servo seeing it, [0, 0.2]
+  double backlash_rad = 0.0;  // total free play of each leg joint's gear train, [0, 0.2]
 };
 
 // Periodic alternating-tetrapod gait; a command <long, lat, turn> in [-1, 1]^3 scales the

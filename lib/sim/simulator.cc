@@ -23,6 +23,9 @@ struct Simulator::Impl {
   // the oldest (computed latency_steps steps ago) and is the one the servos see now.
   std::vector<Targets> pending;
   int head = 0;
+  // The targets the servos see now (after the latency); data->ctrl holds them, or with backlash
+  // the dead-banded command q + db(target - q) written before each step.
+  Targets servo{};
 
   Targets JointTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) const {
     Targets q;
@@ -33,6 +36,7 @@ struct Simulator::Impl {
     return q;
   }
   void WriteCtrl(const Targets& q) {
+    servo = q;
     for (int leg = 0; leg < kNumLegs; ++leg) {
       for (int j = 0; j < 3; ++j) data->ctrl[parts.actuator[leg][j]] = q[3 * leg + j];
     }
@@ -65,8 +69,23 @@ struct Simulator::Impl {
     pose.rotation = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(data->xmat + 9 * b);
     return pose;
   }
+  // Backlash b as a dead band of each leg servo: ctrl = q + sign(e) max(0, |e| - b/2), e = q* - q
+  // (MuJoCo's position actuator then applies kp * (ctrl - q)). No-op at b = 0.
+  void ApplyBacklash() {
+    const double half = 0.5 * config.actuators.backlash_rad;
+    if (half <= 0) return;
+    for (int leg = 0; leg < kNumLegs; ++leg) {
+      for (int j = 0; j < 3; ++j) {
+        const int a = parts.actuator[leg][j];
+        const double q = data->qpos[model->jnt_qposadr[model->actuator_trnid[2 * a]]];
+        const double e = servo[3 * leg + j] - q;
+        data->ctrl[a] = q + std::copysign(std::max(0.0, std::abs(e) - half), e);
+      }
+    }
+  }
   // One physics step; false on a MuJoCo warning (bad numbers, full contact buffers).
   bool Step() {
+    ApplyBacklash();
     mj_step(model.get(), data.get());
     time_s += model->opt.timestep;
     bool ok = true;

@@ -3,8 +3,13 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <set>
 
+#include <mujoco/mujoco.h>
+
+#include "sim/mujoco_model.h"
+#include "sim/protocol.h"
 #include "sim/simulator.h"
 
 namespace dgmm::sim {
@@ -29,10 +34,39 @@ TEST(Knobs, BuiltInRobotHasEveryFamilyAndBothSides) {
   }
   EXPECT_EQ(legs, kNumLegs);
   EXPECT_EQ(sides, 2);
-  for (const char* f : {"friction", "contact", "mass", "payload", "actuator_gain", "joint_damping", "latency"}) {
+  for (const char* f : {"friction", "contact", "mass", "payload", "actuator_gain", "joint_damping", "latency",
+                        "backlash", "tracker_noise"}) {
     EXPECT_TRUE(families.count(f)) << f;
   }
-  EXPECT_TRUE(names.count("floor.solref.timeconst"));
+  for (const char* n : {"floor.solref.timeconst", "floor.solimp.dmax", "floor.solimp.width", "actuators.backlash_rad"}) {
+    EXPECT_TRUE(names.count(n)) << n;
+  }
+  EXPECT_EQ(knobs.back().kind, KnobKind::kTrackerNoiseScale);  // appended last
+}
+
+// The solimp knobs start from the compiled model (MuJoCo's default 0.9 0.95 0.001 0.5 2 for the
+// built-in robot's floor); the tracker noise knob exists only when the tracker is noisy.
+TEST(Knobs, NominalsComeFromTheModelAndTheConfig) {
+  SimConfig base;
+  base.actuators.backlash_rad = 0.05;
+  std::vector<Knob> knobs = EnumerateKnobs(base);
+  auto knob = [&](KnobKind kind) {
+    for (const auto& k : knobs) {
+      if (k.kind == kind) return k;
+    }
+    ADD_FAILURE() << "no knob of kind " << static_cast<int>(kind);
+    return Knob{};
+  };
+  EXPECT_DOUBLE_EQ(knob(KnobKind::kFloorSolimpDmax).nominal, 0.95);
+  EXPECT_EQ(knob(KnobKind::kFloorSolimpDmax).probes, std::vector<double>{0.7});
+  EXPECT_DOUBLE_EQ(knob(KnobKind::kFloorSolimpWidth).nominal, 0.001);
+  EXPECT_EQ(knob(KnobKind::kFloorSolimpWidth).probes, std::vector<double>{0.01});
+  EXPECT_DOUBLE_EQ(knob(KnobKind::kBacklash).nominal, 0.05);
+  EXPECT_DOUBLE_EQ(knob(KnobKind::kBacklash).probes.at(0), 0.08);
+  base.noise.tracker_position_sd_m = base.noise.tracker_yaw_sd_rad = 0;
+  base.noise.tracker_roll_sd_rad = base.noise.tracker_pitch_sd_rad = 0;
+  knobs = EnumerateKnobs(base);
+  for (const auto& k : knobs) EXPECT_NE(k.kind, KnobKind::kTrackerNoiseScale);
 }
 
 TEST(Knobs, ConfigKnobsChangeTheConfigModelKnobsMakeAnEdit) {
@@ -50,6 +84,26 @@ TEST(Knobs, ConfigKnobsChangeTheConfigModelKnobsMakeAnEdit) {
   EXPECT_FALSE(static_cast<bool>(edit));
   c = ApplyKnobs(base, knobs, {{find("floor.solref.timeconst"), 0.06}}, &edit);
   EXPECT_TRUE(static_cast<bool>(edit));
+  c = ApplyKnobs(base, knobs, {{find("floor.solimp.dmax"), 0.7}, {find("floor.solimp.width"), 0.01}}, &edit);
+  ASSERT_TRUE(static_cast<bool>(edit));
+  {
+    MjModelPtr model = LoadRobotModel(c);
+    edit(model.get());
+    const int g = mj_name2id(model.get(), mjOBJ_GEOM, "floor");
+    ASSERT_GE(g, 0);
+    EXPECT_DOUBLE_EQ(model->geom_solimp[mjNIMP * g + 0], 0.7);  // dmin 0.9 lowered to dmax
+    EXPECT_DOUBLE_EQ(model->geom_solimp[mjNIMP * g + 1], 0.7);
+    EXPECT_DOUBLE_EQ(model->geom_solimp[mjNIMP * g + 2], 0.01);
+  }
+  c = ApplyKnobs(base, knobs, {{find("actuators.backlash_rad"), 0.04}, {find("tracker.noise_scale"), 2.0}}, &edit);
+  EXPECT_FALSE(static_cast<bool>(edit));
+  EXPECT_DOUBLE_EQ(c.actuators.backlash_rad, 0.04);
+  EXPECT_DOUBLE_EQ(c.noise.tracker_position_sd_m, 2 * base.noise.tracker_position_sd_m);
+  EXPECT_DOUBLE_EQ(c.noise.tracker_yaw_sd_rad, 2 * base.noise.tracker_yaw_sd_rad);
+  EXPECT_DOUBLE_EQ(c.noise.tracker_roll_sd_rad, 2 * base.noise.tracker_roll_sd_rad);
+  EXPECT_DOUBLE_EQ(c.noise.tracker_pitch_sd_rad, 2 * base.noise.tracker_pitch_sd_rad);
+  EXPECT_DOUBLE_EQ(c.noise.imu_pitch_sd_rad, base.noise.imu_pitch_sd_rad);  // the IMU's untouched
+  EXPECT_DOUBLE_EQ(c.noise.imu_roll_sd_rad, base.noise.imu_roll_sd_rad);
   c = ApplyKnobs(base, knobs, {{find("actuators.left_side.gain"), 0.5}}, &edit);
   int halved = 0;
   for (double g : c.actuators.leg_gain) halved += g == 0.5;
@@ -77,6 +131,33 @@ TEST(Knobs, LowFrictionMovesTheRobotDownhill) {
   };
   const double nominal = downhill(1.0), slippery = downhill(0.25);
   EXPECT_GT(slippery, nominal + 0.02);
+}
+
+// Every knob added with the solimp, backlash and tracker noise knobs moves a short protocol at its
+// probe on both shipped robots (the analysis drops a knob whose probe recording is bit-identical
+// to the nominal one as inert).
+TEST(Knobs, NewKnobsChangeAShortProtocolOnTheShippedRobots) {
+  for (const char* config_path : {"datasets/robots/default.json", "datasets/robots/harvestman.json"}) {
+    const SimConfig base = LoadSimConfig(std::string(DGMM_SOURCE_DIR) + "/" + config_path);
+    const std::vector<Knob> knobs = EnumerateKnobs(base);
+    ProtocolOptions options;
+    options.seed = 3;
+    options.placements = 2;
+    options.executions_per_placement = 2;
+    const SampleSet nominal = SimulateWithKnobs(base, options, knobs, {});
+    int tested = 0;
+    for (size_t k = 0; k < knobs.size(); ++k) {
+      const Knob& knob = knobs[k];
+      if (knob.family != "backlash" && knob.family != "tracker_noise" && knob.name.rfind("floor.solimp", 0) != 0) {
+        continue;
+      }
+      const SampleSet probe = SimulateWithKnobs(base, options, knobs, {{static_cast<int>(k), knob.probes.at(0)}});
+      ASSERT_EQ(probe.x.rows(), nominal.x.rows()) << config_path << " " << knob.name;
+      EXPECT_GT((probe.x - nominal.x).cwiseAbs().maxCoeff(), 0) << config_path << " " << knob.name << " is inert";
+      ++tested;
+    }
+    EXPECT_EQ(tested, 4) << config_path;
+  }
 }
 
 }  // namespace

@@ -24,6 +24,7 @@ TEST(SimConfigTest, JsonRoundTripKeepsEveryField) {
   c.payload.position_body_m = Eigen::Vector3d(0.05, -0.1, 0.06);
   c.actuators.leg_gain[3] = 0.4;
   c.actuators.latency_s = 0.03;
+  c.actuators.backlash_rad = 0.05;
   c.noise.imu_roll_sd_rad = 0.02;
   c.mjcf_path = "/tmp/robot.xml";
   c.names.torso_body = "body";
@@ -32,6 +33,7 @@ TEST(SimConfigTest, JsonRoundTripKeepsEveryField) {
   EXPECT_DOUBLE_EQ(back.payload.position_body_m.y(), -0.1);
   EXPECT_DOUBLE_EQ(back.actuators.leg_gain[3], 0.4);
   EXPECT_DOUBLE_EQ(back.actuators.latency_s, 0.03);
+  EXPECT_DOUBLE_EQ(back.actuators.backlash_rad, 0.05);
   EXPECT_EQ(back.names.torso_body, "body");
 }
 
@@ -56,6 +58,8 @@ TEST(SimConfigTest, RejectsBadInputNamingTheField) {
       {R"({"masses": {"torso_kg": -1}})", "masses"},
       {R"({"actuators": {"latency_s": 0.3}})", "actuators.latency_s"},
       {R"({"actuators": {"latency_s": -0.01}})", "actuators.latency_s"},
+      {R"({"actuators": {"backlash_rad": 0.25}})", "actuators.backlash_rad"},
+      {R"({"actuators": {"backlash_rad": -0.01}})", "actuators.backlash_rad"},
       {R"({"command_duration_s": 1.2})", "command_duration_s"},
       {R"({"timestep_s": 0})", "timestep_s"},
       {R"([1, 2])", "object"},

@@ -148,6 +148,40 @@ TEST_F(SimulatorTest, LatencyDelaysServoTargets) {
   EXPECT_GT(max_diff_at_once, kVisibleM);
 }
 
+// At backlash 0 the servo path is the one before backlash existed: the torso pose after one
+// command equals, bit for bit, the one recorded with this repository's Release build (g++,
+// x86-64, MuJoCo 2.2.2) at commit 32e2dee. Another compiler or CPU may round differently: then
+// record the values anew from a build without backlash.
+TEST_F(SimulatorTest, ZeroBacklashIsTheServoOfBefore) {
+  Simulator sim{SimConfig{}};
+  ASSERT_EQ(sim.Place(0, 0, 1.0), RunOutcome::kCompleted);
+  ASSERT_EQ(sim.RunCommand(Eigen::Vector3d(0.5, 0.5, 0.5)), RunOutcome::kCompleted);
+  const Pose p = sim.TorsoPose();
+  EXPECT_EQ(p.position_m.x(), -0.35399083378912838);
+  EXPECT_EQ(p.position_m.y(), 0.44859693711589521);
+  EXPECT_EQ(p.position_m.z(), 0.13766839026861391);
+  EXPECT_EQ(p.rotation(0, 1), -0.98613834908719633);
+}
+
+// Backlash b is a dead band of +-b/2 around each servo target: the joints stop short of their
+// targets under load, so the torso stands lower and walks a visibly different path; the same
+// config still gives the same trajectory.
+TEST_F(SimulatorTest, BacklashChangesTheMotionDeterministically) {
+  SimConfig loose = Flat();
+  loose.actuators.backlash_rad = 0.1;
+  Simulator a(loose), b(loose), tight(Flat());
+  const Eigen::Vector3d command(0.5, 0, 0.3);
+  ASSERT_EQ(tight.Place(0, 0, 0), RunOutcome::kCompleted);
+  const double tight_z = tight.TorsoPose().position_m.z();
+  ASSERT_EQ(a.Place(0, 0, 0), RunOutcome::kCompleted);
+  const double loose_z = a.TorsoPose().position_m.z();
+  const Vec6 with = RunOnce(a, command), again = RunOnce(b, command), without = RunOnce(tight, command);
+  EXPECT_EQ(with, again);
+  const double kVisible = 0.005;  // m and rad: well above rounding, below the gait's own scale
+  EXPECT_GT((with - without).cwiseAbs().maxCoeff(), kVisible) << (with - without).transpose();
+  EXPECT_LT(loose_z, tight_z) << "the joints give way by up to b/2 under the robot's weight";
+}
+
 TEST_F(SimulatorTest, TippingOverIsReportedAsAFall) {
   SimConfig c;
   c.slope_deg = 30;
