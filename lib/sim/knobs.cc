@@ -35,6 +35,21 @@ Knob MakeKnob(KnobKind kind, int index, std::string name, std::string family, st
   return k;
 }
 
+// Largest |x| and |y| of the leg roots (the torso's children carrying the leg actuators) in the
+// torso frame; one falls back on the other when it is under 1 cm (legs in one line).
+Eigen::Vector2d LegRootSpan(const mjModel* m, const RobotParts& parts) {
+  Eigen::Vector2d span = Eigen::Vector2d::Zero();
+  for (int leg = 0; leg < kNumLegs; ++leg) {
+    const int joint = m->actuator_trnid[2 * parts.actuator[leg][0]];
+    const int root = TorsoChildOf(m, m->jnt_bodyid[joint], parts.torso_body);
+    if (root < 0) continue;
+    span = span.cwiseMax(Eigen::Vector2d(std::abs(m->body_pos[3 * root]), std::abs(m->body_pos[3 * root + 1])));
+  }
+  if (span.x() < 0.01) span.x() = span.y();
+  if (span.y() < 0.01) span.y() = span.x();
+  return span.cwiseMax(0.01);
+}
+
 }  // namespace
 
 std::string RobotMjcfText(const SimConfig& config) {
@@ -89,10 +104,14 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
     const double m0 = PayloadProbeMass(config);
     knobs.push_back(MakeKnob(KnobKind::kPayloadMass, -1, "payload.mass_kg", "payload", "kg",
                              config.payload.mass_kg, 0.0, 4 * m0, {config.payload.mass_kg + m0}));
+    // Offsets relative to the robot's size: the leg roots' largest |x| and |y| in the torso frame
+    // (the built-in robot's 0.225 and 0.15 m give probes of 0.1 m and a range of +-0.3 m).
+    const Eigen::Vector2d span = LegRootSpan(m, parts);
     knobs.push_back(MakeKnob(KnobKind::kPayloadX, -1, "payload.position_x_m", "payload", "m",
-                             config.payload.position_body_m.x(), -0.3, 0.3, {0.1}));
+                             config.payload.position_body_m.x(), -4.0 / 3 * span.x(), 4.0 / 3 * span.x(),
+                             {4.0 / 9 * span.x()}));
     knobs.push_back(MakeKnob(KnobKind::kPayloadY, -1, "payload.position_y_m", "payload", "m",
-                             config.payload.position_body_m.y(), -0.3, 0.3, {0.1}));
+                             config.payload.position_body_m.y(), -2 * span.y(), 2 * span.y(), {2.0 / 3 * span.y()}));
   }
   // Legs: the torso's child subtrees that carry the leg actuators; the side from the root's y.
   bool side_has[2] = {false, false};

@@ -136,6 +136,29 @@ TEST(Knobs, LowFrictionMovesTheRobotDownhill) {
 // Every knob added with the solimp, backlash and tracker noise knobs moves a short protocol at its
 // probe on both shipped robots (the analysis drops a knob whose probe recording is bit-identical
 // to the nominal one as inert).
+// The payload's offsets scale with the robot: the built-in robot's leg roots reach 0.225 m
+// forward and 0.15 m sideways (probes 0.1 m, range +-0.3 m); the harvestman's 0.18 and 0.12 m.
+TEST(Knobs, PayloadOffsetsScaleWithTheLegRootSpan) {
+  auto payload = [](const SimConfig& c, KnobKind kind) {
+    for (const Knob& k : EnumerateKnobs(c)) {
+      if (k.kind == kind) return k;
+    }
+    return Knob{};
+  };
+  const SimConfig builtin;
+  const SimConfig harvestman = LoadSimConfig(std::string(DGMM_SOURCE_DIR) + "/datasets/robots/harvestman.json");
+  const Knob x0 = payload(builtin, KnobKind::kPayloadX), y0 = payload(builtin, KnobKind::kPayloadY);
+  const Knob x1 = payload(harvestman, KnobKind::kPayloadX), y1 = payload(harvestman, KnobKind::kPayloadY);
+  ASSERT_EQ(x0.probes.size(), 1u);
+  EXPECT_NEAR(x0.probes[0], 0.1, 1e-12);
+  EXPECT_NEAR(y0.probes[0], 0.1, 1e-12);
+  EXPECT_NEAR(x0.hi, 0.3, 1e-12);
+  EXPECT_NEAR(y0.lo, -0.3, 1e-12);
+  EXPECT_NEAR(x1.probes[0], 0.1 * 0.18 / 0.225, 1e-12);
+  EXPECT_NEAR(y1.probes[0], 0.1 * 0.12 / 0.15, 1e-12);
+  EXPECT_NEAR(x1.hi, 0.3 * 0.18 / 0.225, 1e-12);
+}
+
 TEST(Knobs, NewKnobsChangeAShortProtocolOnTheShippedRobots) {
   for (const char* config_path : {"datasets/robots/default.json", "datasets/robots/harvestman.json"}) {
     const SimConfig base = LoadSimConfig(std::string(DGMM_SOURCE_DIR) + "/" + config_path);
