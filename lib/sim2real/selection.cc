@@ -77,6 +77,19 @@ std::vector<int> MakeFolds(const FitProblem& fp, const std::vector<int>& rows, i
   return fold;
 }
 
+FoldSplit SplitFold(const std::vector<int>& rows, const std::vector<int>& fold, int f) {
+  FoldSplit split;
+  for (size_t k = 0; k < rows.size(); ++k) {
+    if (fold[k] == f) {
+      split.test.push_back(rows[k]);
+      split.test_pos.push_back(static_cast<int>(k));
+    } else {
+      split.train.push_back(rows[k]);
+    }
+  }
+  return split;
+}
+
 Eigen::VectorXd CrossValidate(const FitProblem& fp, const std::vector<int>& effects,
                               const std::vector<int>& rows, const std::vector<int>& fold,
                               const EffectFitOptions& options) {
@@ -84,19 +97,11 @@ Eigen::VectorXd CrossValidate(const FitProblem& fp, const std::vector<int>& effe
   const int folds = fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1;
   if (effects.empty()) return CorrectedLogLikelihood(fp, EffectFit{}, rows);
   for (int f = 0; f < folds; ++f) {
-    std::vector<int> train, test, test_pos;
-    for (size_t k = 0; k < rows.size(); ++k) {
-      if (fold[k] == f) {
-        test.push_back(rows[k]);
-        test_pos.push_back(static_cast<int>(k));
-      } else {
-        train.push_back(rows[k]);
-      }
-    }
-    if (test.empty() || train.empty()) continue;
-    EffectFit fit = FitEffects(fp, effects, train, options);
-    Eigen::VectorXd t = CorrectedLogLikelihood(fp, fit, test);
-    for (size_t k = 0; k < test.size(); ++k) ll(test_pos[k]) = t(k);
+    const FoldSplit split = SplitFold(rows, fold, f);
+    if (split.test.empty() || split.train.empty()) continue;
+    EffectFit fit = FitEffects(fp, effects, split.train, options);
+    Eigen::VectorXd t = CorrectedLogLikelihood(fp, fit, split.test);
+    for (size_t k = 0; k < split.test.size(); ++k) ll(split.test_pos[k]) = t(k);
   }
   return ll;
 }

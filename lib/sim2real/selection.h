@@ -34,6 +34,12 @@ struct SelectionOptions {
 std::vector<int> MakeFolds(const FitProblem& problem, const std::vector<int>& rows, int folds,
                            std::mt19937_64& rng);
 
+// The rows of fold f held out (`test`, and their positions in `rows`) and the rest (`train`).
+struct FoldSplit {
+  std::vector<int> train, test, test_pos;
+};
+FoldSplit SplitFold(const std::vector<int>& rows, const std::vector<int>& fold, int f);
+
 // Held-out log-likelihood per entry of `rows` of the corrected model with `effects`.
 Eigen::VectorXd CrossValidate(const FitProblem& problem, const std::vector<int>& effects,
                               const std::vector<int>& rows, const std::vector<int>& fold,

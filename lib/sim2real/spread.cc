@@ -86,18 +86,14 @@ SpreadTest TestTrackerSpread(const SpreadProblem& sp, const std::vector<int>& ef
   Eigen::VectorXd diff = Eigen::VectorXd::Zero(rows.size());
   const int folds = fold.empty() ? 0 : *std::max_element(fold.begin(), fold.end()) + 1;
   for (int f = 0; f < folds; ++f) {
-    std::vector<int> train, test, test_pos;
-    for (size_t q = 0; q < rows.size(); ++q) {
-      if (fold[q] == f) test.push_back(rows[q]), test_pos.push_back(static_cast<int>(q));
-      else train.push_back(rows[q]);
-    }
-    if (test.empty() || train.empty()) continue;
-    const EffectFit fit = fit_on(train);
+    const FoldSplit split = SplitFold(rows, fold, f);
+    if (split.test.empty() || split.train.empty()) continue;
+    const EffectFit fit = fit_on(split.train);
     const Eigen::VectorXd k = KnobSpread(sp, fit, options);
-    const double a = FitTrackerCoefficient(sp, fit, k, sp.tracker, train);
-    const Eigen::VectorXd d = SpreadLogLikelihood(sp, fit, k + a * sp.tracker, test) -
-                              SpreadLogLikelihood(sp, fit, k, test);
-    for (size_t q = 0; q < test.size(); ++q) diff(test_pos[q]) = d(q);
+    const double a = FitTrackerCoefficient(sp, fit, k, sp.tracker, split.train);
+    const Eigen::VectorXd d = SpreadLogLikelihood(sp, fit, k + a * sp.tracker, split.test) -
+                              SpreadLogLikelihood(sp, fit, k, split.test);
+    for (size_t q = 0; q < split.test.size(); ++q) diff(split.test_pos[q]) = d(q);
   }
   std::vector<int> cluster;
   for (int r : rows) cluster.push_back(fp.episode[r]);
