@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <map>
 #include <random>
@@ -42,6 +43,10 @@ double NextRefineValue(const std::vector<std::pair<double, double>>& trace, doub
   return std::clamp(next, lo, hi);
 }
 
+// One more simulation at the given knob values (cached like the signatures), as its paired shift
+// from the nominal run.
+using Resimulate = std::function<PairedShift(const std::vector<KnobValue>&)>;
+
 // Step 5c of AnalyseKnobs (spread.h): tests the tracker noise beyond the selected knobs' own
 // simulated spread change, and when it is needed refines its scale s by re-simulation until the
 // simulated tracker's coefficient is about 1. Fills out->spread and the refinement trace; returns
@@ -50,9 +55,8 @@ double TrackerSpreadStage(const FitProblem& problem, const Samples& real, const 
                           const std::vector<ExternalCandidate>& externals, const std::vector<int>& selected,
                           const std::vector<SelectionStep>& steps, int noise_k, const std::vector<int>& rows, const std::vector<int>& fold,
                           const std::vector<Knob>& knobs, std::pair<int, double> probe, int probe_shift,
-                          const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                          const SampleSet& nominal_set, const SampleSet& sim_set, const KnobAnalysisOptions& options,
-                          std::vector<PairedShift>* shifts, KnobAnalysis* out) {
+                          const std::vector<PairedShift>& shifts, const Resimulate& resimulate,
+                          const KnobAnalysisOptions& options, KnobAnalysis* out) {
   const Knob& knob = knobs[probe.first];
   SpreadProblem sp;
   sp.fit = &problem;
@@ -62,7 +66,7 @@ double TrackerSpreadStage(const FitProblem& problem, const Samples& real, const 
   sp.log_var.assign(problem.library.size(), Eigen::VectorXd());
   for (size_t k = 0; k < problem.library.size(); ++k) {
     if (out->candidates[k].physical && !externals[k].shifts.empty()) {
-      sp.log_var[k] = (*shifts)[externals[k].shifts[0]].log_variance_ratio();
+      sp.log_var[k] = shifts[externals[k].shifts[0]].log_variance_ratio();
     }
   }
   // T and the range of a = (s^2 - 1) / (s_sig^2 - 1) for a tracker signature simulated at s_sig.
@@ -72,7 +76,7 @@ double TrackerSpreadStage(const FitProblem& problem, const Samples& real, const 
     sp.a_lo = std::min((knob.lo * knob.lo - 1) / den, (knob.hi * knob.hi - 1) / den);
     sp.a_hi = std::max((knob.lo * knob.lo - 1) / den, (knob.hi * knob.hi - 1) / den);
   };
-  set_signature((*shifts)[probe_shift], probe.second);
+  set_signature(shifts[probe_shift], probe.second);
   std::vector<int> mean;
   for (int e : selected) {
     if (e != noise_k) mean.push_back(e);
@@ -94,10 +98,7 @@ double TrackerSpreadStage(const FitProblem& problem, const Samples& real, const 
   for (int it = 0; it < options.refine_iterations && std::abs(best_a - 1) >= 0.1; ++it) {
     const double s = std::clamp(scale_at(s_sig, a), knob.lo, knob.hi);
     if (std::abs(s * s - 1) < 0.05) break;  // no tracker signature can be simulated that close to nominal
-    SimulationBatch one = SimulateBatch(config, protocol, seed, knobs, {{{KnobValue{probe.first, s}}}}, options.signatures);
-    out->simulations += one.simulated;
-    out->from_cache += one.from_cache;
-    set_signature(PairedShift::Fit(nominal_set, one.sets[0], sim_set, options.signatures.slope_ridge), s);
+    set_signature(resimulate({KnobValue{probe.first, s}}), s);
     s_sig = s;
     a = FitTrackerCoefficient(sp, fit, k, sp.tracker, rows);
     out->refine_trace.push_back({knob.name, s_sig, a});
@@ -182,6 +183,12 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
   out.signature_seconds = batch.wall_seconds;
   out.placements = options.signatures.placements;
   out.cache_dir = options.signatures.cache_dir.empty() ? DefaultCacheDir() : options.signatures.cache_dir;
+  const Resimulate resimulate = [&](const std::vector<KnobValue>& values) {
+    SimulationBatch one = SimulateBatch(config, protocol, seed, knobs, {SimulationRequest{values}}, options.signatures);
+    out.simulations += one.simulated;
+    out.from_cache += one.from_cache;
+    return PairedShift::Fit(batch.sets[0], one.sets[0], sim_set, options.signatures.slope_ridge);
+  };
   std::vector<PairedShift> shifts;
   for (size_t r = 1; r < requests.size(); ++r) {
     shifts.push_back(PairedShift::Fit(batch.sets[0], batch.sets[r], sim_set, options.signatures.slope_ridge));
@@ -377,10 +384,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
     FitProblem trial = problem;
     for (int it = 0; it < options.refine_iterations && best_err >= 0.1; ++it) {
       if (std::abs(value - c.nominal) < 1e-9 * (1 + std::abs(c.nominal))) break;
-      SimulationBatch one = SimulateBatch(config, protocol, seed, knobs, {{{KnobValue{knob, value}}}}, options.signatures);
-      out.simulations += one.simulated;
-      out.from_cache += one.from_cache;
-      shifts.push_back(PairedShift::Fit(batch.sets[0], one.sets[0], sim_set, options.signatures.slope_ridge));
+      shifts.push_back(resimulate({KnobValue{knob, value}}));
       externals[top].shifts = {static_cast<int>(shifts.size()) - 1};
       fill_design(&trial, top);
       const double a = FitEffects(trial, sel.selected, {}, options.selection.fit).theta[pos](0);
@@ -427,12 +431,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
       FitProblem trial = problem;
       for (int it = 0; it < options.refine_iterations && best_err >= 0.1; ++it) {
         if (std::abs(mass - c.nominal) < 1e-9 * (1 + std::abs(c.nominal))) break;
-        SimulationBatch one = SimulateBatch(config, protocol, seed, knobs,
-                                            {{{KnobValue{mass_knob, mass}, KnobValue{x_knob, px}, KnobValue{y_knob, py}}}},
-                                            options.signatures);
-        out.simulations += one.simulated;
-        out.from_cache += one.from_cache;
-        shifts.push_back(PairedShift::Fit(batch.sets[0], one.sets[0], sim_set, options.signatures.slope_ridge));
+        shifts.push_back(resimulate({KnobValue{mass_knob, mass}, KnobValue{x_knob, px}, KnobValue{y_knob, py}}));
         externals[pay].shifts = {static_cast<int>(shifts.size()) - 1, probes[0], probes[1], probes[2]};
         fill_design(&trial, pay);
         const double a = FitEffects(trial, sel.selected, {}, options.selection.fit).theta[pos](0);
@@ -460,8 +459,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
                                        out.candidates.begin());
   if (tracker_shift >= 0 && std::find(sel.selected.begin(), sel.selected.end(), noise_k) != sel.selected.end()) {
     out.tracker_scale = TrackerSpreadStage(problem, real, model, externals, sel.selected, sel.steps, noise_k, rows, fold,
-                                           knobs, probe_of[tracker_shift], tracker_shift, config, protocol, seed,
-                                           batch.sets[0], sim_set, options, &shifts, &out);
+                                           knobs, probe_of[tracker_shift], tracker_shift, shifts, resimulate, options, &out);
   }
   out.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_start).count();
   std::vector<double> inclusion(library.size(), -1.0);
