@@ -75,6 +75,7 @@ FitProblem MakeFitProblem(const Samples& real, const LinearGaussianModel& sim_mo
     auto l = p.chol.triangularView<Eigen::Lower>();
     fp.r0.row(i) = l.solve(real.x.row(i).transpose() - p.mean).transpose();
     fp.log_norm(i) = -0.5 * (fp.dx * std::log(2 * std::numbers::pi) + p.log_det);
+    fp.chol.push_back(p.chol);
     for (size_t k = 0; k < library.size(); ++k) {
       if (library[k].is_noise) continue;
       Eigen::MatrixXd d = EffectDesign(library[k], layout, p.mean, real.gravity.row(i).transpose(),

@@ -19,6 +19,7 @@ struct FitProblem {
   std::vector<EffectSpec> library;
   Eigen::MatrixXd r0;               // n x dx whitened residuals under the sim model
   Eigen::VectorXd log_norm;         // n: -1/2 (dx log 2 pi + log det Sigma_i)
+  std::vector<Eigen::MatrixXd> chol;  // n: lower Cholesky factor L_i of Sigma_i (dx x dx)
   std::vector<Eigen::MatrixXd> g;   // per library effect: (n dx) x p_e whitened designs
   std::vector<Eigen::MatrixXd> d;   // per library effect: (n dx) x p_e raw mean-shift designs
   std::vector<int> episode;         // for grouped folds and the bootstrap

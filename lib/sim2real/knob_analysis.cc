@@ -51,8 +51,7 @@ using Resimulate = std::function<PairedShift(const std::vector<KnobValue>&)>;
 // simulated spread change, and when it is needed refines its scale s by re-simulation until the
 // simulated tracker's coefficient is about 1. Fills out->spread and the refinement trace; returns
 // s (NaN when the tracker noise is not needed).
-double TrackerSpreadStage(const FitProblem& problem, const Samples& real, const LinearGaussianModel& model,
-                          const std::vector<ExternalCandidate>& externals, const std::vector<int>& selected,
+double TrackerSpreadStage(const FitProblem& problem, const std::vector<ExternalCandidate>& externals, const std::vector<int>& selected,
                           const std::vector<SelectionStep>& steps, int noise_k, const std::vector<int>& rows, const std::vector<int>& fold,
                           const std::vector<Knob>& knobs, std::pair<int, double> probe, int probe_shift,
                           const std::vector<PairedShift>& shifts, const Resimulate& resimulate,
@@ -60,9 +59,6 @@ double TrackerSpreadStage(const FitProblem& problem, const Samples& real, const 
   const Knob& knob = knobs[probe.first];
   SpreadProblem sp;
   sp.fit = &problem;
-  for (int i = 0; i < real.size(); ++i) {
-    sp.chol.push_back(model.Predict(real.command[i], real.z.row(i).transpose(), real.first_execution[i]).chol);
-  }
   sp.log_var.assign(problem.library.size(), Eigen::VectorXd());
   for (size_t k = 0; k < problem.library.size(); ++k) {
     if (out->candidates[k].physical && !externals[k].shifts.empty()) {
@@ -331,11 +327,10 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
   FitProblem problem = MakeFitProblem(real, model, library, layout);
   auto fill_design = [&](FitProblem* fp, int k) {
     for (int i = 0; i < real.size(); ++i) {
-      const Prediction p = model.Predict(real.command[i], real.z.row(i).transpose(), real.first_execution[i]);
       const Eigen::MatrixXd d = ExternalDesign(externals[k], shifts, model, layout, dx, real.command[i],
                                                real.z.row(i).transpose(), real.first_execution[i]);
       fp->d[k].middleRows(i * dx, dx) = d;
-      fp->g[k].middleRows(i * dx, dx) = p.chol.triangularView<Eigen::Lower>().solve(d);
+      fp->g[k].middleRows(i * dx, dx) = fp->chol[i].triangularView<Eigen::Lower>().solve(d);
     }
   };
   for (size_t k = 0; k < library.size(); ++k) {
@@ -458,7 +453,7 @@ KnobAnalysis AnalyseKnobs(const SampleSet& sim_in, const SampleSet& real_in, con
                                                     [](const KnobCandidate& c) { return c.key == "tracker_noise"; }) -
                                        out.candidates.begin());
   if (tracker_shift >= 0 && std::find(sel.selected.begin(), sel.selected.end(), noise_k) != sel.selected.end()) {
-    out.tracker_scale = TrackerSpreadStage(problem, real, model, externals, sel.selected, sel.steps, noise_k, rows, fold,
+    out.tracker_scale = TrackerSpreadStage(problem, externals, sel.selected, sel.steps, noise_k, rows, fold,
                                            knobs, probe_of[tracker_shift], tracker_shift, shifts, resimulate, options, &out);
   }
   out.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - refine_start).count();

@@ -26,12 +26,11 @@ Eigen::VectorXd KnobSpread(const SpreadProblem& sp, const EffectFit& fit, const 
   return log_k.cwiseMax(-options.max_log_ratio).cwiseMin(options.max_log_ratio).array().exp();
 }
 
-Eigen::VectorXd SpreadLogLikelihood(const SpreadProblem& sp, const EffectFit& fit, const Eigen::VectorXd& rho,
-                                    const std::vector<int>& rows) {
-  const FitProblem& fp = *sp.fit;
-  const Eigen::VectorXd inv_sd = rho.cwiseMax(1e-12).cwiseSqrt().cwiseInverse();
-  const double log_det = rho.cwiseMax(1e-12).array().log().sum();
-  Eigen::VectorXd ll(rows.size());
+namespace {
+
+// Raw residuals x_i - mean_i = L_i w_i (dx x rows) after the mean effects of `fit`.
+Eigen::MatrixXd RawResiduals(const FitProblem& fp, const EffectFit& fit, const std::vector<int>& rows) {
+  Eigen::MatrixXd raw(fp.dx, rows.size());
   for (size_t k = 0; k < rows.size(); ++k) {
     const int i = rows[k];
     Eigen::VectorXd w = fp.r0.row(i).transpose();
@@ -39,11 +38,30 @@ Eigen::VectorXd SpreadLogLikelihood(const SpreadProblem& sp, const EffectFit& fi
       if (fp.library[fit.effects[j]].is_noise) continue;
       w -= fp.g[fit.effects[j]].middleRows(i * fp.dx, fp.dx) * fit.theta[j];
     }
-    const auto l = sp.chol[i].triangularView<Eigen::Lower>();
-    const Eigen::VectorXd u = (sp.chol[i] * w).cwiseProduct(inv_sd);  // S^-1 (x - mean)
-    ll(k) = fp.log_norm(i) - 0.5 * log_det - 0.5 * l.solve(u).squaredNorm();
+    raw.col(k) = fp.chol[i] * w;
+  }
+  return raw;
+}
+
+// log p of those residuals under S Sigma_i S, S = diag(sqrt(rho)).
+Eigen::VectorXd ResidualLogLikelihood(const FitProblem& fp, const Eigen::MatrixXd& raw, const std::vector<int>& rows,
+                                      const Eigen::VectorXd& rho) {
+  const Eigen::VectorXd inv_sd = rho.cwiseMax(1e-12).cwiseSqrt().cwiseInverse();
+  const double log_det = rho.cwiseMax(1e-12).array().log().sum();
+  Eigen::VectorXd ll(rows.size());
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const int i = rows[k];
+    const Eigen::VectorXd u = raw.col(k).cwiseProduct(inv_sd);  // S^-1 (x - mean)
+    ll(k) = fp.log_norm(i) - 0.5 * log_det - 0.5 * fp.chol[i].triangularView<Eigen::Lower>().solve(u).squaredNorm();
   }
   return ll;
+}
+
+}  // namespace
+
+Eigen::VectorXd SpreadLogLikelihood(const SpreadProblem& sp, const EffectFit& fit, const Eigen::VectorXd& rho,
+                                    const std::vector<int>& rows) {
+  return ResidualLogLikelihood(*sp.fit, RawResiduals(*sp.fit, fit, rows), rows, rho);
 }
 
 double FitTrackerCoefficient(const SpreadProblem& sp, const EffectFit& fit, const Eigen::VectorXd& k,
@@ -54,7 +72,8 @@ double FitTrackerCoefficient(const SpreadProblem& sp, const EffectFit& fit, cons
     if (t(d) > 0) lo = std::max(lo, -0.99 * k(d) / t(d));
   }
   if (!(lo < hi)) return std::clamp(0.0, sp.a_lo, sp.a_hi);
-  auto cost = [&](double a) { return -SpreadLogLikelihood(sp, fit, k + a * t, rows).sum(); };
+  const Eigen::MatrixXd raw = RawResiduals(*sp.fit, fit, rows);  // independent of a
+  auto cost = [&](double a) { return -ResidualLogLikelihood(*sp.fit, raw, rows, k + a * t).sum(); };
   // Golden section (the likelihood is unimodal in a for a per-axis scale).
   const double g = (std::sqrt(5.0) - 1) / 2;
   double a = lo, b = hi, c = b - g * (b - a), d = a + g * (b - a);

@@ -23,10 +23,9 @@ struct SpreadOptions {
   bool IsValid(std::string* error) const;
 };
 
-// Everything but the effects: the sim model's lower Cholesky factor L_i (dx x dx) per real row.
+// Everything but the effects (the rows' Cholesky factors L_i come with the FitProblem).
 struct SpreadProblem {
   const FitProblem* fit = nullptr;
-  std::vector<Eigen::MatrixXd> chol;
   std::vector<Eigen::VectorXd> log_var;  // per library effect: v (dx), empty when it has none
   Eigen::VectorXd tracker;               // T (dx); empty: no tracker-noise knob
   double a_lo = -1, a_hi = 1;            // the tracker knob's range in a

@@ -46,7 +46,7 @@ Case MakeCase(const Eigen::Vector3d& rho, double theta, std::uint64_t seed, int 
     fp.r0.row(i) = l.triangularView<Eigen::Lower>().solve(raw).transpose();
     fp.episode.push_back(i / 10);
     fp.command.push_back((i / 10) % 4);
-    c.sp.chol.push_back(l);
+    fp.chol.push_back(l);
   }
   fp.d = {d};
   fp.g = {g};
