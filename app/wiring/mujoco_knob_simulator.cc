@@ -1,0 +1,123 @@
+#include "app/wiring/mujoco_knob_simulator.h"
+
+#include <cmath>
+#include <cstdio>
+
+#include "sim/protocol.h"
+#include "sim/simulator.h"
+#include "util/error.h"
+
+namespace dgmm::app {
+namespace {
+
+// Bump when a change of lib/sim changes what a recording at the same inputs contains.
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v1";
+
+std::uint64_t Fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
+  for (unsigned char c : s) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  return h;
+}
+
+sim2real::Knob::Role RoleOf(sim::KnobKind kind) {
+  switch (kind) {
+    case sim::KnobKind::kPayloadMass: return sim2real::Knob::Role::kPayloadMass;
+    case sim::KnobKind::kPayloadX: return sim2real::Knob::Role::kPayloadX;
+    case sim::KnobKind::kPayloadY: return sim2real::Knob::Role::kPayloadY;
+    case sim::KnobKind::kTrackerNoiseScale: return sim2real::Knob::Role::kSpread;
+    default: return sim2real::Knob::Role::kShift;
+  }
+}
+
+sim2real::Knob FromSim(const sim::Knob& k) {
+  sim2real::Knob out;
+  out.name = k.name;
+  out.family = k.family;
+  out.unit = k.unit;
+  out.role = RoleOf(k.kind);
+  out.nominal = k.nominal;
+  out.lo = k.lo;
+  out.hi = k.hi;
+  out.probes = k.probes;
+  // Offsets may have either sign; every other knob is a non-negative physical quantity.
+  const bool offset = k.kind == sim::KnobKind::kPayloadX || k.kind == sim::KnobKind::kPayloadY;
+  if (!offset) out.physical_min = 0;
+  if (k.kind == sim::KnobKind::kLegGain) out.leg = "leg" + std::to_string(k.index);
+  if (k.kind == sim::KnobKind::kSideGain) out.side = k.index == 0 ? "left" : "right";
+  return out;
+}
+
+}  // namespace
+
+MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_(config) {
+  sim_knobs_ = sim::EnumerateKnobs(config_);
+  for (const auto& k : sim_knobs_) knobs_.push_back(FromSim(k));
+  sim::SimConfig keyed = config_;
+  keyed.mjcf_path.clear();  // moving the robot's folder must not change the key
+  const std::string text = std::string(kSimulatorCodeVersion) + "\n" + sim::RobotMjcfText(config_) + "\n" +
+                           sim::SimConfigToJson(keyed);
+  char hex[33];
+  std::snprintf(hex, sizeof hex, "%016llx%016llx", static_cast<unsigned long long>(Fnv1a(text)),
+                static_cast<unsigned long long>(Fnv1a(text, 0x9e3779b97f4a7c15ull)));
+  fingerprint_ = hex;
+  const sim::Simulator robot(config_);
+  total_mass_kg_ = robot.total_mass_kg();
+  for (const auto& leg : robot.legs()) {
+    leg_reach_m_ = std::max(leg_reach_m_, leg.coxa_out_m + leg.femur_m + leg.tibia_m);
+  }
+}
+
+std::vector<sim::KnobValue> MujocoKnobSimulator::ToSim(const std::vector<sim2real::KnobValue>& values) const {
+  std::vector<sim::KnobValue> out;
+  for (const auto& v : values) {
+    if (v.knob < 0 || v.knob >= static_cast<int>(sim_knobs_.size())) {
+      throw MakeInputError("simulator", "knob", "index " + std::to_string(v.knob) + " out of range");
+    }
+    out.push_back({v.knob, v.value});
+  }
+  return out;
+}
+
+SampleSet MujocoKnobSimulator::Record(const sim2real::Recording& recording,
+                                      const std::vector<sim2real::KnobValue>& values, int /*threads*/) const {
+  sim::ProtocolOptions options;
+  options.protocol = sim::ParseProtocol(recording.protocol);
+  options.seed = recording.seed;
+  options.placements = recording.placements;
+  return sim::SimulateWithKnobs(config_, options, sim_knobs_, ToSim(values));
+}
+
+sim2real::CellRecording MujocoKnobSimulator::RecordCell(const sim2real::Cell& cell,
+                                                        const std::vector<sim2real::KnobValue>& values) const {
+  if (cell.command.size() != 3) {
+    throw MakeInputError("experiment cell", "command", "expected (long, lat, turn)");
+  }
+  if (cell.terrain.size() != 2) {
+    throw MakeInputError("experiment cell", "terrain", "expected (pitch, roll)");
+  }
+  sim2real::CellRecording out;
+  const double heading = sim::HeadingForTerrain(config_, cell.terrain(0), cell.terrain(1));
+  out.heading_deg = heading * 180.0 / M_PI;
+  char where[96];
+  std::snprintf(where, sizeof where, "heading %.0f deg on the %.3g deg slope", out.heading_deg, config_.slope_deg);
+  out.placement = where;
+  sim::CellOptions options;
+  options.command = cell.command;
+  options.heading_rad = heading;
+  options.placements = cell.placements;
+  options.executions_per_placement = cell.executions_per_placement;
+  options.seed = cell.seed;
+  sim::ModelEdit edit;
+  const sim::SimConfig c = sim::ApplyKnobs(config_, sim_knobs_, ToSim(values), &edit);
+  out.set = sim::SimulateCell(c, options, nullptr, edit);
+  return out;
+}
+
+std::string MujocoKnobSimulator::ConfigJson(const std::vector<sim2real::KnobValue>& values) const {
+  sim::ModelEdit edit;  // knobs that edit the compiled model are not in the config (yet)
+  return sim::SimConfigToJson(sim::ApplyKnobs(config_, sim_knobs_, ToSim(values), &edit));
+}
+
+}  // namespace dgmm::app
