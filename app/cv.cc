@@ -22,7 +22,8 @@ namespace {
 struct CvArgs {
   std::string path;
   double k = 0.7;
-  int folds = 10;
+  int folds = 0;  // 0: chosen from the data (unless --folds was given)
+  bool folds_given = false;
   int repeats = 10;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -32,6 +33,7 @@ struct CvArgs {
   int em_n_init = 3;
   DgmmFlags dgmm;
   bool stratified = false;
+  bool with_terrain = false, without_terrain = false;
   std::vector<std::string> pose_dims, terrain_dims;
   bool json = false;
 };
@@ -49,18 +51,28 @@ void RunCv(const CvArgs& args) {
   if (!(args.k > 0) || !std::isfinite(args.k)) {
     throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
   }
-  if (args.folds < 2) throw MakeInputError("", "--folds", "must be >= 2");
+  if (args.folds_given && args.folds < 2) {
+    throw MakeInputError("", "--folds", "must be >= 2 (omit --folds to choose from the data)");
+  }
   if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
+  if (args.with_terrain && args.without_terrain) {
+    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
+  }
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
-  WarnIfUnderdetermined(set, true, "cv");
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  RefuseMoreFoldsThanSamples(set, args.folds, args.path);
+  if (args.with_terrain && set.terrain_dim() == 0) {
+    throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
+  }
+  WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
   CvOptions options;
+  options.folds =
+      CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
+  options.without_terrain = !args.with_terrain;
+  options.with_terrain = !args.without_terrain;
   options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
   options.dgmm.k = args.k;
   options.group_by_episode = !args.stratified;
-  options.folds = args.folds;
   options.repeats = args.repeats;
   options.seed = args.seed;
   options.threads = args.threads;
@@ -81,12 +93,16 @@ void RunCv(const CvArgs& args) {
     const char* key;
     const char* label;
     const CvScore* score;
+    const std::string* omitted;  // why the row was not computed ("" when it was, or not asked)
   };
+  const std::string none;
   const Row rows[] = {
-      {"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain},
-      {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain},
-      {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain},
-      {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain}};
+      {"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain, &none},
+      {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain, &none},
+      {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain,
+       &summary.em_without_terrain_omitted},
+      {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain,
+       &summary.em_with_terrain_omitted}};
   if (args.json) {
     nlohmann::json out = {{"file", args.path},
                           {"samples", summary.samples},
@@ -102,17 +118,21 @@ void RunCv(const CvArgs& args) {
                           {"scored_per_repeat", summary.scored_per_repeat},
                           {"unscored_per_repeat", summary.unscored_per_repeat},
                           {"seconds", summary.seconds}};
+    out["rows"] = nlohmann::json::object();
+    out["omitted_rows"] = nlohmann::json::object();
     for (const Row& row : rows) {
       if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
+      if (!row.omitted->empty()) out["omitted_rows"][row.key] = *row.omitted;
     }
     std::cout << out.dump(2) << "\n";
     return;
   }
   std::cout << fmt::format(
-      "{}: {} samples, {} commands; {} x {}-fold cross-validation, k = {}, seed {} ({:.1f} s)\n"
+      "{}: {}, {}; {} x {}-fold cross-validation, k = {}, seed {} ({})\n"
       "folds: {}; DGMM: {} variant, covariance {}, S0 {}\n",
-      args.path, summary.samples, summary.commands, summary.repeats, summary.folds, args.k,
-      args.seed, summary.seconds, summary.folds_by, args.dgmm.variant, args.dgmm.covariance,
+      args.path, Plural(summary.samples, "sample"), Plural(summary.commands, "command"),
+      summary.repeats, summary.folds, args.k, args.seed, FormatSeconds(summary.seconds),
+      summary.folds_by, args.dgmm.variant, args.dgmm.covariance,
       fmt::format("{}", fmt::join(args.dgmm.init_cov, ",")));
   if (summary.unscored_per_repeat > 0) {
     std::cout << fmt::format(
@@ -130,6 +150,9 @@ void RunCv(const CvArgs& args) {
                              fmt::format("{:.1f} +- {:.1f}", s.mean, s.sd), s.standard_error,
                              s.mean_per_sample, k);
   }
+  for (const Row& row : rows) {
+    if (!row.omitted->empty()) std::cout << row.label << ": omitted, " << *row.omitted << "\n";
+  }
   if (!summary.has_terrain) std::cout << "(the set has no terrain: no with-terrain rows)\n";
 }
 
@@ -142,8 +165,9 @@ void SetupCv(CLI::App& root) {
   cmd->add_option("set", args->path, "Sample set (.h5)")->required();
   cmd->add_option("--k", args->k, "DGMM merge rate k > 0")->capture_default_str();
   cmd->add_option("--folds", args->folds,
-                  "Folds (whole episodes when the set has them, else stratified by command), >= 2")
-      ->capture_default_str();
+                  "Folds, >= 2 (whole episodes when the set has enough, else stratified by "
+                  "command); default: chosen from the data (leave-one-episode-out for up to 10 "
+                  "episodes, else 10 folds; stratified: at most the smallest command's samples)");
   cmd->add_option("--repeats", args->repeats, "Repeats with new folds")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of folds and merges")->capture_default_str();
   cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")
@@ -156,6 +180,10 @@ void SetupCv(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--em-n-init", args->em_n_init, "EM restarts per fit")->capture_default_str();
   AddDgmmFlags(cmd, &args->dgmm);
+  cmd->add_flag("--with-terrain", args->with_terrain,
+                "Only the with-terrain rows, p(x | c, z) (default: both)");
+  cmd->add_flag("--without-terrain", args->without_terrain,
+                "Only the without-terrain rows, p(x | c) (as fit --without-terrain)");
   cmd->add_flag("--stratified", args->stratified,
                 "Folds stratified by command even when the set has episodes (default: whole "
                 "episodes per fold when it has them)");
@@ -166,7 +194,10 @@ void SetupCv(CLI::App& root) {
                   "Terrain dimensions to condition on, by name (default: all)")
       ->delimiter(',');
   cmd->add_flag("--json", args->json, "Print JSON");
-  cmd->callback([args] { RunCv(*args); });
+  cmd->callback([args, cmd] {
+    args->folds_given = cmd->count("--folds") > 0;
+    RunCv(*args);
+  });
 }
 
 }  // namespace

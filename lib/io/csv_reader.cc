@@ -232,13 +232,22 @@ double UnitToSi(const std::string& unit) {
 
 std::map<std::string, double> ParseUnits(const std::vector<std::string>& items) {
   std::map<std::string, double> units;
+  std::map<std::string, std::string> names;  // as given, for the message
   for (const std::string& item : items) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
       throw MakeInputError("", "--units",
                            "'" + item + "' is not COLUMN=UNIT (e.g. yaw=deg,x=mm; comma-separated)");
     }
-    units[Trim(item.substr(0, eq))] = UnitToSi(Trim(item.substr(eq + 1)));
+    const std::string column = Trim(item.substr(0, eq)), unit = Trim(item.substr(eq + 1));
+    const double factor = UnitToSi(unit);
+    const auto [it, fresh] = units.try_emplace(column, factor);
+    if (!fresh && it->second != factor) {
+      throw MakeInputError("", "--units",
+                           "column '" + column + "' is given two different units (" +
+                               names[column] + " and " + unit + "); give one");
+    }
+    names[column] = unit;
   }
   return units;
 }

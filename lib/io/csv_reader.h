@@ -50,7 +50,7 @@ bool ParseFiniteNumber(const std::string& cell, double* value, std::string* prob
 double UnitToSi(const std::string& unit);
 
 // "col=unit" items (e.g. {"yaw=deg", "x=mm"}) -> column -> factor to SI. InputError for an item
-// without '=' or with an unknown unit.
+// without '=', an unknown unit, or a column given two different units (x=mm,x=m).
 std::map<std::string, double> ParseUnits(const std::vector<std::string>& items);
 
 // Invalid rows: refuse (rethrow the row's InputError, which names file and line) unless

@@ -284,6 +284,9 @@ TEST(LogImport, OptionsAndUnitsChecked) {
   EXPECT_THROW(ImportLog(o), InputError);
   EXPECT_THROW(ParseUnits({"yaw=degrees"}), InputError);
   EXPECT_THROW(ParseUnits({"yaw"}), InputError);
+  // Contradictory units for one column are refused (issue #24); the same unit twice is harmless.
+  EXPECT_THROW(ParseUnits({"x=mm", "x=m"}), InputError);
+  EXPECT_EQ(ParseUnits({"x=mm", "x=mm"}).at("x"), 1e-3);
   EXPECT_THROW(ParseDelimiter("::"), InputError);
   EXPECT_EQ(ParseDelimiter("tab"), '\t');
 }
