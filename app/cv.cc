@@ -64,10 +64,10 @@ void RunCv(const CvArgs& args) {
   if (args.with_terrain && set.terrain_dim() == 0) {
     throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
   }
-  WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
   CvOptions options;
   options.folds =
       CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
+  WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
   options.without_terrain = !args.with_terrain;
   options.with_terrain = !args.without_terrain;
   options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());

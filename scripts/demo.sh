@@ -36,14 +36,10 @@ step "Simulated robot: paper protocol on the 18 degree slope (390 samples)"
 "$dgmm" simulate --protocol paper --seed 1 -o "$out/robot_390.h5"
 "${render[@]}" "$dgmm" tune-k "$out/robot_390.h5" --folds 5 --repeats 2 --seed 1 \
   --curve-csv "$out/tune_k_curve.csv" --plot "$out/tune_k_curve.png" --json > "$out/tune_k.json"
-# k, the S0 scale and the prior pseudo-count tune chose, as fit flags (null: not tuned).
+# k, the S0 scale and the prior pseudo-count tune chose, as fit flags.
 read -r -a tuned <<< "$(/usr/bin/python3 -c '
 import json, sys
-t = json.load(open(sys.argv[1]))
-flags = ["--k", repr(t["k"])]
-if t.get("init_scale") is not None: flags += ["--init-scale", repr(t["init_scale"])]
-if t.get("prior_count") is not None: flags += ["--prior-count", repr(t["prior_count"])]
-print(" ".join(flags))' "$out/tune_k.json")"
+print(" ".join(json.load(open(sys.argv[1]))["recommended"]["flags"]))' "$out/tune_k.json")"
 echo "tune chose ${tuned[*]} (curve: $out/tune_k_curve.png)"
 "$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_terrain.h5" "${tuned[@]}" --seed 1
 "$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_no_terrain.h5" "${tuned[@]}" --seed 1 --without-terrain
