@@ -19,6 +19,7 @@ struct ImportLogArgs {
   LogImportOptions log;
   std::string output, delimiter = ",", time_column;
   std::vector<std::string> units;
+  std::string bin_rule = "quantile";
   bool json = false, quiet = false;
 };
 
@@ -26,6 +27,11 @@ void Run(ImportLogArgs args) {
   LogImportOptions& o = args.log;
   o.delimiter = ParseDelimiter(args.delimiter);
   o.units = ParseUnits(args.units);
+  if (args.bin_rule == "width") {
+    o.bins.rule = CommandBinOptions::Rule::kWidth;
+  } else if (args.bin_rule != "quantile") {
+    throw MakeInputError("", "--bin-rule", "'" + args.bin_rule + "', expected quantile or width");
+  }
   if (!args.time_column.empty()) {
     for (LogStream* s : {&o.commands, &o.pose, &o.attitude}) {
       if (s->time_column == "t") s->time_column = args.time_column;
@@ -47,10 +53,6 @@ void Run(ImportLogArgs args) {
                    "outside the pose/attitude coverage): %s\n",
                    summary.unmatched_commands.size(), o.commands.path.c_str(), list.c_str());
     }
-    if (summary.short_segments > 0) {
-      std::fprintf(stderr, "dgmm: warning: %d of %d command segments were shorter than %.3g s and skipped\n",
-                   summary.short_segments, summary.segments, summary.min_duration_s);
-    }
   }
   if (args.json) {
     nlohmann::json out = {{"output", args.output},
@@ -59,17 +61,32 @@ void Run(ImportLogArgs args) {
                           {"terrain_dim", set.terrain_dim()},
                           {"commands", set.command_labels},
                           {"episodes", summary.episodes},
+                          {"trials", summary.trials},
                           {"segments", summary.segments},
-                          {"short_segments", summary.short_segments},
+                          {"windows_kept", summary.samples},
+                          {"dropped",
+                           {{"short_segments", summary.short_segments},
+                            {"segment_remainders", summary.remainders},
+                            {"command_rows_outside_coverage", summary.commands_outside_coverage},
+                            {"trials_without_overlap", summary.trials_without_overlap},
+                            {"invalid_rows", summary.dropped_rows}}},
+                          {"near_miss_remainders", summary.near_miss_remainders},
+                          {"largest_near_miss_s", summary.largest_near_miss_s},
+                          {"window_s",
+                           {{"min", summary.min_window_s},
+                            {"median", summary.median_window_s},
+                            {"max", summary.max_window_s}}},
                           {"gap_s", summary.gap_s},
                           {"min_duration_s", summary.min_duration_s},
-                          {"dropped_rows", summary.dropped_rows},
+                          {"time_tolerance_s", summary.time_tolerance_s},
+                          {"warnings", summary.warnings},
                           {"unmatched_commands", summary.unmatched_commands}};
     std::cout << out.dump(2) << "\n";
     return;
   }
   std::printf("imported %s\n", summary.BriefReport().c_str());
-  std::printf("%d commands:", set.num_commands());
+  std::printf("%s\n", summary.WindowReport().c_str());
+  std::printf("%s:", Plural(set.num_commands(), "command").c_str());
   for (const auto& label : set.command_labels) std::printf(" [%s]", label.c_str());
   std::printf("\nwrote %s\n", args.output.c_str());
 }
@@ -85,16 +102,24 @@ void Setup(CLI::App& root) {
       "pose change expressed in the robot frame at the sample start (docs/log-import.md). "
       "Lists are comma-separated.");
   LogImportOptions& o = args->log;
-  cmd->add_option("--commands", o.commands.path, "command stream CSV")->required();
+  cmd->add_option("--commands", o.commands.path,
+                  "command stream: a CSV file, or a folder of them or a glob pattern (quoted) with "
+                  "one file per trial")
+      ->required();
   cmd->add_option("--command-cols", o.commands.columns,
                   "command columns (comma-separated; numbers, or text taken as labels)")
       ->delimiter(',');
-  cmd->add_option("--pose", o.pose.path, "pose stream CSV (fixed frame, e.g. map/odom)")->required();
+  cmd->add_option("--pose", o.pose.path,
+                  "pose stream in a fixed frame (e.g. map/odom): a CSV file, folder or glob; "
+                  "trial files are paired with the command files by the part of their names "
+                  "that differs")
+      ->required();
   cmd->add_option("--pose-cols", o.pose.columns,
                   "x,y,yaw (planar) or x,y,z,roll,pitch,yaw (6-DoF) columns, in that order")
       ->delimiter(',')
       ->required();
-  cmd->add_option("--attitude", o.attitude.path, "attitude (IMU) stream CSV (optional)");
+  cmd->add_option("--attitude", o.attitude.path,
+                  "attitude (IMU) stream: a CSV file, folder or glob (optional)");
   cmd->add_option("--terrain-cols", o.attitude.columns,
                   "attitude angle columns stored as the terrain z (e.g. pitch,roll)")
       ->delimiter(',');
@@ -107,7 +132,8 @@ void Setup(CLI::App& root) {
                   "t_ms=ms,x=mm,yaw=deg; units s ms us ns m cm mm rad deg); default SI")
       ->delimiter(',');
   cmd->add_option("--episode-col", o.episode_column,
-                  "integer episode column of the command stream (default: episodes from gaps)");
+                  "integer episode column of the command stream (default: one episode per trial "
+                  "file, split at logging gaps)");
   cmd->add_option("--gap", o.gap_s,
                   "a pause longer than this (s) in the pose or attitude stream ends an episode "
                   "(0: 10 x the slower stream's median interval)")
@@ -119,10 +145,24 @@ void Setup(CLI::App& root) {
   cmd->add_option("--min-duration", o.min_duration_s,
                   "skip command segments shorter than this (s; 0: two pose intervals)")
       ->capture_default_str();
-  cmd->add_option("--bins", o.bins,
-                  "bin numeric command columns into this many equal-width bins (0: every "
-                  "distinct value is a command)")
+  cmd->add_option("--bins", o.bins.bins,
+                  "bin numeric command columns into this many bins of equal counts (quantiles; "
+                  "--bin-rule width: equal widths); a zero is its own command (a stop); 0: every "
+                  "distinct value is a command")
       ->capture_default_str();
+  cmd->add_option("--bin-rule", args->bin_rule, "quantile or width (for --bins)")
+      ->capture_default_str();
+  cmd->add_option("--bin-edges", o.bins.edges,
+                  "explicit inner bin edges of numeric command columns, increasing, "
+                  "comma-separated (instead of --bins); a zero is its own command")
+      ->delimiter(',');
+  cmd->add_option("--time-tolerance", o.time_tolerance_s,
+                  "each end of a window may lie this long (s) beyond its segment's data, so a "
+                  "window one pose sample short is kept (0: half the median pose interval)")
+      ->capture_default_str();
+  cmd->add_flag("--per-second", o.per_second,
+                "divide each pose change by its window's duration (rates in m/s and rad/s), for "
+                "samples of unequal duration");
   cmd->add_option("--delimiter", args->delimiter, "field separator: , ; tab | space")
       ->capture_default_str();
   cmd->add_flag("--drop-invalid", o.drop_invalid,
