@@ -1,5 +1,6 @@
 // `dgmm import-log`: time-stamped CSV streams (commands, pose, attitude) -> an HDF5 sample set
 // (io/log_import.h, docs/log-import.md).
+#include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
@@ -20,6 +21,8 @@ struct ImportLogArgs {
   std::string output, delimiter = ",", time_column;
   std::vector<std::string> units;
   std::string bin_rule = "quantile";
+  double rate_hz = 0;
+  bool no_header = false;
   bool json = false, quiet = false;
 };
 
@@ -27,6 +30,16 @@ void Run(ImportLogArgs args) {
   LogImportOptions& o = args.log;
   o.delimiter = ParseDelimiter(args.delimiter);
   o.units = ParseUnits(args.units);
+  o.has_header = !args.no_header;
+  if (args.rate_hz < 0 || !std::isfinite(args.rate_hz)) {
+    throw MakeInputError("", "--rate", "expected rows per second > 0");
+  }
+  if (args.rate_hz > 0 && !args.time_column.empty()) {
+    throw MakeInputError("", "--rate/--time-col", "give one: times come from a column or a rate");
+  }
+  if (args.rate_hz > 0) {
+    for (LogStream* s : {&o.commands, &o.pose, &o.attitude}) s->rate_hz = args.rate_hz;
+  }
   if (args.bin_rule == "width") {
     o.bins.rule = CommandBinOptions::Rule::kWidth;
   } else if (args.bin_rule != "quantile") {
@@ -124,6 +137,18 @@ void Setup(CLI::App& root) {
                   "attitude angle columns stored as the terrain z (e.g. pitch,roll)")
       ->delimiter(',');
   cmd->add_option("--time-col", args->time_column, "time column name of every stream (default t)");
+  auto* rate = cmd->add_option("--rate", args->rate_hz,
+                               "rows per second of every stream without a time column (row i at "
+                               "t = i / rate from the file's start)");
+  cmd->add_option("--commands-rate", o.commands.rate_hz, "rows per second of the command stream")
+      ->excludes(rate);
+  cmd->add_option("--pose-rate", o.pose.rate_hz, "rows per second of the pose stream")
+      ->excludes(rate);
+  cmd->add_option("--attitude-rate", o.attitude.rate_hz, "rows per second of the attitude stream")
+      ->excludes(rate);
+  cmd->add_flag("--no-header", args->no_header,
+                "the files have no header row: name columns by position, 1, 2, ... (e.g. "
+                "--pose-cols 1,2,3)");
   cmd->add_option("--commands-time", o.commands.time_column, "time column of the command stream");
   cmd->add_option("--pose-time", o.pose.time_column, "time column of the pose stream");
   cmd->add_option("--attitude-time", o.attitude.time_column, "time column of the attitude stream");

@@ -148,7 +148,7 @@ bool CsvTable::IsNumericColumn(int col) const {
   return true;
 }
 
-CsvTable ReadCsv(const std::string& path, char delimiter) {
+CsvTable ReadCsv(const std::string& path, char delimiter, bool has_header) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     throw MakeInputError(path, "", "is a folder, expected a CSV file");
@@ -166,13 +166,18 @@ CsvTable ReadCsv(const std::string& path, char delimiter) {
     if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
     if (Trim(line).empty()) continue;
     auto fields = SplitRecord(line, delimiter, path, line_no);
+    if (table.header.empty() && !has_header) {
+      for (size_t i = 1; i <= fields.size(); ++i) table.header.push_back(std::to_string(i));
+    }
     if (table.header.empty()) {
       table.header = std::move(fields);
     } else {
       table.records.push_back({line_no, std::move(fields)});
     }
   }
-  if (table.header.empty()) throw MakeInputError(path, "", "empty file (expected a header row)");
+  if (table.header.empty()) {
+    throw MakeInputError(path, "", has_header ? "empty file (expected a header row)" : "empty file");
+  }
   return table;
 }
 

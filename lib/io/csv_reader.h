@@ -36,8 +36,9 @@ std::string EchoCell(const std::string& text);
 
 // Reads `path` with fields separated by `delimiter` ("quoted" fields may hold it; "" is a quote).
 // Lines may end in \n, \r\n or a lone \r. InputError for a missing/unreadable/empty file, a
-// folder, or an unterminated quote.
-CsvTable ReadCsv(const std::string& path, char delimiter = ',');
+// folder, or an unterminated quote. has_header false: every row is data and the columns are
+// named by position, "1", "2", ... (from the first row's field count).
+CsvTable ReadCsv(const std::string& path, char delimiter = ',', bool has_header = true);
 
 // "," ";" "tab" (or "\t") "|" " " -> the character; InputError naming --delimiter otherwise.
 char ParseDelimiter(const std::string& text);

@@ -15,13 +15,13 @@ namespace {
 
 namespace fs = std::filesystem;
 
-bool IsGlob(const std::string& path) { return path.find_first_of("*?[") != std::string::npos; }
+bool IsGlob(const std::string& path) { return path.find_first_of("*?[{") != std::string::npos; }
 
 std::vector<std::string> Glob(const std::string& pattern) {
   glob_t found{};
   std::unique_ptr<glob_t, void (*)(glob_t*)> owner(&found, globfree);
   std::vector<std::string> files;
-  if (glob(pattern.c_str(), 0, nullptr, &found) != 0) return files;
+  if (glob(pattern.c_str(), GLOB_BRACE, nullptr, &found) != 0) return files;
   for (size_t i = 0; i < found.gl_pathc; ++i) {
     if (fs::is_regular_file(found.gl_pathv[i])) files.emplace_back(found.gl_pathv[i]);
   }

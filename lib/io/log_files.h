@@ -9,7 +9,7 @@
 namespace dgmm {
 
 // The CSV files a stream option names, sorted: the file itself, the *.csv files of a folder, or
-// the matches of a glob pattern (*, ?, [...]). InputError naming `flag` and the path when nothing
+// the matches of a glob pattern (*, ?, [...], {a,b}). InputError naming `flag` and the path when nothing
 // matches.
 std::vector<std::string> ResolveStreamFiles(const std::string& path, const std::string& flag);
 

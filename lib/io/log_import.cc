@@ -40,9 +40,12 @@ std::string FormatNumber(double v) {
   return buf;
 }
 
-// The time of record r in seconds; InputError when it does not increase past `previous`.
-double RowTime(const CsvTable& table, const CsvRecord& r, int col, const LogStream& stream,
-               const std::string& path, double unit, const std::vector<double>& previous) {
+// The time of record r (the index-th data row) in seconds: index / rate_hz when the stream has a
+// rate, else its time column; InputError when it does not increase past `previous`.
+double RowTime(const CsvTable& table, const CsvRecord& r, size_t index, int col,
+               const LogStream& stream, const std::string& path, double unit,
+               const std::vector<double>& previous) {
+  if (stream.rate_hz > 0) return static_cast<double>(index) / stream.rate_hz;
   const double t = table.Number(r, col) * unit;
   if (!previous.empty() && t <= previous.back()) {
     throw MakeInputError(path, "line " + std::to_string(r.line) + ", column '" + stream.time_column + "'",
@@ -55,17 +58,18 @@ double RowTime(const CsvTable& table, const CsvRecord& r, int col, const LogStre
 // are invalid (refused or dropped by `invalid`).
 Series ReadSeries(const std::string& path, const LogStream& stream, const LogImportOptions& o,
                   InvalidRows* invalid, long long* rows) {
-  const CsvTable table = ReadCsv(path, o.delimiter);
-  const int time_col = table.Column(stream.time_column);
+  const CsvTable table = ReadCsv(path, o.delimiter, o.has_header);
+  const int time_col = stream.rate_hz > 0 ? -1 : table.Column(stream.time_column);
   std::vector<int> cols;
   for (const auto& c : stream.columns) cols.push_back(table.Column(c));
   Series s;
   s.path = path;
   s.values.resize(cols.size());
-  for (const CsvRecord& r : table.records) {
+  for (size_t i = 0; i < table.records.size(); ++i) {
+    const CsvRecord& r = table.records[i];
     try {
       table.CheckFieldCount(r);
-      const double t = RowTime(table, r, time_col, stream, path, Unit(o, stream.time_column), s.t);
+      const double t = RowTime(table, r, i, time_col, stream, path, Unit(o, stream.time_column), s.t);
       std::vector<double> v;
       for (size_t j = 0; j < cols.size(); ++j) v.push_back(table.Number(r, cols[j]) * Unit(o, stream.columns[j]));
       s.t.push_back(t);
@@ -191,8 +195,8 @@ std::vector<double> RowKey(const CsvTable& table, const CsvRecord& r, const std:
 CommandRows ReadCommands(const std::string& path, const LogImportOptions& o,
                          CommandColumns* shared, InvalidRows* invalid, long long* rows) {
   const LogStream& s = o.commands;
-  const CsvTable table = ReadCsv(path, o.delimiter);
-  const int time_col = table.Column(s.time_column);
+  const CsvTable table = ReadCsv(path, o.delimiter, o.has_header);
+  const int time_col = s.rate_hz > 0 ? -1 : table.Column(s.time_column);
   const int episode_col = o.episode_column.empty() ? -1 : table.Column(o.episode_column);
   std::vector<int> cols;
   for (size_t j = 0; j < s.columns.size(); ++j) {
@@ -207,10 +211,11 @@ CommandRows ReadCommands(const std::string& path, const LogImportOptions& o,
   }
   CommandRows out;
   out.path = path;
-  for (const CsvRecord& r : table.records) {
+  for (size_t i = 0; i < table.records.size(); ++i) {
+    const CsvRecord& r = table.records[i];
     try {
       table.CheckFieldCount(r);
-      const double t = RowTime(table, r, time_col, s, path, Unit(o, s.time_column), out.t);
+      const double t = RowTime(table, r, i, time_col, s, path, Unit(o, s.time_column), out.t);
       std::vector<std::string> text;
       std::vector<double> key = RowKey(table, r, cols, o, path, shared, &text);
       int episode = 0;
@@ -494,7 +499,9 @@ void CheckDurations(const std::vector<double>& durations, const LogImportOptions
   summary->min_window_s = *lo;
   summary->max_window_s = *hi;
   summary->median_window_s = Median(durations);
-  if (o.per_second || *hi - *lo <= std::max(2 * ts.tolerance, 0.02 * summary->median_window_s)) return;
+  // Windows shortened by up to the tolerance at each end are expected; more than that is not.
+  const double expected = std::max(2 * ts.tolerance, 0.02 * summary->median_window_s) * 1.01;
+  if (o.per_second || *hi - *lo <= expected) return;
   summary->warnings.push_back(
       "samples last from " + FormatNumber(*lo) + " to " + FormatNumber(*hi) + " s (median " +
       FormatNumber(summary->median_window_s) +
@@ -581,6 +588,12 @@ bool LogImportOptions::IsValid(std::string* error) const {
   if (!(gap_s >= 0) || !std::isfinite(gap_s)) return fail("--gap: expected seconds >= 0");
   if (!(window_s >= 0) || !std::isfinite(window_s)) return fail("--window: expected seconds >= 0");
   if (!(min_duration_s >= 0) || !std::isfinite(min_duration_s)) return fail("--min-duration: expected seconds >= 0");
+  for (const auto& [stream, flag] : {std::pair{&commands, "--commands-rate"}, {&pose, "--pose-rate"},
+                                     {&attitude, "--attitude-rate"}}) {
+    if (!(stream->rate_hz >= 0) || !std::isfinite(stream->rate_hz)) {
+      return fail(std::string(flag) + ": expected rows per second >= 0");
+    }
+  }
   if (!(time_tolerance_s >= 0) || !std::isfinite(time_tolerance_s)) {
     return fail("--time-tolerance: expected seconds >= 0");
   }

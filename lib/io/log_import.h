@@ -20,6 +20,8 @@ struct LogStream {
   std::string path;
   std::string time_column = "t";
   std::vector<std::string> columns;
+  // > 0: the stream has no time column; data row i (from 0) is at t = i / rate_hz in each file.
+  double rate_hz = 0;
 };
 
 struct LogImportOptions {
@@ -50,6 +52,7 @@ struct LogImportOptions {
   // unequal duration (e.g. one sample per command segment).
   bool per_second = false;
   char delimiter = ',';
+  bool has_header = true;  // false: no header row; columns are named by position "1", "2", ...
   bool drop_invalid = false;               // skip (and count) invalid rows instead of refusing
   std::map<std::string, double> units;     // column -> factor to SI (csv_reader.h ParseUnits)
   std::string source = "real";
