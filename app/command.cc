@@ -131,11 +131,11 @@ int CheckedFolds(const SampleSet& set, int folds, bool given, bool group_by_epis
     const std::string label =
         id < static_cast<int>(set.command_labels.size()) ? " '" + set.command_labels[id] + "'" : "";
     throw MakeInputError(path, "--folds",
-                         fmt::format("{} folds stratified by command ({}), but command {}{} has {} "
-                                     "({} in all); use --folds {} or omit --folds to choose from "
-                                     "the data",
-                                     folds, plan.reason, id, label, Plural(count, "sample"),
-                                     set.size(), std::max(2, count)));
+                         fmt::format("{}, but command {}{} has {} ({} in all); at most {} "
+                                     "folds expected (use --folds {} or omit --folds to choose "
+                                     "from the data)",
+                                     plan.reason, id, label, Plural(count, "sample"), set.size(),
+                                     count, std::max(2, count)));
   }
   return folds;
 }
