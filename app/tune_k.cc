@@ -18,6 +18,7 @@
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "render/chart.h"
+#include "render/display.h"
 #include "tune/dimensions.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -419,6 +420,7 @@ void RunTuneK(const TuneKArgs& args) {
     RefuseOutputThatIsAnInput(output, {args.path}, flag);
     AtomicFile probe(output);
   }
+  if (!args.plot.empty()) RequireDisplay();  // before the long run, not after it
   const SampleSet set =
       SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
   if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");

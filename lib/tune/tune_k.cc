@@ -6,6 +6,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <tuple>
 
@@ -366,12 +367,13 @@ std::string TuneKSummary::PlateauMeaning() const {
   if (!plateau) return "";
   const std::string within = plateau_tolerance_is_se
                                  ? std::string("within 1 SE")
-                                 : "within " + ShortNumber(plateau_tolerance) + " nats";
+                                 : "within " + ShortNumber(plateau_tolerance) + " nats of the best";
   if (plateau_spans_grid) {
     return "k not identifiable from this data, smallest model " + within + " chosen";
   }
-  return "k from " + ShortNumber(plateau_k_lo) + " to " + ShortNumber(plateau_k_hi) +
-         " equally good " + within + ", smallest model there chosen";
+  char range[64];
+  std::snprintf(range, sizeof range, "k from %.4g to %.4g", plateau_k_lo, plateau_k_hi);
+  return range + (" equally good " + within + ", smallest model there chosen");
 }
 
 std::string TuneKSummary::BriefReport() const {
