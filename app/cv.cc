@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "app/command.h"
 #include "app/dgmm_flags.h"
@@ -47,27 +48,28 @@ nlohmann::json ScoreJson(const CvScore& s) {
           {"mean_components", s.mean_components}};
 }
 
-void RunCv(const CvArgs& args) {
-  if (!(args.k > 0) || !std::isfinite(args.k)) {
-    throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
-  }
-  if (args.folds_given && args.folds < 2) {
-    throw MakeInputError("", "--folds", "must be >= 2 (omit --folds to choose from the data)");
-  }
-  if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
-  if (args.with_terrain && args.without_terrain) {
-    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
-  }
-  const SampleSet set =
-      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
-  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  if (args.with_terrain && set.terrain_dim() == 0) {
-    throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
-  }
+// One row of the table: its JSON key, its label, its score, and why it was omitted ("" when it
+// was computed or not asked for).
+struct Row {
+  const char* key;
+  const char* label;
+  const CvScore* score;
+  const std::string* omitted;
+};
+
+std::vector<Row> Rows(const CvSummary& summary) {
+  static const std::string none;
+  return {{"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain, &none},
+          {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain, &none},
+          {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain,
+           &summary.em_without_terrain_omitted},
+          {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain,
+           &summary.em_with_terrain_omitted}};
+}
+
+CvOptions MakeCvOptions(const CvArgs& args, const SampleSet& set) {
   CvOptions options;
-  options.folds =
-      CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
-  WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
+  options.folds = CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
   options.without_terrain = !args.with_terrain;
   options.with_terrain = !args.without_terrain;
   options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
@@ -87,46 +89,34 @@ void RunCv(const CvArgs& args) {
                        {{"em_max_components", "--em-max-components"}, {"threads", "--threads"},
                         {"folds", "--folds"}, {"repeats", "--repeats"}, {"n_init", "--em-n-init"}});
   }
-  const CvSummary summary = CrossValidate(set, options);
+  return options;
+}
 
-  struct Row {
-    const char* key;
-    const char* label;
-    const CvScore* score;
-    const std::string* omitted;  // why the row was not computed ("" when it was, or not asked)
-  };
-  const std::string none;
-  const Row rows[] = {
-      {"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain, &none},
-      {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain, &none},
-      {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain,
-       &summary.em_without_terrain_omitted},
-      {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain,
-       &summary.em_with_terrain_omitted}};
-  if (args.json) {
-    nlohmann::json out = {{"file", args.path},
-                          {"samples", summary.samples},
-                          {"commands", summary.commands},
-                          {"folds", summary.folds},
-                          {"repeats", summary.repeats},
-                          {"k", args.k},
-                          {"seed", args.seed},
-                          {"folds_by", summary.folds_by},
-                          {"dgmm_options", DgmmOptionsJson(options.dgmm)},
-                          {"shuffle_training", args.shuffle_training},
-                          {"has_terrain", summary.has_terrain},
-                          {"scored_per_repeat", summary.scored_per_repeat},
-                          {"unscored_per_repeat", summary.unscored_per_repeat},
-                          {"seconds", summary.seconds}};
-    out["rows"] = nlohmann::json::object();
-    out["omitted_rows"] = nlohmann::json::object();
-    for (const Row& row : rows) {
-      if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
-      if (!row.omitted->empty()) out["omitted_rows"][row.key] = *row.omitted;
-    }
-    std::cout << out.dump(2) << "\n";
-    return;
+nlohmann::json CvJson(const CvArgs& args, const CvOptions& options, const CvSummary& summary) {
+  nlohmann::json out = {{"file", args.path},
+                        {"samples", summary.samples},
+                        {"commands", summary.commands},
+                        {"folds", summary.folds},
+                        {"repeats", summary.repeats},
+                        {"k", args.k},
+                        {"seed", args.seed},
+                        {"folds_by", summary.folds_by},
+                        {"dgmm_options", DgmmOptionsJson(options.dgmm)},
+                        {"shuffle_training", args.shuffle_training},
+                        {"has_terrain", summary.has_terrain},
+                        {"scored_per_repeat", summary.scored_per_repeat},
+                        {"unscored_per_repeat", summary.unscored_per_repeat},
+                        {"seconds", summary.seconds}};
+  out["rows"] = nlohmann::json::object();
+  out["omitted_rows"] = nlohmann::json::object();
+  for (const Row& row : Rows(summary)) {
+    if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
+    if (!row.omitted->empty()) out["omitted_rows"][row.key] = *row.omitted;
   }
+  return out;
+}
+
+void PrintCvTable(const CvArgs& args, const CvSummary& summary) {
   std::cout << fmt::format(
       "{}: {}, {}; {} x {}-fold cross-validation, k = {}, seed {} ({})\n"
       "folds: {}; DGMM: {} variant, covariance {}, S0 {}\n",
@@ -142,6 +132,7 @@ void RunCv(const CvArgs& args) {
   std::cout << "held-out log-likelihood, summed over all validation folds of a repeat\n";
   std::cout << fmt::format("{:<24}{:>22}{:>12}{:>12}{:>10}\n", "model", "mean +- sd (repeats)",
                            "std. error", "per sample", "mean K");
+  const std::vector<Row> rows = Rows(summary);
   for (const Row& row : rows) {
     if (!row.score->evaluated) continue;
     const CvScore& s = *row.score;
@@ -154,6 +145,33 @@ void RunCv(const CvArgs& args) {
     if (!row.omitted->empty()) std::cout << row.label << ": omitted, " << *row.omitted << "\n";
   }
   if (!summary.has_terrain) std::cout << "(the set has no terrain: no with-terrain rows)\n";
+}
+
+void RunCv(const CvArgs& args) {
+  if (!(args.k > 0) || !std::isfinite(args.k)) {
+    throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
+  }
+  if (args.folds_given && args.folds < 2) {
+    throw MakeInputError("", "--folds", "must be >= 2 (omit --folds to choose from the data)");
+  }
+  if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
+  if (args.with_terrain && args.without_terrain) {
+    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
+  }
+  const SampleSet set =
+      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
+  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
+  if (args.with_terrain && set.terrain_dim() == 0) {
+    throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
+  }
+  const CvOptions options = MakeCvOptions(args, set);
+  WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
+  const CvSummary summary = CrossValidate(set, options);
+  if (args.json) {
+    std::cout << CvJson(args, options, summary).dump(2) << "\n";
+    return;
+  }
+  PrintCvTable(args, summary);
 }
 
 void SetupCv(CLI::App& root) {

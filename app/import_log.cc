@@ -26,8 +26,9 @@ struct ImportLogArgs {
   bool json = false, quiet = false;
 };
 
-void Run(ImportLogArgs args) {
-  LogImportOptions& o = args.log;
+// The options the flags name (delimiter, units, header, rates, bin rule, time column).
+LogImportOptions OptionsFromArgs(const ImportLogArgs& args) {
+  LogImportOptions o = args.log;
   o.delimiter = ParseDelimiter(args.delimiter);
   o.units = ParseUnits(args.units);
   o.has_header = !args.no_header;
@@ -50,51 +51,63 @@ void Run(ImportLogArgs args) {
       if (s->time_column == "t") s->time_column = args.time_column;
     }
   }
+  return o;
+}
+
+// Warnings, dropped rows and commands without a sample, on stderr unless quiet.
+void ReportProblems(const LogImportSummary& summary, const std::string& commands_path) {
+  if (Quiet()) return;
+  for (const auto& w : summary.warnings) std::fprintf(stderr, "dgmm: warning: %s\n", w.c_str());
+  for (const auto& line : summary.dropped_report) std::fprintf(stderr, "dgmm: %s\n", line.c_str());
+  if (summary.unmatched_commands.empty()) return;
+  std::string list;
+  for (const auto& c : summary.unmatched_commands) list += (list.empty() ? "" : "; ") + c;
+  std::fprintf(stderr,
+               "dgmm: warning: %zu command(s) in %s gave no sample (segments too short or "
+               "outside the pose/attitude coverage): %s\n",
+               summary.unmatched_commands.size(), commands_path.c_str(), list.c_str());
+}
+
+nlohmann::json ImportJson(const SampleSet& set, const LogImportSummary& summary,
+                          const std::string& output) {
+  return {{"output", output},
+          {"samples", set.size()},
+          {"pose_dim", set.pose_dim()},
+          {"terrain_dim", set.terrain_dim()},
+          {"commands", set.command_labels},
+          {"episodes", summary.episodes},
+          {"trials", summary.trials},
+          {"segments", summary.segments},
+          {"windows_kept", summary.samples},
+          {"dropped",
+           {{"short_segments", summary.short_segments},
+            {"segment_remainders", summary.remainders},
+            {"command_rows_outside_coverage", summary.commands_outside_coverage},
+            {"trials_without_overlap", summary.trials_without_overlap},
+            {"invalid_rows", summary.dropped_rows}}},
+          {"near_miss_remainders", summary.near_miss_remainders},
+          {"largest_near_miss_s", summary.largest_near_miss_s},
+          {"window_s",
+           {{"min", summary.min_window_s},
+            {"median", summary.median_window_s},
+            {"max", summary.max_window_s}}},
+          {"gap_s", summary.gap_s},
+          {"min_duration_s", summary.min_duration_s},
+          {"time_tolerance_s", summary.time_tolerance_s},
+          {"warnings", summary.warnings},
+          {"unmatched_commands", summary.unmatched_commands}};
+}
+
+void Run(const ImportLogArgs& args) {
+  const LogImportOptions o = OptionsFromArgs(args);
   RefuseOutputThatIsAnInput(args.output, {o.commands.path, o.pose.path, o.attitude.path});
   { AtomicFile probe(args.output); }  // fail before reading when the output is unwritable
   LogImportSummary summary;
   const SampleSet set = ImportLog(o, &summary);
   WriteSampleSet(set, args.output);
-  if (!Quiet()) {
-    for (const auto& w : summary.warnings) std::fprintf(stderr, "dgmm: warning: %s\n", w.c_str());
-    for (const auto& line : summary.dropped_report) std::fprintf(stderr, "dgmm: %s\n", line.c_str());
-    if (!summary.unmatched_commands.empty()) {
-      std::string list;
-      for (const auto& c : summary.unmatched_commands) list += (list.empty() ? "" : "; ") + c;
-      std::fprintf(stderr,
-                   "dgmm: warning: %zu command(s) in %s gave no sample (segments too short or "
-                   "outside the pose/attitude coverage): %s\n",
-                   summary.unmatched_commands.size(), o.commands.path.c_str(), list.c_str());
-    }
-  }
+  ReportProblems(summary, o.commands.path);
   if (args.json) {
-    nlohmann::json out = {{"output", args.output},
-                          {"samples", set.size()},
-                          {"pose_dim", set.pose_dim()},
-                          {"terrain_dim", set.terrain_dim()},
-                          {"commands", set.command_labels},
-                          {"episodes", summary.episodes},
-                          {"trials", summary.trials},
-                          {"segments", summary.segments},
-                          {"windows_kept", summary.samples},
-                          {"dropped",
-                           {{"short_segments", summary.short_segments},
-                            {"segment_remainders", summary.remainders},
-                            {"command_rows_outside_coverage", summary.commands_outside_coverage},
-                            {"trials_without_overlap", summary.trials_without_overlap},
-                            {"invalid_rows", summary.dropped_rows}}},
-                          {"near_miss_remainders", summary.near_miss_remainders},
-                          {"largest_near_miss_s", summary.largest_near_miss_s},
-                          {"window_s",
-                           {{"min", summary.min_window_s},
-                            {"median", summary.median_window_s},
-                            {"max", summary.max_window_s}}},
-                          {"gap_s", summary.gap_s},
-                          {"min_duration_s", summary.min_duration_s},
-                          {"time_tolerance_s", summary.time_tolerance_s},
-                          {"warnings", summary.warnings},
-                          {"unmatched_commands", summary.unmatched_commands}};
-    std::cout << out.dump(2) << "\n";
+    std::cout << ImportJson(set, summary, args.output).dump(2) << "\n";
     return;
   }
   std::printf("imported %s\n", summary.BriefReport().c_str());
@@ -104,16 +117,8 @@ void Run(ImportLogArgs args) {
   std::printf("\nwrote %s\n", args.output.c_str());
 }
 
-void Setup(CLI::App& root) {
-  auto args = std::make_shared<ImportLogArgs>();
-  CLI::App* cmd = root.add_subcommand(
-      "import-log",
-      "Turn time-stamped CSV logs (a command stream, a pose stream and optionally an IMU "
-      "attitude stream, each with its own time column and rate) into an HDF5 sample set: "
-      "streams are joined by time (commands held, pose and attitude interpolated), episodes "
-      "split at logging gaps, samples cut at command changes (or into --window seconds) and the "
-      "pose change expressed in the robot frame at the sample start (docs/log-import.md). "
-      "Lists are comma-separated.");
+// The streams: files (or folders or globs), columns, times and units.
+void AddStreamFlags(CLI::App* cmd, ImportLogArgs* args) {
   LogImportOptions& o = args->log;
   cmd->add_option("--commands", o.commands.path,
                   "command stream: a CSV file, or a folder of them or a glob pattern (quoted) with "
@@ -156,6 +161,11 @@ void Setup(CLI::App& root) {
                   "units converted to s, m and rad, COLUMN=UNIT comma-separated (e.g. "
                   "t_ms=ms,x=mm,yaw=deg; units s ms us ns m cm mm rad deg); default SI")
       ->delimiter(',');
+}
+
+// How samples are cut: episodes, windows, tolerance, bins, durations, invalid rows, output.
+void AddSampleFlags(CLI::App* cmd, ImportLogArgs* args) {
+  LogImportOptions& o = args->log;
   cmd->add_option("--episode-col", o.episode_column,
                   "integer episode column of the command stream (default: one episode per trial "
                   "file, split at logging gaps)");
@@ -197,6 +207,21 @@ void Setup(CLI::App& root) {
   cmd->add_option("--source", o.source, "where the data came from")->capture_default_str();
   cmd->add_option("-o,--output", args->output, "sample set to write (.h5)")->required();
   cmd->add_flag("--json", args->json, "print the summary as JSON");
+}
+
+void Setup(CLI::App& root) {
+  auto args = std::make_shared<ImportLogArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "import-log",
+      "Turn time-stamped CSV logs (a command stream, a pose stream and optionally an IMU "
+      "attitude stream, each with its own time column or rate, each one file or a folder or "
+      "glob of per-trial files) into an HDF5 sample set: "
+      "streams are joined by time (commands held, pose and attitude interpolated), episodes "
+      "split at logging gaps, samples cut at command changes (or into --window seconds) and the "
+      "pose change expressed in the robot frame at the sample start (docs/log-import.md). "
+      "Lists are comma-separated.");
+  AddStreamFlags(cmd, args.get());
+  AddSampleFlags(cmd, args.get());
   cmd->callback([args] { Run(*args); });
 }
 

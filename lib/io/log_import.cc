@@ -1,6 +1,5 @@
 #include "io/log_import.h"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -11,19 +10,11 @@
 
 #include "io/csv_reader.h"
 #include "io/log_files.h"
+#include "io/log_time_series.h"
 #include "util/error.h"
 
 namespace dgmm {
 namespace {
-
-using Interval = std::pair<double, double>;  // [begin, end] in seconds
-
-// A parsed numeric stream: strictly increasing times (s) and one vector per column (SI units).
-struct Series {
-  std::string path;
-  std::vector<double> t;
-  std::vector<std::vector<double>> values;  // columns x rows
-};
 
 std::string Filename(const std::string& path) {
   return std::filesystem::path(path).filename().string();
@@ -81,75 +72,6 @@ Series ReadSeries(const std::string& path, const LogStream& stream, const LogImp
   *rows += static_cast<long long>(table.records.size());
   if (s.t.size() < 2) throw MakeInputError(path, "", "fewer than 2 valid rows");
   return s;
-}
-
-// Replaces an angle series by its continuous version: each step is the shortest arc.
-void Unwrap(std::vector<double>* a) {
-  for (size_t i = 1; i < a->size(); ++i) {
-    const double step = std::remainder((*a)[i] - (*a)[i - 1], 2 * std::numbers::pi);
-    (*a)[i] = (*a)[i - 1] + step;
-  }
-}
-
-// Index i with t[i] <= time <= t[i+1] and the fraction between them (clamped to [t0, tn]).
-std::pair<size_t, double> Bracket(const std::vector<double>& t, double time) {
-  size_t i = std::upper_bound(t.begin(), t.end(), time) - t.begin();
-  i = std::clamp<size_t>(i == 0 ? 0 : i - 1, 0, t.size() - 2);
-  const double f = std::clamp((time - t[i]) / (t[i + 1] - t[i]), 0.0, 1.0);
-  return {i, f};
-}
-
-double Lerp(const std::vector<double>& v, std::pair<size_t, double> b) {
-  return v[b.first] + b.second * (v[b.first + 1] - v[b.first]);
-}
-
-double Median(std::vector<double> d) {
-  if (d.empty()) return 0;
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
-}
-
-double MedianInterval(const std::vector<double>& t) {
-  std::vector<double> d;
-  for (size_t i = 1; i < t.size(); ++i) d.push_back(t[i] - t[i - 1]);
-  return Median(d);
-}
-
-// Runs of the stream with no pause longer than gap_s.
-std::vector<Interval> Runs(const std::vector<double>& t, double gap_s) {
-  std::vector<Interval> runs;
-  size_t start = 0;
-  for (size_t i = 1; i <= t.size(); ++i) {
-    if (i == t.size() || t[i] - t[i - 1] > gap_s) {
-      if (i - 1 > start) runs.push_back({t[start], t[i - 1]});
-      start = i;
-    }
-  }
-  return runs;
-}
-
-std::vector<Interval> Intersect(const std::vector<Interval>& a, const std::vector<Interval>& b) {
-  std::vector<Interval> out;
-  size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    const double lo = std::max(a[i].first, b[j].first), hi = std::min(a[i].second, b[j].second);
-    if (hi > lo) out.push_back({lo, hi});
-    (a[i].second < b[j].second) ? ++i : ++j;
-  }
-  return out;
-}
-
-// Rz(yaw) Ry(pitch) Rx(roll) as a quaternion.
-Eigen::Quaterniond FromRpy(double roll, double pitch, double yaw) {
-  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-         Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
-}
-
-// <roll, pitch, yaw> of R = Rz(yaw) Ry(pitch) Rx(roll), pitch in [-pi/2, pi/2].
-Eigen::Vector3d ToRpy(const Eigen::Matrix3d& r) {
-  return {std::atan2(r(2, 1), r(2, 2)), std::asin(std::clamp(-r(2, 0), -1.0, 1.0)),
-          std::atan2(r(1, 0), r(0, 0))};
 }
 
 // The command stream of one trial: per valid row its time, the command key (numbers, bin centres
@@ -316,31 +238,12 @@ struct SampleSink {
 void SampleSink::Add(const CommandRows& c, size_t row, const TrialStreams& s, double t0, double t1,
                      int episode_id, int step_in_episode, bool per_second) {
   const Series& pose = s.pose;
-  const auto b0 = Bracket(pose.t, t0), b1 = Bracket(pose.t, t1);
   // The duration the pose change covers (the pose is held at the stream's ends).
   const double duration = std::clamp(t1, pose.t.front(), pose.t.back()) -
                           std::clamp(t0, pose.t.front(), pose.t.back());
   const size_t first = xs.size();
-  if (s.six_dof) {
-    auto at = [&](std::pair<size_t, double> b) {
-      return Eigen::Vector3d(Lerp(pose.values[0], b), Lerp(pose.values[1], b), Lerp(pose.values[2], b));
-    };
-    auto rotation = [&](std::pair<size_t, double> b) {
-      auto q = [&](size_t i) { return FromRpy(pose.values[3][i], pose.values[4][i], pose.values[5][i]); };
-      return q(b.first).slerp(b.second, q(b.first + 1));  // shortest arc
-    };
-    const Eigen::Quaterniond q0 = rotation(b0), q1 = rotation(b1);
-    const Eigen::Vector3d dp = q0.conjugate() * (at(b1) - at(b0));
-    const Eigen::Vector3d drpy = ToRpy((q0.conjugate() * q1).toRotationMatrix());
-    xs.insert(xs.end(), {dp.x(), dp.y(), dp.z(), drpy.x(), drpy.y(), drpy.z()});
-  } else {
-    const double yaw0 = Lerp(pose.values[2], b0);
-    const double dx = Lerp(pose.values[0], b1) - Lerp(pose.values[0], b0);
-    const double dy = Lerp(pose.values[1], b1) - Lerp(pose.values[1], b0);
-    xs.insert(xs.end(), {std::cos(yaw0) * dx + std::sin(yaw0) * dy,
-                         -std::sin(yaw0) * dx + std::cos(yaw0) * dy,
-                         Lerp(pose.values[2], b1) - yaw0});
-  }
+  const Eigen::VectorXd dx = BodyFramePoseChange(pose, t0, t1);
+  xs.insert(xs.end(), dx.data(), dx.data() + dx.size());
   if (per_second) {
     for (size_t i = first; i < xs.size(); ++i) xs[i] /= std::max(duration, 1e-12);
   }

@@ -165,6 +165,24 @@ std::string EmUnderdetermined(const SampleSet& set, const std::vector<std::vecto
          " (unregularised EM would fit noise)";
 }
 
+// em_for[terrain]: whether the EM baseline runs for that terrain setting (asked for, and every
+// command has enough training samples in every fold; else the reason goes to *summary).
+std::array<bool, 2> EmRowsToRun(const SampleSet& set, const std::vector<std::vector<int>>& fold_of,
+                                const CvOptions& options, CvSummary* summary) {
+  std::array<bool, 2> em_for = {false, false};
+  if (!options.em_baseline) return em_for;
+  for (bool terrain : {false, true}) {
+    if (terrain ? !(options.with_terrain && summary->has_terrain) : !options.without_terrain) {
+      continue;
+    }
+    const int d = set.pose_dim() + (terrain ? set.terrain_dim() : 0);
+    std::string& why = terrain ? summary->em_with_terrain_omitted : summary->em_without_terrain_omitted;
+    why = EmUnderdetermined(set, fold_of, options.folds, d);
+    em_for[terrain] = why.empty();
+  }
+  return em_for;
+}
+
 double SampleSd(const std::vector<double>& v) {
   if (v.size() < 2) return 0.0;
   const double mean = std::accumulate(v.begin(), v.end(), 0.0) / v.size();
@@ -293,19 +311,7 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
     fold_of[r] = by_episode ? EpisodeFolds(set.episode, planned.folds, rng)
                             : StratifiedFolds(set.command, planned.folds, rng);
   }
-  // The EM baseline only where every command has enough training samples (else the reason).
-  std::array<bool, 2> em_for = {false, false};
-  if (options.em_baseline) {
-    for (bool terrain : {false, true}) {
-      if (terrain ? !(options.with_terrain && summary.has_terrain) : !options.without_terrain) {
-        continue;
-      }
-      const int d = set.pose_dim() + (terrain ? set.terrain_dim() : 0);
-      std::string& why = terrain ? summary.em_with_terrain_omitted : summary.em_without_terrain_omitted;
-      why = EmUnderdetermined(set, fold_of, planned.folds, d);
-      em_for[terrain] = why.empty();
-    }
-  }
+  const std::array<bool, 2> em_for = EmRowsToRun(set, fold_of, planned, &summary);
   const int tasks = options.repeats * planned.folds;
   std::vector<FoldResult> results(tasks);
   std::atomic<int> next{0}, done{0};
