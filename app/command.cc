@@ -10,6 +10,8 @@
 
 #include <fmt/format.h>
 
+#include "io/sample_set_io.h"
+#include "tune/dimensions.h"
 #include "tune/fold_plan.h"
 #include "util/error.h"
 
@@ -170,6 +172,20 @@ std::string DidYouMean(const std::string& word, CLI::App& root) {
     }
   }
   return best.empty() ? "" : " (did you mean '" + best + "'?)";
+}
+
+SampleSet ReadSetToCrossValidate(const std::string& path, const std::vector<std::string>& pose_dims,
+                                 const std::vector<std::string>& terrain_dims, bool with_terrain,
+                                 bool without_terrain) {
+  if (with_terrain && without_terrain) {
+    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
+  }
+  SampleSet set = SelectDimensions(ReadSampleSet(path), pose_dims, terrain_dims);
+  if (set.size() == 0) throw MakeInputError(path, "samples", "the set is empty");
+  if (with_terrain && set.terrain_dim() == 0) {
+    throw MakeInputError(path, "z", "--with-terrain needs a set with terrain");
+  }
+  return set;
 }
 
 std::string Plural(long long count, const std::string& noun) {

@@ -72,6 +72,12 @@ int CheckedFolds(const SampleSet& set, int folds, bool given, bool group_by_epis
 // two edits; "" when none is that close.
 std::string DidYouMean(const std::string& word, CLI::App& root);
 
+// The set of `path` with the chosen pose and terrain dimensions (tune/dimensions.h) for cv and
+// tune; InputError for an empty set, both terrain flags, or --with-terrain without terrain.
+SampleSet ReadSetToCrossValidate(const std::string& path, const std::vector<std::string>& pose_dims,
+                                 const std::vector<std::string>& terrain_dims, bool with_terrain,
+                                 bool without_terrain);
+
 // "1 component", "2 components": the count and the noun, with an 's' unless the count is 1.
 std::string Plural(long long count, const std::string& noun);
 

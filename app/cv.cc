@@ -155,15 +155,8 @@ void RunCv(const CvArgs& args) {
     throw MakeInputError("", "--folds", "must be >= 2 (omit --folds to choose from the data)");
   }
   if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
-  if (args.with_terrain && args.without_terrain) {
-    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
-  }
-  const SampleSet set =
-      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
-  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  if (args.with_terrain && set.terrain_dim() == 0) {
-    throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
-  }
+  const SampleSet set = ReadSetToCrossValidate(args.path, args.pose_dims, args.terrain_dims,
+                                               args.with_terrain, args.without_terrain);
   const CvOptions options = MakeCvOptions(args, set);
   WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
   const CvSummary summary = CrossValidate(set, options);

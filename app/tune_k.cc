@@ -407,9 +407,6 @@ TuneKOptions MakeTuneOptions(const TuneKArgs& args, const SampleSet& set) {
 }
 
 void RunTuneK(const TuneKArgs& args) {
-  if (args.with_terrain && args.without_terrain) {
-    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
-  }
   if (args.folds_given && args.folds < 2) {
     throw MakeInputError(args.path, "--folds", "must be >= 2 (omit --folds to choose from the data)");
   }
@@ -421,12 +418,8 @@ void RunTuneK(const TuneKArgs& args) {
     AtomicFile probe(output);
   }
   if (!args.plot.empty()) RequireDisplay();  // before the long run, not after it
-  const SampleSet set =
-      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
-  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  if (args.with_terrain && set.terrain_dim() == 0) {
-    throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
-  }
+  const SampleSet set = ReadSetToCrossValidate(args.path, args.pose_dims, args.terrain_dims,
+                                               args.with_terrain, args.without_terrain);
   const TuneKOptions options = MakeTuneOptions(args, set);
   WarnIfUnderdetermined(set, !args.without_terrain, "tune", true);
   const TuneKSummary s = TuneK(set, options);

@@ -61,22 +61,26 @@ std::string WrapAt(const std::string& line, const std::string& separator, double
   return out + (out.empty() ? "" : "\n") + current;
 }
 
+// f applied to each line of `text` ('\n'-separated), the results joined by '\n'.
+std::string MapLines(const std::string& text, const std::function<std::string(const std::string&)>& f) {
+  std::string out;
+  size_t start = 0;
+  while (start <= text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    out += (start == 0 ? "" : "\n") + f(text.substr(start, end - start));
+    start = end + 1;
+  }
+  return out;
+}
+
 // Breaks after commas first ("pitch -8.9 deg,\nroll -11.2 deg"), then at spaces where a line is
 // still too wide.
 std::string WrapLine(const std::string& line, double block_px, int size,
                      const std::function<double(const std::string&, int)>& width) {
-  const std::string at_commas = WrapAt(line, ", ", block_px, size, width);
-  std::string out;
-  size_t start = 0;
-  while (start <= at_commas.size()) {
-    size_t end = at_commas.find('\n', start);
-    if (end == std::string::npos) end = at_commas.size();
-    const std::string part = at_commas.substr(start, end - start);
-    out += (start == 0 ? "" : "\n") +
-           (width(part, size) > block_px ? WrapAt(part, " ", block_px, size, width) : part);
-    start = end + 1;
-  }
-  return out;
+  return MapLines(WrapAt(line, ", ", block_px, size, width), [&](const std::string& part) {
+    return width(part, size) > block_px ? WrapAt(part, " ", block_px, size, width) : part;
+  });
 }
 
 }  // namespace
@@ -90,16 +94,9 @@ FittedLabels FitCategoryLabels(const std::vector<std::string>& names, double blo
     out.font_size = size;
     out.fits = true;
     for (const std::string& name : names) {
-      std::string label;
-      size_t start = 0;
-      while (start <= name.size()) {
-        size_t end = name.find('\n', start);
-        if (end == std::string::npos) end = name.size();
-        const std::string line = name.substr(start, end - start);
-        label += (start == 0 ? "" : "\n") +
-                 (width(line, size) > block_px ? WrapLine(line, block_px, size, width) : line);
-        start = end + 1;
-      }
+      const std::string label = MapLines(name, [&](const std::string& line) {
+        return width(line, size) > block_px ? WrapLine(line, block_px, size, width) : line;
+      });
       out.fits = out.fits && width(label, size) <= block_px;
       out.labels.push_back(label);
     }
