@@ -168,7 +168,7 @@ void AddSampleFlags(CLI::App* cmd, ImportLogArgs* args) {
   LogImportOptions& o = args->log;
   cmd->add_option("--episode-col", o.episode_column,
                   "integer episode column of the command stream (default: one episode per trial "
-                  "file, split at logging gaps)");
+                  "file; a single file is split into episodes at logging gaps)");
   cmd->add_option("--gap", o.gap_s,
                   "a pause longer than this (s) in the pose or attitude stream ends an episode "
                   "(0: 10 x the slower stream's median interval)")
