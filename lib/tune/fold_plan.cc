@@ -35,7 +35,9 @@ FoldPlan ChooseFolds(const SampleSet& set, int requested, bool group_by_episode,
                     ")";
     } else {
       plan.reason = automatic + std::to_string(plan.folds) + " folds of whole episodes (" +
-                    std::to_string(e) + " episodes)";
+                    std::to_string(e) + " episodes" +
+                    (requested == 0 ? ", at most " + std::to_string(max_auto_folds) + " folds" : "") +
+                    ")";
     }
     return plan;
   }

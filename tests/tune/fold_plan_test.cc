@@ -41,7 +41,7 @@ TEST(ChooseFolds, TenFoldsOfWholeEpisodesWhenThereAreMany) {
   const FoldPlan plan = ChooseFolds(set, 0, true);
   EXPECT_TRUE(plan.by_episode);
   EXPECT_EQ(plan.folds, 10);
-  EXPECT_NE(plan.reason.find("10 folds of whole episodes (41 episodes)"), std::string::npos)
+  EXPECT_NE(plan.reason.find("10 folds of whole episodes (41 episodes, at most 10 folds)"), std::string::npos)
       << plan.reason;
   CvOptions options;
   options.folds = 0;
