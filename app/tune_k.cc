@@ -334,11 +334,14 @@ void PrintSearch(const TuneKSummary& s) {
                            "k = {:.4g}\n",
                            s.bracket_lo, s.bracket_hi, s.fit_points, s.quadratic_k);
   if (s.plateau) {
-    std::cout << fmt::format(
-        "PLATEAU: {} evaluations within {:.3g} of the best, k from {:.4g} to {:.4g}; {}: k = "
-        "{:.5g}\n",
-        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, s.PlateauMeaning(),
-        cyclic.k);
+    // The meaning names the range itself unless the plateau is the whole grid.
+    const std::string range =
+        s.plateau_spans_grid
+            ? fmt::format(", k from {:.4g} to {:.4g} (the whole grid)", s.plateau_k_lo, s.plateau_k_hi)
+            : "";
+    std::cout << fmt::format("PLATEAU: {} evaluations within {:.3g} of the best{}: {}: k = {:.5g}\n",
+                             s.plateau_points, s.plateau_tolerance, range, s.PlateauMeaning(),
+                             cyclic.k);
   } else {
     std::cout << "k: " << s.k_rule << "\n";
   }

@@ -185,6 +185,13 @@ TEST(SmallData, DefaultFoldsWorkOnFortyOneShortTrials) {
   const RunResult too_many = RunDgmm({"cv", six, "--folds", "7", "--stratified", "--repeats", "1"});
   EXPECT_EQ(too_many.exit_code, 2);
   EXPECT_NE(too_many.err.find("omit --folds"), std::string::npos) << too_many.err;
+  // The suggested --folds works.
+  const size_t use = too_many.err.find("use --folds ");
+  ASSERT_NE(use, std::string::npos) << too_many.err;
+  const std::string suggested = too_many.err.substr(use + 12, too_many.err.find(' ', use + 12) - use - 12);
+  const RunResult fixed = RunDgmm({"cv", six, "--folds", suggested, "--stratified", "--repeats", "1",
+                                   "--quiet"});
+  EXPECT_EQ(fixed.exit_code, 0) << suggested << ": " << fixed.err;
 }
 
 TEST(TuneJson, KeysSayWhatTheyAre) {
