@@ -126,7 +126,8 @@ void PrintCvTable(const CvArgs& args, const CvSummary& summary) {
       fmt::format("{}", fmt::join(args.dgmm.init_cov, ",")));
   if (summary.unscored_per_repeat > 0) {
     std::cout << fmt::format(
-        "note: {} held-out samples per repeat not scored (their command has no other sample)\n",
+        "note: {} held-out samples per repeat not scored (their command has no sample outside "
+        "their fold, e.g. it was recorded in one episode)\n",
         summary.unscored_per_repeat);
   }
   std::cout << "held-out log-likelihood, summed over all validation folds of a repeat\n";
