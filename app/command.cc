@@ -1,5 +1,6 @@
 #include "app/command.h"
 
+#include <fmt/format.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -7,8 +8,6 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
-
-#include <fmt/format.h>
 
 #include "io/sample_set_io.h"
 #include "tune/dimensions.h"
@@ -92,7 +91,8 @@ void WarnIfUnderdetermined(const SampleSet& set, bool with_terrain, const std::s
   }
   if (list.empty()) return;
   std::vector<std::string> fixes = {"record more samples"};
-  if (accepts_dims) fixes.push_back("model fewer dimensions with dgmm " + what + " --pose-dims/--terrain-dims");
+  if (accepts_dims)
+    fixes.push_back("model fewer dimensions with dgmm " + what + " --pose-dims/--terrain-dims");
   if (terrain) fixes.push_back("drop the terrain with dgmm " + what + " --without-terrain");
   std::string fix;
   for (size_t i = 0; i < fixes.size(); ++i) {
@@ -114,9 +114,9 @@ InputError OptionsError(const std::string& file, const std::string& message,
 int CheckedFolds(const SampleSet& set, int folds, bool given, bool group_by_episode,
                  const std::string& path) {
   if (given && folds < 2) {
-    throw MakeInputError(path, "--folds",
-                         fmt::format("must be >= 2, got {} (omit --folds to choose from the data)",
-                                     folds));
+    throw MakeInputError(
+        path, "--folds",
+        fmt::format("must be >= 2, got {} (omit --folds to choose from the data)", folds));
   }
   FoldPlan plan;
   try {

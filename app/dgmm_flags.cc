@@ -105,7 +105,8 @@ std::vector<std::string> NonDefaultDgmmFlags(const DgmmFlags& f) {
   const DgmmFlags defaults;
   std::vector<std::string> words;
   if (f.variant != defaults.variant) words.insert(words.end(), {"--variant", f.variant});
-  if (f.covariance != defaults.covariance) words.insert(words.end(), {"--covariance", f.covariance});
+  if (f.covariance != defaults.covariance)
+    words.insert(words.end(), {"--covariance", f.covariance});
   if (f.init_cov != defaults.init_cov) {
     std::string joined;
     for (const auto& v : f.init_cov) joined += (joined.empty() ? "" : ",") + v;

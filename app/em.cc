@@ -127,8 +127,8 @@ void Run(const EmArgs& args) {
   std::printf("fitted an EM mixture per command (%s, %s, seed %llu, d = %d) on %s in %s\n",
               Plural(args.em.components, "component").c_str(),
               Plural(args.em.n_init, "restart").c_str(),
-              static_cast<unsigned long long>(args.em.seed), dim,
-              Plural(samples, "sample").c_str(), FormatSeconds(seconds).c_str());
+              static_cast<unsigned long long>(args.em.seed), dim, Plural(samples, "sample").c_str(),
+              FormatSeconds(seconds).c_str());
   for (const auto& c : commands) {
     std::printf("  command %d '%s': %s\n", c["command"].get<int>(),
                 c["label"].get<std::string>().c_str(), c["report"].get<std::string>().c_str());

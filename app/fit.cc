@@ -129,10 +129,9 @@ void Run(const FitArgs& args) {
     std::cout << out.dump(2) << "\n";
     return;
   }
-  std::printf(
-      "fitted a DGMM per command (k = %g, seed %llu, %s, d = %d) on %s in %s\n", args.k,
-      static_cast<unsigned long long>(args.seed), args.dgmm.variant.c_str(), model.dim(),
-      Plural(samples, "sample").c_str(), FormatSeconds(seconds).c_str());
+  std::printf("fitted a DGMM per command (k = %g, seed %llu, %s, d = %d) on %s in %s\n", args.k,
+              static_cast<unsigned long long>(args.seed), args.dgmm.variant.c_str(), model.dim(),
+              Plural(samples, "sample").c_str(), FormatSeconds(seconds).c_str());
   const DgmmOptions& o = model.dgmm_options;
   std::printf("  covariance %s%s, S0 %s (diagonal %s), floor %.3g\n",
               CovarianceRuleName(o.covariance_rule),

@@ -53,7 +53,8 @@ void Run(const ScoreArgs& args) {
               s.total_log_likelihood, Plural(s.samples, "sample").c_str(), s.mean_log_likelihood);
   for (const auto& [id, c] : score.by_command) {
     std::printf("  command %d '%s': %s, total %.10g, mean %.6f\n", id, c.label.c_str(),
-                Plural(c.samples, "sample").c_str(), c.total_log_likelihood, c.total_log_likelihood / c.samples);
+                Plural(c.samples, "sample").c_str(), c.total_log_likelihood,
+                c.total_log_likelihood / c.samples);
   }
 }
 

@@ -103,12 +103,12 @@ void PlotCurve(const TuneKSummary& s, const std::string& path) {
   // tolerance (the evaluations between the two lines are equivalent).
   if (s.plateau) {
     const double top = s.best_evaluated_log_likelihood, bottom = top - s.plateau_tolerance;
-    spec.series.push_back({fmt::format("plateau: {}", s.PlateauMeaning()),
-                           {s.plateau_k_lo, s.plateau_k_lo, s.plateau_k_hi, s.plateau_k_hi,
-                            s.plateau_k_lo},
-                           {bottom, top, top, bottom, bottom},
-                           {},
-                           std::array<unsigned char, 3>{120, 120, 120}});
+    spec.series.push_back(
+        {fmt::format("plateau: {}", s.PlateauMeaning()),
+         {s.plateau_k_lo, s.plateau_k_lo, s.plateau_k_hi, s.plateau_k_hi, s.plateau_k_lo},
+         {bottom, top, top, bottom, bottom},
+         {},
+         std::array<unsigned char, 3>{120, 120, 120}});
   }
   RenderLineChart(spec, path);
 }
@@ -198,14 +198,14 @@ std::vector<std::string> RecommendedFlags(const TuneKSummary& s, const TuneKArgs
   std::vector<std::string> words = {"--k", fmt::format("{:.6g}", s.k)};
   const DgmmFlags defaults;
   if (s.init_scale_tuned || args.dgmm.init_scale != defaults.init_scale) {
-    words.insert(words.end(), {"--init-scale", fmt::format("{:.6g}", s.init_scale_tuned
-                                                                         ? s.init_scale
-                                                                         : args.dgmm.init_scale)});
+    words.insert(words.end(),
+                 {"--init-scale",
+                  fmt::format("{:.6g}", s.init_scale_tuned ? s.init_scale : args.dgmm.init_scale)});
   }
   if (s.prior_count_tuned || args.dgmm.prior_count != defaults.prior_count) {
-    words.insert(words.end(), {"--prior-count", fmt::format("{:.6g}", s.prior_count_tuned
-                                                                           ? s.prior_count
-                                                                           : args.dgmm.prior_count)});
+    words.insert(words.end(), {"--prior-count",
+                               fmt::format("{:.6g}", s.prior_count_tuned ? s.prior_count
+                                                                         : args.dgmm.prior_count)});
   }
   const std::vector<std::string> other = NonDefaultDgmmFlags(args.dgmm);
   words.insert(words.end(), other.begin(), other.end());
@@ -217,8 +217,8 @@ std::vector<std::string> RecommendedFlags(const TuneKSummary& s, const TuneKArgs
 std::pair<std::string, std::string> Recipes(const TuneKSummary& s, const TuneKArgs& args) {
   const std::string flags = fmt::format("{}", fmt::join(RecommendedFlags(s, args), " "));
   const std::string terrain = s.with_terrain ? "" : " --without-terrain";
-  std::string fit = fmt::format("dgmm fit {} {}{} --seed {} -o model.h5", args.path, flags, terrain,
-                                args.seed);
+  std::string fit =
+      fmt::format("dgmm fit {} {}{} --seed {} -o model.h5", args.path, flags, terrain, args.seed);
   std::string cv = fmt::format("dgmm cv {} {}{}", args.path, flags, terrain);
   if (args.folds_given) cv += fmt::format(" --folds {}", args.folds);
   if (args.stratified) cv += " --stratified";
@@ -253,64 +253,63 @@ nlohmann::json PointsJson(const std::vector<TuneKPoint>& pts, const TuneKSummary
 nlohmann::json TuneJson(const TuneKSummary& s, const TuneKArgs& args, const TuneKOptions& options) {
   const auto [fit, cv] = Recipes(s, args);
   auto or_null = [](bool tuned, double v) { return tuned ? nlohmann::json(v) : nlohmann::json(); };
-  return {
-      {"file", args.path},
-      {"samples", s.samples},
-      {"with_terrain", s.with_terrain},
-      {"folds", s.folds},
-      {"folds_by", s.folds_by},
-      {"repeats", s.repeats},
-      {"seed", args.seed},
-      {"recommended",
-       {{"k", s.k},
-        {"init_scale", or_null(s.init_scale_tuned, s.init_scale)},
-        {"prior_count", or_null(s.prior_count_tuned, s.prior_count)},
-        {"log_likelihood", s.log_likelihood},
-        {"standard_error", s.standard_error},
-        {"sd", s.sd},
-        {"components_per_command", s.components},
-        {"flags", RecommendedFlags(s, args)},
-        {"fit_command", fit},
-        {"cv_command", cv}}},
-      {"k_search",
-       {{"grid", {{"k_min", s.k_min}, {"k_max", s.k_max}, {"points", options.grid_points}}},
-        {"best_grid_k", s.best_grid_k},
-        {"optimum_at_grid_edge", !s.grid_edge.empty()},
-        {"grid_edge", s.grid_edge.empty() ? nlohmann::json() : nlohmann::json(s.grid_edge)},
-        {"bracket", {s.bracket_lo, s.bracket_hi}},
-        {"quadratic_refinement",
-         {{"k_at_maximum", s.quadratic_k},
-          {"u0", s.u0},
-          {"a", s.a},
-          {"b", s.b},
-          {"c", s.c},
-          {"points", s.fit_points},
-          {"fit_report", s.fit_report},
-          {"maximise_report", s.maximise_report}}},
-        {"best_evaluated",
-         {{"k", s.best_evaluated_k}, {"log_likelihood", s.best_evaluated_log_likelihood}}},
-        {"plateau",
-         {{"flat", s.plateau},
-          {"k_range", {s.plateau_k_lo, s.plateau_k_hi}},
-          {"points", s.plateau_points},
-          {"tolerance", s.plateau_tolerance},
-          {"spans_whole_grid", s.plateau_spans_grid},
-          {"meaning", s.PlateauMeaning()}}},
-        {"rule", s.k_rule},
-        {"curve", PointsJson(s.curve, &s)}}},
-      {"init_scale_search",
-       {{"tuned", s.init_scale_tuned},
-        {"plateau", s.init_scale_plateau},
-        {"curve", PointsJson(s.scale_curve, nullptr)}}},
-      {"prior_count_search",
-       {{"tuned", s.prior_count_tuned},
-        {"plateau", s.prior_count_plateau},
-        {"curve", PointsJson(s.prior_curve, nullptr)}}},
-      {"joint", JointJson(s.joint)},
-      {"evaluations", s.evaluations},
-      {"cycles", s.cycles},
-      {"start_dgmm_options", DgmmOptionsJson(options.cv.dgmm)},
-      {"seconds", s.seconds}};
+  return {{"file", args.path},
+          {"samples", s.samples},
+          {"with_terrain", s.with_terrain},
+          {"folds", s.folds},
+          {"folds_by", s.folds_by},
+          {"repeats", s.repeats},
+          {"seed", args.seed},
+          {"recommended",
+           {{"k", s.k},
+            {"init_scale", or_null(s.init_scale_tuned, s.init_scale)},
+            {"prior_count", or_null(s.prior_count_tuned, s.prior_count)},
+            {"log_likelihood", s.log_likelihood},
+            {"standard_error", s.standard_error},
+            {"sd", s.sd},
+            {"components_per_command", s.components},
+            {"flags", RecommendedFlags(s, args)},
+            {"fit_command", fit},
+            {"cv_command", cv}}},
+          {"k_search",
+           {{"grid", {{"k_min", s.k_min}, {"k_max", s.k_max}, {"points", options.grid_points}}},
+            {"best_grid_k", s.best_grid_k},
+            {"optimum_at_grid_edge", !s.grid_edge.empty()},
+            {"grid_edge", s.grid_edge.empty() ? nlohmann::json() : nlohmann::json(s.grid_edge)},
+            {"bracket", {s.bracket_lo, s.bracket_hi}},
+            {"quadratic_refinement",
+             {{"k_at_maximum", s.quadratic_k},
+              {"u0", s.u0},
+              {"a", s.a},
+              {"b", s.b},
+              {"c", s.c},
+              {"points", s.fit_points},
+              {"fit_report", s.fit_report},
+              {"maximise_report", s.maximise_report}}},
+            {"best_evaluated",
+             {{"k", s.best_evaluated_k}, {"log_likelihood", s.best_evaluated_log_likelihood}}},
+            {"plateau",
+             {{"flat", s.plateau},
+              {"k_range", {s.plateau_k_lo, s.plateau_k_hi}},
+              {"points", s.plateau_points},
+              {"tolerance", s.plateau_tolerance},
+              {"spans_whole_grid", s.plateau_spans_grid},
+              {"meaning", s.PlateauMeaning()}}},
+            {"rule", s.k_rule},
+            {"curve", PointsJson(s.curve, &s)}}},
+          {"init_scale_search",
+           {{"tuned", s.init_scale_tuned},
+            {"plateau", s.init_scale_plateau},
+            {"curve", PointsJson(s.scale_curve, nullptr)}}},
+          {"prior_count_search",
+           {{"tuned", s.prior_count_tuned},
+            {"plateau", s.prior_count_plateau},
+            {"curve", PointsJson(s.prior_curve, nullptr)}}},
+          {"joint", JointJson(s.joint)},
+          {"evaluations", s.evaluations},
+          {"cycles", s.cycles},
+          {"start_dgmm_options", DgmmOptionsJson(options.cv.dgmm)},
+          {"seconds", s.seconds}};
 }
 
 // The k step, f and nu0 steps as text.
@@ -330,26 +329,27 @@ void PrintSearch(const TuneKSummary& s) {
                              p.log_likelihood, p.standard_error, s.Smoothed(p.k), p.components,
                              p.role);
   }
-  std::cout << fmt::format("bracket [{:.4g}, {:.4g}]; quadratic refinement on {} points: maximum at "
-                           "k = {:.4g}\n",
-                           s.bracket_lo, s.bracket_hi, s.fit_points, s.quadratic_k);
+  std::cout << fmt::format(
+      "bracket [{:.4g}, {:.4g}]; quadratic refinement on {} points: maximum at "
+      "k = {:.4g}\n",
+      s.bracket_lo, s.bracket_hi, s.fit_points, s.quadratic_k);
   if (s.plateau) {
     // The meaning names the range itself unless the plateau is the whole grid.
-    const std::string range =
-        s.plateau_spans_grid
-            ? fmt::format(", k from {:.4g} to {:.4g} (the whole grid)", s.plateau_k_lo, s.plateau_k_hi)
-            : "";
-    std::cout << fmt::format("PLATEAU: {} evaluations within {:.3g} of the best{}: {}: k = {:.5g}\n",
-                             s.plateau_points, s.plateau_tolerance, range, s.PlateauMeaning(),
-                             cyclic.k);
+    const std::string range = s.plateau_spans_grid
+                                  ? fmt::format(", k from {:.4g} to {:.4g} (the whole grid)",
+                                                s.plateau_k_lo, s.plateau_k_hi)
+                                  : "";
+    std::cout << fmt::format(
+        "PLATEAU: {} evaluations within {:.3g} of the best{}: {}: k = {:.5g}\n", s.plateau_points,
+        s.plateau_tolerance, range, s.PlateauMeaning(), cyclic.k);
   } else {
     std::cout << "k: " << s.k_rule << "\n";
   }
   if (!s.grid_edge.empty() && !s.plateau_spans_grid) {
-    std::cout << fmt::format("k at the {} end of the grid [{:.4g}, {:.4g}]: the optimum may lie "
-                             "beyond it (widen {})\n",
-                             s.grid_edge, s.k_min, s.k_max,
-                             s.grid_edge == "low" ? "--k-min" : "--k-max");
+    std::cout << fmt::format(
+        "k at the {} end of the grid [{:.4g}, {:.4g}]: the optimum may lie "
+        "beyond it (widen {})\n",
+        s.grid_edge, s.k_min, s.k_max, s.grid_edge == "low" ? "--k-min" : "--k-max");
   }
   auto print_side = [](const char* name, const std::vector<TuneKPoint>& pts, bool scale) {
     for (const auto& p : pts) {
@@ -411,7 +411,8 @@ TuneKOptions MakeTuneOptions(const TuneKArgs& args, const SampleSet& set) {
 
 void RunTuneK(const TuneKArgs& args) {
   if (args.folds_given && args.folds < 2) {
-    throw MakeInputError(args.path, "--folds", "must be >= 2 (omit --folds to choose from the data)");
+    throw MakeInputError(args.path, "--folds",
+                         "must be >= 2 (omit --folds to choose from the data)");
   }
   // Unwritable output folders are reported before the long run, not after it.
   for (const auto& [output, flag] :
@@ -432,11 +433,11 @@ void RunTuneK(const TuneKArgs& args) {
     std::cout << TuneJson(s, args, options).dump(2) << "\n";
     return;
   }
-  std::cout << fmt::format(
-      "{}: {}, {} x {}-fold, {} terrain, seed {}; {} in {} ({})\n", args.path,
-      Plural(s.samples, "sample"), s.repeats, s.folds, s.with_terrain ? "with" : "without",
-      args.seed, Plural(s.evaluations, "cross-validation"), Plural(s.cycles, "cycle"),
-      FormatSeconds(s.seconds));
+  std::cout << fmt::format("{}: {}, {} x {}-fold, {} terrain, seed {}; {} in {} ({})\n", args.path,
+                           Plural(s.samples, "sample"), s.repeats, s.folds,
+                           s.with_terrain ? "with" : "without", args.seed,
+                           Plural(s.evaluations, "cross-validation"), Plural(s.cycles, "cycle"),
+                           FormatSeconds(s.seconds));
   std::cout << "folds: " << s.folds_by << "\n";
   PrintSearch(s);
   PrintJoint(s);

@@ -11,7 +11,7 @@ namespace dgmm {
 
 struct CommandBinOptions {
   enum class Rule { kQuantile, kWidth };
-  int bins = 0;               // > 0: this many bins of the non-zero values (rule)
+  int bins = 0;  // > 0: this many bins of the non-zero values (rule)
   Rule rule = Rule::kQuantile;
   std::vector<double> edges;  // non-empty: explicit increasing inner edges (bins = edges + 1)
   bool zero_is_own_bin = true;

@@ -176,7 +176,8 @@ CsvTable ReadCsv(const std::string& path, char delimiter, bool has_header) {
     }
   }
   if (table.header.empty()) {
-    throw MakeInputError(path, "", has_header ? "empty file (expected a header row)" : "empty file");
+    throw MakeInputError(path, "",
+                         has_header ? "empty file (expected a header row)" : "empty file");
   }
   return table;
 }

@@ -32,7 +32,8 @@ std::vector<std::string> CsvFilesIn(const fs::path& folder) {
   std::vector<std::string> files;
   for (const auto& entry : fs::directory_iterator(folder)) {
     std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return std::tolower(c); });
     if (entry.is_regular_file() && ext == ".csv") files.push_back(entry.path().string());
   }
   return files;
@@ -40,7 +41,8 @@ std::vector<std::string> CsvFilesIn(const fs::path& folder) {
 
 // "007" -> "7" for an all-digit key; anything else unchanged.
 std::string Canonical(const std::string& key) {
-  if (key.empty() || !std::all_of(key.begin(), key.end(), [](unsigned char c) { return std::isdigit(c); })) {
+  if (key.empty() ||
+      !std::all_of(key.begin(), key.end(), [](unsigned char c) { return std::isdigit(c); })) {
     return key;
   }
   const size_t first = key.find_first_not_of('0');
@@ -69,10 +71,14 @@ std::vector<std::string> TrialKeys(const std::vector<std::string>& names) {
   if (names.size() <= 1) return std::vector<std::string>(names.size());
   size_t prefix = names[0].size(), suffix = names[0].size();
   for (const std::string& n : names) {
-    prefix = std::min(prefix, static_cast<size_t>(std::mismatch(n.begin(), n.end(), names[0].begin(),
-                                                                names[0].end()).first - n.begin()));
-    suffix = std::min(suffix, static_cast<size_t>(std::mismatch(n.rbegin(), n.rend(), names[0].rbegin(),
-                                                                names[0].rend()).first - n.rbegin()));
+    prefix = std::min(
+        prefix,
+        static_cast<size_t>(
+            std::mismatch(n.begin(), n.end(), names[0].begin(), names[0].end()).first - n.begin()));
+    suffix = std::min(
+        suffix, static_cast<size_t>(
+                    std::mismatch(n.rbegin(), n.rend(), names[0].rbegin(), names[0].rend()).first -
+                    n.rbegin()));
   }
   // Never end the prefix or start the suffix inside a number or a word ("trial_1" of trial_1,
   // trial_10; "t/pose.csv" of left/pose.csv, right/pose.csv).
@@ -156,9 +162,11 @@ std::vector<LogTrial> PairTrials(const std::vector<std::string>& commands,
   // Trials in file order of the commands stream (numbers compare as numbers).
   std::sort(trials.begin(), trials.end(), [](const LogTrial& a, const LogTrial& b) {
     const bool na = !a.name.empty() && std::isdigit(static_cast<unsigned char>(a.name[0])) &&
-                    a.name.size() < 19 && a.name.find_first_not_of("0123456789") == std::string::npos;
+                    a.name.size() < 19 &&
+                    a.name.find_first_not_of("0123456789") == std::string::npos;
     const bool nb = !b.name.empty() && std::isdigit(static_cast<unsigned char>(b.name[0])) &&
-                    b.name.size() < 19 && b.name.find_first_not_of("0123456789") == std::string::npos;
+                    b.name.size() < 19 &&
+                    b.name.find_first_not_of("0123456789") == std::string::npos;
     if (na && nb) return std::stoll(a.name) < std::stoll(b.name);
     return a.commands < b.commands;
   });

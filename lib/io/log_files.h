@@ -9,8 +9,8 @@
 namespace dgmm {
 
 // The CSV files a stream option names, sorted: the file itself, the *.csv files of a folder, or
-// the matches of a glob pattern (*, ?, [...], {a,b}). InputError naming `flag` and the path when nothing
-// matches.
+// the matches of a glob pattern (*, ?, [...], {a,b}). InputError naming `flag` and the path when
+// nothing matches.
 std::vector<std::string> ResolveStreamFiles(const std::string& path, const std::string& flag);
 
 // One trial: a file of each stream (attitude empty when there is no attitude stream).

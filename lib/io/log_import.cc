@@ -39,7 +39,8 @@ double RowTime(const CsvTable& table, const CsvRecord& r, size_t index, int col,
   if (stream.rate_hz > 0) return static_cast<double>(index) / stream.rate_hz;
   const double t = table.Number(r, col) * unit;
   if (!previous.empty() && t <= previous.back()) {
-    throw MakeInputError(path, "line " + std::to_string(r.line) + ", column '" + stream.time_column + "'",
+    throw MakeInputError(path,
+                         "line " + std::to_string(r.line) + ", column '" + stream.time_column + "'",
                          "time does not increase (expected rows sorted by time)");
   }
   return t;
@@ -60,7 +61,8 @@ Series ReadSeries(const std::string& path, const LogStream& stream, const LogImp
     const CsvRecord& r = table.records[i];
     try {
       table.CheckFieldCount(r);
-      const double t = RowTime(table, r, i, time_col, stream, path, Unit(o, stream.time_column), s.t);
+      const double t =
+          RowTime(table, r, i, time_col, stream, path, Unit(o, stream.time_column), s.t);
       std::vector<double> v;
       for (size_t j = 0; j < cols.size(); ++j) v.push_back(table.Number(r, cols[j]) * Unit(o, stream.columns[j]));
       s.t.push_back(t);
@@ -106,16 +108,19 @@ std::vector<double> RowKey(const CsvTable& table, const CsvRecord& r, const std:
       continue;
     }
     if (cell.empty()) {
-      throw MakeInputError(path, "line " + std::to_string(r.line) + ", column '" + o.commands.columns[j] + "'",
-                           "empty command label");
+      throw MakeInputError(
+          path, "line " + std::to_string(r.line) + ", column '" + o.commands.columns[j] + "'",
+          "empty command label");
     }
-    key.push_back(shared->codes[j].try_emplace(cell, static_cast<int>(shared->codes[j].size())).first->second);
+    key.push_back(shared->codes[j]
+                      .try_emplace(cell, static_cast<int>(shared->codes[j].size()))
+                      .first->second);
   }
   return key;
 }
 
-CommandRows ReadCommands(const std::string& path, const LogImportOptions& o,
-                         CommandColumns* shared, InvalidRows* invalid, long long* rows) {
+CommandRows ReadCommands(const std::string& path, const LogImportOptions& o, CommandColumns* shared,
+                         InvalidRows* invalid, long long* rows) {
   const LogStream& s = o.commands;
   const CsvTable table = ReadCsv(path, o.delimiter, o.has_header);
   const int time_col = s.rate_hz > 0 ? -1 : table.Column(s.time_column);
@@ -144,8 +149,9 @@ CommandRows ReadCommands(const std::string& path, const LogImportOptions& o,
       if (episode_col >= 0) {
         const double e = table.Number(r, episode_col);
         if (e != std::floor(e) || std::abs(e) > 2e9) {
-          throw MakeInputError(path, "line " + std::to_string(r.line) + ", column '" + o.episode_column + "'",
-                               "episode id must be an integer");
+          throw MakeInputError(
+              path, "line " + std::to_string(r.line) + ", column '" + o.episode_column + "'",
+              "episode id must be an integer");
         }
         episode = static_cast<int>(e);
       }
@@ -194,7 +200,8 @@ void KeyCommands(const LogImportOptions& o, const CommandColumns& shared,
     for (size_t i = 0; i < c.t.size(); ++i) {
       std::string label;
       for (size_t j = 0; j < o.commands.columns.size(); ++j) {
-        label += (j ? "," : "") + (shared.numeric[j] == 1 ? FormatNumber(c.key[i][j]) : c.text[i][j]);
+        label +=
+            (j ? "," : "") + (shared.numeric[j] == 1 ? FormatNumber(c.key[i][j]) : c.text[i][j]);
       }
       c.label.push_back(o.commands.columns.empty() ? "all" : label);
     }
@@ -239,8 +246,8 @@ void SampleSink::Add(const CommandRows& c, size_t row, const TrialStreams& s, do
                      int episode_id, int step_in_episode, bool per_second) {
   const Series& pose = s.pose;
   // The duration the pose change covers (the pose is held at the stream's ends).
-  const double duration = std::clamp(t1, pose.t.front(), pose.t.back()) -
-                          std::clamp(t0, pose.t.front(), pose.t.back());
+  const double duration =
+      std::clamp(t1, pose.t.front(), pose.t.back()) - std::clamp(t0, pose.t.front(), pose.t.back());
   const size_t first = xs.size();
   const Eigen::VectorXd dx = BodyFramePoseChange(pose, t0, t1);
   xs.insert(xs.end(), dx.data(), dx.data() + dx.size());
@@ -249,7 +256,8 @@ void SampleSink::Add(const CommandRows& c, size_t row, const TrialStreams& s, do
   }
   if (s.has_attitude) {
     const auto ba = Bracket(s.attitude.t, t0);
-    for (const auto& column : s.attitude.values) zs.push_back(std::remainder(Lerp(column, ba), 2 * std::numbers::pi));
+    for (const auto& column : s.attitude.values)
+      zs.push_back(std::remainder(Lerp(column, ba), 2 * std::numbers::pi));
   }
   auto [it, fresh] = command_ids.try_emplace(c.key[row], static_cast<int>(table_rows.size()));
   if (fresh) {
@@ -414,7 +422,8 @@ void CheckDurations(const std::vector<double>& durations, const LogImportOptions
 
 void CheckUnits(const LogImportOptions& o) {
   std::set<std::string> known = {o.commands.time_column, o.pose.time_column, o.episode_column};
-  for (const auto* s : {&o.commands, &o.pose, &o.attitude}) known.insert(s->columns.begin(), s->columns.end());
+  for (const auto* s : {&o.commands, &o.pose, &o.attitude})
+    known.insert(s->columns.begin(), s->columns.end());
   if (!o.attitude.path.empty()) known.insert(o.attitude.time_column);
   for (const auto& [column, factor] : o.units) {
     if (!known.count(column)) {
@@ -475,7 +484,10 @@ SampleSet Assemble(SampleSink& sink, const LogImportOptions& o, const std::vecto
 }  // namespace
 
 bool LogImportOptions::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& m) { *error = m; return false; };
+  auto fail = [&](const std::string& m) {
+    *error = m;
+    return false;
+  };
   if (commands.path.empty()) return fail("--commands: a command stream is required");
   if (pose.path.empty()) return fail("--pose: a pose stream is required");
   if (pose.columns.size() != 3 && pose.columns.size() != 6) {
@@ -490,8 +502,10 @@ bool LogImportOptions::IsValid(std::string* error) const {
   }
   if (!(gap_s >= 0) || !std::isfinite(gap_s)) return fail("--gap: expected seconds >= 0");
   if (!(window_s >= 0) || !std::isfinite(window_s)) return fail("--window: expected seconds >= 0");
-  if (!(min_duration_s >= 0) || !std::isfinite(min_duration_s)) return fail("--min-duration: expected seconds >= 0");
-  for (const auto& [stream, flag] : {std::pair{&commands, "--commands-rate"}, {&pose, "--pose-rate"},
+  if (!(min_duration_s >= 0) || !std::isfinite(min_duration_s))
+    return fail("--min-duration: expected seconds >= 0");
+  for (const auto& [stream, flag] : {std::pair{&commands, "--commands-rate"},
+                                     {&pose, "--pose-rate"},
                                      {&attitude, "--attitude-rate"}}) {
     if (!(stream->rate_hz >= 0) || !std::isfinite(stream->rate_hz)) {
       return fail(std::string(flag) + ": expected rows per second >= 0");
@@ -501,19 +515,21 @@ bool LogImportOptions::IsValid(std::string* error) const {
     return fail("--time-tolerance: expected seconds >= 0");
   }
   if (window_s > 0 && 2 * time_tolerance_s >= window_s) {
-    return fail("--time-tolerance: must be shorter than half the --window (it applies at each end)");
+    return fail(
+        "--time-tolerance: must be shorter than half the --window (it applies at each end)");
   }
   return bins.IsValid(error);
 }
 
 std::string LogImportSummary::BriefReport() const {
   char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "%d samples from %d episodes%s (%d command segments, %d shorter than %.3g s skipped; "
-                "gap %.3g s); rows: %lld commands, %lld pose, %lld attitude, %lld dropped",
-                samples, episodes, trials > 1 ? (" in " + std::to_string(trials) + " trials").c_str() : "",
-                segments, short_segments, min_duration_s, gap_s, command_rows, pose_rows,
-                attitude_rows, dropped_rows);
+  std::snprintf(
+      buf, sizeof buf,
+      "%d samples from %d episodes%s (%d command segments, %d shorter than %.3g s skipped; "
+      "gap %.3g s); rows: %lld commands, %lld pose, %lld attitude, %lld dropped",
+      samples, episodes, trials > 1 ? (" in " + std::to_string(trials) + " trials").c_str() : "",
+      segments, short_segments, min_duration_s, gap_s, command_rows, pose_rows, attitude_rows,
+      dropped_rows);
   return buf;
 }
 
@@ -529,11 +545,12 @@ std::string LogImportSummary::WindowReport() const {
                                      " coverage");
   add(trials_without_overlap, "trials whose streams do not overlap in time");
   add(dropped_rows, "invalid rows");
-  std::string out = "windows: " + std::to_string(samples) + " kept; dropped: " +
-                    (dropped.empty() ? "none" : dropped);
+  std::string out = "windows: " + std::to_string(samples) +
+                    " kept; dropped: " + (dropped.empty() ? "none" : dropped);
   if (near_miss_remainders > 0) {
-    out += "; " + std::to_string(near_miss_remainders) + " of them fell short of a window by at most " +
-           FormatNumber(largest_near_miss_s) + " s (time tolerance " + FormatNumber(time_tolerance_s) +
+    out += "; " + std::to_string(near_miss_remainders) +
+           " of them fell short of a window by at most " + FormatNumber(largest_near_miss_s) +
+           " s (time tolerance " + FormatNumber(time_tolerance_s) +
            " s at each end of a window; keep them with --time-tolerance " +
            FormatNumber(0.5 * largest_near_miss_s * 1.01) + ")";
   }
@@ -598,10 +615,12 @@ SampleSet ImportLog(const LogImportOptions& o, LogImportSummary* summary_out) {
     throw MakeInputError(trials[0].commands, "",
                          "no samples: every command segment was shorter than " +
                              FormatNumber(summary.min_duration_s) +
-                             " s (continuous commands need --bins) (" + summary.WindowReport() + ")");
+                             " s (continuous commands need --bins) (" + summary.WindowReport() +
+                             ")");
   }
-  SampleSet set = Assemble(sink, o, trials, summary, streams[0].six_dof,
-                           streams[0].has_attitude ? static_cast<int>(o.attitude.columns.size()) : 0);
+  SampleSet set =
+      Assemble(sink, o, trials, summary, streams[0].six_dof,
+               streams[0].has_attitude ? static_cast<int>(o.attitude.columns.size()) : 0);
   if (std::string e = set.Validate(); !e.empty()) throw MakeInputError(trials[0].commands, "", e);
   return set;
 }

@@ -21,7 +21,6 @@ Eigen::Vector3d ToRpy(const Eigen::Matrix3d& r) {
           std::atan2(r(1, 0), r(0, 0))};
 }
 
-
 }  // namespace
 
 // Replaces an angle series by its continuous version: each step is the shortest arc.
@@ -84,10 +83,13 @@ Eigen::VectorXd BodyFramePoseChange(const Series& pose, double t0, double t1) {
   const auto b0 = Bracket(pose.t, t0), b1 = Bracket(pose.t, t1);
   if (pose.values.size() == 6) {
     auto at = [&](std::pair<size_t, double> b) {
-      return Eigen::Vector3d(Lerp(pose.values[0], b), Lerp(pose.values[1], b), Lerp(pose.values[2], b));
+      return Eigen::Vector3d(Lerp(pose.values[0], b), Lerp(pose.values[1], b),
+                             Lerp(pose.values[2], b));
     };
     auto rotation = [&](std::pair<size_t, double> b) {
-      auto q = [&](size_t i) { return FromRpy(pose.values[3][i], pose.values[4][i], pose.values[5][i]); };
+      auto q = [&](size_t i) {
+        return FromRpy(pose.values[3][i], pose.values[4][i], pose.values[5][i]);
+      };
       return q(b.first).slerp(b.second, q(b.first + 1));  // shortest arc
     };
     const Eigen::Quaterniond q0 = rotation(b0), q1 = rotation(b1);

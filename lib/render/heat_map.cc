@@ -5,17 +5,17 @@
 #include <vtkChartHistogram2D.h>
 #include <vtkColorLegend.h>
 #include <vtkColorTransferFunction.h>
-#include <vtkDiscretizableColorTransferFunction.h>
 #include <vtkContextScene.h>
 #include <vtkContourFilter.h>
+#include <vtkDiscretizableColorTransferFunction.h>
 #include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkPlotLine.h>
 #include <vtkPlotPoints.h>
 #include <vtkPolyData.h>
-#include <vtkTable.h>
-#include <vtkStringArray.h>
 #include <vtkRenderWindow.h>
+#include <vtkStringArray.h>
+#include <vtkTable.h>
 #include <vtkTextProperty.h>
 #include <vtkTextRenderer.h>
 
@@ -268,8 +268,8 @@ std::vector<std::array<double, 4>> XTickBoxes(vtkChartHistogram2D* chart, const 
     vtkTextRenderer::GetInstance()->GetBoundingBox(property, text, box, dpi);
     const double width = box[1] - box[0] + 1, height = box[3] - box[2] + 1;
     const double centre = layout.ToPixel(positions->GetValue(k), layout.range.y_min).x();
-    boxes.push_back({centre - width / 2, centre + width / 2, layout.bottom - 5 - height,
-                     layout.bottom - 5});
+    boxes.push_back(
+        {centre - width / 2, centre + width / 2, layout.bottom - 5 - height, layout.bottom - 5});
   }
   return boxes;
 }

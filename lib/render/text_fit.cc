@@ -41,8 +41,8 @@ namespace {
 
 // `line` broken at `separator` into lines no wider than block_px (greedy; a piece wider than that
 // stays whole). The separator's trailing space is dropped at a break ("a, b" -> "a,\nb").
-std::string WrapAt(const std::string& line, const std::string& separator, double block_px,
-                   int size, const std::function<double(const std::string&, int)>& width) {
+std::string WrapAt(const std::string& line, const std::string& separator, double block_px, int size,
+                   const std::function<double(const std::string&, int)>& width) {
   std::string out, current;
   size_t start = 0;
   while (start <= line.size()) {
@@ -62,7 +62,8 @@ std::string WrapAt(const std::string& line, const std::string& separator, double
 }
 
 // f applied to each line of `text` ('\n'-separated), the results joined by '\n'.
-std::string MapLines(const std::string& text, const std::function<std::string(const std::string&)>& f) {
+std::string MapLines(const std::string& text,
+                     const std::function<std::string(const std::string&)>& f) {
   std::string out;
   size_t start = 0;
   while (start <= text.size()) {

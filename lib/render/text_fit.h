@@ -1,7 +1,7 @@
 #pragma once
 // Titles and tick labels that fit their room: a smaller font, line breaks (no VTK here).
-#include <string>
 #include <functional>
+#include <string>
 #include <utility>
 #include <vector>
 

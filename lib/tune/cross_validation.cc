@@ -176,7 +176,8 @@ std::array<bool, 2> EmRowsToRun(const SampleSet& set, const std::vector<std::vec
       continue;
     }
     const int d = set.pose_dim() + (terrain ? set.terrain_dim() : 0);
-    std::string& why = terrain ? summary->em_with_terrain_omitted : summary->em_without_terrain_omitted;
+    std::string& why =
+        terrain ? summary->em_with_terrain_omitted : summary->em_without_terrain_omitted;
     why = EmUnderdetermined(set, fold_of, options.folds, d);
     em_for[terrain] = why.empty();
   }
@@ -404,7 +405,8 @@ std::string CvSummary::BriefReport() const {
   if (!em_without_terrain_omitted.empty()) {
     out << "; EM-BIC without terrain omitted: " << em_without_terrain_omitted;
   }
-  if (!em_with_terrain_omitted.empty()) out << "; EM-BIC with terrain omitted: " << em_with_terrain_omitted;
+  if (!em_with_terrain_omitted.empty())
+    out << "; EM-BIC with terrain omitted: " << em_with_terrain_omitted;
   return out.str();
 }
 

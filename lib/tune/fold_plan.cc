@@ -14,8 +14,8 @@ FoldPlan ChooseFolds(const SampleSet& set, int requested, bool group_by_episode,
   assert(max_auto_folds >= 2);
   FoldPlan plan;
   if (set.has_sequence()) {
-    plan.episodes = static_cast<int>(
-        std::set<int>(set.episode.data(), set.episode.data() + set.size()).size());
+    plan.episodes =
+        static_cast<int>(std::set<int>(set.episode.data(), set.episode.data() + set.size()).size());
   }
   const int e = plan.episodes;
   std::map<int, int> per_command;
@@ -30,14 +30,14 @@ FoldPlan ChooseFolds(const SampleSet& set, int requested, bool group_by_episode,
     plan.by_episode = true;
     plan.folds = requested > 0 ? requested : std::min(max_auto_folds, e);
     if (plan.folds == e) {
-      plan.reason = automatic + "leave-one-episode-out (" + std::to_string(e) + " episodes" +
-                    (requested == 0 ? ", at most " + std::to_string(max_auto_folds) + " folds" : "") +
-                    ")";
+      plan.reason =
+          automatic + "leave-one-episode-out (" + std::to_string(e) + " episodes" +
+          (requested == 0 ? ", at most " + std::to_string(max_auto_folds) + " folds" : "") + ")";
     } else {
-      plan.reason = automatic + std::to_string(plan.folds) + " folds of whole episodes (" +
-                    std::to_string(e) + " episodes" +
-                    (requested == 0 ? ", at most " + std::to_string(max_auto_folds) + " folds" : "") +
-                    ")";
+      plan.reason =
+          automatic + std::to_string(plan.folds) + " folds of whole episodes (" +
+          std::to_string(e) + " episodes" +
+          (requested == 0 ? ", at most " + std::to_string(max_auto_folds) + " folds" : "") + ")";
     }
     return plan;
   }
@@ -58,11 +58,10 @@ FoldPlan ChooseFolds(const SampleSet& set, int requested, bool group_by_episode,
     why = "only " + std::to_string(e) + " episodes for " + std::to_string(requested) + " folds";
   }
   plan.folds = requested > 0 ? requested : std::clamp(smallest, 2, max_auto_folds);
-  plan.reason = automatic + std::to_string(plan.folds) + " folds stratified by command (" + why +
-                (requested == 0 ? "; smallest command with 2+ samples has " +
-                                      std::to_string(smallest)
-                                : "") +
-                ")";
+  plan.reason =
+      automatic + std::to_string(plan.folds) + " folds stratified by command (" + why +
+      (requested == 0 ? "; smallest command with 2+ samples has " + std::to_string(smallest) : "") +
+      ")";
   return plan;
 }
 

@@ -346,11 +346,11 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
     // The chosen k at an end of the grid, else the best grid point at one (either end).
     auto at_low = [&](double k) { return k <= options.k_min * (1 + 1e-9); };
     auto at_high = [&](double k) { return k >= options.k_max * (1 - 1e-9); };
-    summary.grid_edge = at_low(summary.k)               ? "low"
-                        : at_high(summary.k)            ? "high"
-                        : at_low(summary.best_grid_k)   ? "low"
-                        : at_high(summary.best_grid_k)  ? "high"
-                                                        : "";
+    summary.grid_edge = at_low(summary.k)              ? "low"
+                        : at_high(summary.k)           ? "high"
+                        : at_low(summary.best_grid_k)  ? "low"
+                        : at_high(summary.best_grid_k) ? "high"
+                                                       : "";
   }
   summary.init_scale = chosen.init_scale;
   summary.prior_count = chosen.prior_count;
@@ -382,8 +382,7 @@ std::string TuneKSummary::BriefReport() const {
       << " (" << repeats << " x " << folds << "-fold, " << (with_terrain ? "with" : "without")
       << " terrain); bracket [" << bracket_lo << ", " << bracket_hi << "]"
       << (grid_edge.empty() ? "" : "; k at the " + grid_edge + " end of the grid") << "; "
-      << curve.size()
-      << " evaluations of k; k chosen by " << k_rule
+      << curve.size() << " evaluations of k; k chosen by " << k_rule
       << (plateau ? " (" + PlateauMeaning() + ")" : "") << "; " << evaluations
       << " cross-validations in " << cycles << " cycle(s)";
   if (init_scale_tuned) {

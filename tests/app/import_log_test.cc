@@ -119,9 +119,22 @@ namespace {
 // whole second after the first command row.
 std::vector<std::string> CarArgs(const std::string& out) {
   const std::string root = SourcePath("datasets/f1tenth").string();
-  return {"import-log", "--commands", root + "/measurement_*/input.csv", "--command-cols", "1,2",
-          "--pose", root + "/measurement_*/trajectory.csv", "--pose-cols", "1,2,3", "--no-header",
-          "--rate", "40", "--window", "1", "-o", out};
+  return {"import-log",
+          "--commands",
+          root + "/measurement_*/input.csv",
+          "--command-cols",
+          "1,2",
+          "--pose",
+          root + "/measurement_*/trajectory.csv",
+          "--pose-cols",
+          "1,2,3",
+          "--no-header",
+          "--rate",
+          "40",
+          "--window",
+          "1",
+          "-o",
+          out};
 }
 
 TEST(ImportLogCommand, FolderOfTrialsFromAPublicLog) {

@@ -54,8 +54,9 @@ SampleSet WithoutTerrain(SampleSet set) {
 
 // Runs tune (text), then every command line it printed; cv's DGMM row reproduces tune's value.
 void RunPrintedRecipes(const std::string& set, const fs::path& dir, bool terrain) {
-  std::vector<std::string> args = {"tune", set, "--repeats", "2", "--grid-points", "4",
-                                   "--refine-points", "1", "--no-joint", "--quiet"};
+  std::vector<std::string> args = {"tune",          set,      "--repeats",       "2",
+                                   "--grid-points", "4",      "--refine-points", "1",
+                                   "--no-joint",    "--quiet"};
   const RunResult tune = RunDgmm(args);
   ASSERT_EQ(tune.exit_code, 0) << tune.err;
   args.push_back("--json");
@@ -94,10 +95,10 @@ TEST(TuneRecipes, EveryPrintedLineRunsWithAndWithoutTerrain) {
   WriteSampleSet(WithEpisodes(WithoutTerrain(MakeTerrainSet(3, 16, 1.0, 4)), 8), without);
   RunPrintedRecipes(with, dir, true);
   RunPrintedRecipes(without, dir, false);
-  // tune --without-terrain on a set with terrain: the recipe says --without-terrain, and cv runs it.
-  const RunResult r = RunDgmm({"tune", with, "--without-terrain", "--repeats", "1",
-                               "--grid-points", "3", "--refine-points", "0", "--no-joint",
-                               "--quiet"});
+  // tune --without-terrain on a set with terrain: the recipe says --without-terrain, and cv runs
+  // it.
+  const RunResult r = RunDgmm({"tune", with, "--without-terrain", "--repeats", "1", "--grid-points",
+                               "3", "--refine-points", "0", "--no-joint", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const std::vector<std::string> cv = Words(LineAfter(r.out, "cross-validate with: "));
   ASSERT_NE(std::find(cv.begin(), cv.end(), "--without-terrain"), cv.end());
@@ -110,9 +111,9 @@ TEST(TuneRecipes, UserDgmmFlagsAreCarriedIntoTheRecipes) {
   const fs::path dir = MakeTempDir("tune_recipes_flags");
   const std::string set = (dir / "set.h5").string();
   WriteSampleSet(MakeTerrainSet(2, 20, 1.0, 5), set);
-  const RunResult r = RunDgmm({"tune", set, "--covariance", "blend", "--variant", "improved",
-                               "--repeats", "1", "--grid-points", "3", "--refine-points", "0",
-                               "--no-joint", "--quiet"});
+  const RunResult r =
+      RunDgmm({"tune", set, "--covariance", "blend", "--variant", "improved", "--repeats", "1",
+               "--grid-points", "3", "--refine-points", "0", "--no-joint", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* prefix : {"fit with: ", "cross-validate with: "}) {
     const std::string line = LineAfter(r.out, prefix);
@@ -129,8 +130,10 @@ TEST(TuneRecipes, WarningsSuggestOnlyFlagsTheCommandAccepts) {
   WriteSampleSet(MakeTerrainSet(2, 8, 1.0, 6), set);  // 8 samples, 14 parameters in d = 4
   for (const std::string command : {"em", "cv", "tune"}) {
     std::vector<std::string> args = {command, set};
-    if (command == "em") args.insert(args.end(), {"-o", (dir / "em.h5").string(), "--components", "1"});
-    if (command == "tune") args.insert(args.end(), {"--grid-points", "3", "--refine-points", "0", "--no-joint"});
+    if (command == "em")
+      args.insert(args.end(), {"-o", (dir / "em.h5").string(), "--components", "1"});
+    if (command == "tune")
+      args.insert(args.end(), {"--grid-points", "3", "--refine-points", "0", "--no-joint"});
     if (command != "em") args.insert(args.end(), {"--repeats", "1"});
     const RunResult r = RunDgmm(args);
     ASSERT_EQ(r.exit_code, 0) << command << ": " << r.err;
@@ -156,7 +159,9 @@ TEST(SmallData, DefaultFoldsWorkOnFortyOneShortTrials) {
   WriteSampleSet(set, path);
   const RunResult cv = RunDgmm({"cv", path, "--repeats", "1", "--quiet"});
   ASSERT_EQ(cv.exit_code, 0) << cv.err;
-  EXPECT_EQ(LineAfter(cv.out, "folds: ").rfind("automatic: 10 folds of whole episodes (41 episodes, at most 10 folds)", 0), 0u)
+  EXPECT_EQ(LineAfter(cv.out, "folds: ")
+                .rfind("automatic: 10 folds of whole episodes (41 episodes, at most 10 folds)", 0),
+            0u)
       << cv.out;
   // The EM reference is omitted with the reason, not printed as a result.
   EXPECT_NE(cv.out.find("EM-BIC without terrain: omitted, command"), std::string::npos) << cv.out;
@@ -169,7 +174,8 @@ TEST(SmallData, DefaultFoldsWorkOnFortyOneShortTrials) {
   WriteSampleSet(WithEpisodes(WithoutTerrain(MakeTerrainSet(2, 6, 1.0, 8)), 6), six);
   const RunResult loo = RunDgmm({"cv", six, "--repeats", "1", "--no-em", "--quiet"});
   ASSERT_EQ(loo.exit_code, 0) << loo.err;
-  EXPECT_NE(LineAfter(loo.out, "folds: ").find("leave-one-episode-out (6 episodes"), std::string::npos)
+  EXPECT_NE(LineAfter(loo.out, "folds: ").find("leave-one-episode-out (6 episodes"),
+            std::string::npos)
       << loo.out;
   // No valid split: one sample per command and no episodes -> one line naming --folds and the fix.
   const std::string tiny = (dir / "tiny.h5").string();
@@ -188,9 +194,10 @@ TEST(SmallData, DefaultFoldsWorkOnFortyOneShortTrials) {
   // The suggested --folds works.
   const size_t use = too_many.err.find("use --folds ");
   ASSERT_NE(use, std::string::npos) << too_many.err;
-  const std::string suggested = too_many.err.substr(use + 12, too_many.err.find(' ', use + 12) - use - 12);
-  const RunResult fixed = RunDgmm({"cv", six, "--folds", suggested, "--stratified", "--repeats", "1",
-                                   "--quiet"});
+  const std::string suggested =
+      too_many.err.substr(use + 12, too_many.err.find(' ', use + 12) - use - 12);
+  const RunResult fixed =
+      RunDgmm({"cv", six, "--folds", suggested, "--stratified", "--repeats", "1", "--quiet"});
   EXPECT_EQ(fixed.exit_code, 0) << suggested << ": " << fixed.err;
 }
 
@@ -200,9 +207,9 @@ TEST(TuneJson, KeysSayWhatTheyAre) {
   WriteSampleSet(MakeTerrainSet(3, 12, 1.0, 10), path);
   // Every evaluation equivalent (a huge tolerance): a plateau over the whole grid, k chosen at the
   // simplest end, which is an edge of the grid.
-  const RunResult r = RunDgmm({"tune", path, "--repeats", "1", "--grid-points", "4",
-                               "--refine-points", "1", "--no-joint", "--plateau-tolerance", "1e9",
-                               "--json", "--quiet"});
+  const RunResult r =
+      RunDgmm({"tune", path, "--repeats", "1", "--grid-points", "4", "--refine-points", "1",
+               "--no-joint", "--plateau-tolerance", "1e9", "--json", "--quiet"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const json j = json::parse(r.out);
   for (const char* key : {"k", "init_scale", "prior_count", "log_likelihood", "standard_error",
@@ -220,11 +227,12 @@ TEST(TuneJson, KeysSayWhatTheyAre) {
                       chosen >= k["grid"]["k_max"].get<double>() * (1 - 1e-9);
   EXPECT_TRUE(at_end) << chosen;
   EXPECT_TRUE(k["optimum_at_grid_edge"].get<bool>());
-  EXPECT_EQ(k["grid_edge"], chosen >= k["grid"]["k_max"].get<double>() * (1 - 1e-9) ? "high" : "low");
+  EXPECT_EQ(k["grid_edge"],
+            chosen >= k["grid"]["k_max"].get<double>() * (1 - 1e-9) ? "high" : "low");
   // The text says the same in words.
-  const RunResult text = RunDgmm({"tune", path, "--repeats", "1", "--grid-points", "4",
-                                  "--refine-points", "1", "--no-joint", "--plateau-tolerance", "1e9",
-                                  "--quiet"});
+  const RunResult text =
+      RunDgmm({"tune", path, "--repeats", "1", "--grid-points", "4", "--refine-points", "1",
+               "--no-joint", "--plateau-tolerance", "1e9", "--quiet"});
   EXPECT_NE(text.out.find("k not identifiable from this data"), std::string::npos) << text.out;
 }
 
@@ -240,7 +248,8 @@ TEST(Output, ElapsedTimesPluralsAndMisspeltCommands) {
   const size_t in = stage.find("done in ");
   ASSERT_NE(in, std::string::npos) << r.err;
   const std::string shown = stage.substr(in + 8);
-  if (shown != "under 1 ms") EXPECT_GE(std::stod(shown), 0.5 * seconds) << stage << " vs " << seconds;
+  if (shown != "under 1 ms")
+    EXPECT_GE(std::stod(shown), 0.5 * seconds) << stage << " vs " << seconds;
   EXPECT_EQ(r.err.find("done in 0.0 s"), std::string::npos) << r.err;
   // "1 component", never "1 components".
   const RunResult em = RunDgmm({"em", path, "-o", (dir / "em.h5").string(), "--components", "1"});

@@ -8,8 +8,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <numbers>
 #include <set>
@@ -308,7 +308,9 @@ struct TrialLog {
   std::vector<std::string> labels;
 };
 
-double TrialSpeed(const std::string& label) { return label == "slow" ? 0.1 : label == "fast" ? 0.3 : 0.0; }
+double TrialSpeed(const std::string& label) {
+  return label == "slow" ? 0.1 : label == "fast" ? 0.3 : 0.0;
+}
 
 TrialLog WriteTrialFolder(const std::string& name, int trials, double pose_end = 2.9667,
                           double speed_scale_per_trial = 0) {
@@ -380,8 +382,10 @@ TEST(LogFiles, FoldersAndGlobsResolveToSortedCsvFiles) {
   const auto folder = ResolveStreamFiles((log.dir / "cmd").string(), "--commands");
   EXPECT_EQ(folder.size(), 3u);
   EXPECT_TRUE(std::is_sorted(folder.begin(), folder.end()));
-  EXPECT_EQ(ResolveStreamFiles((log.dir / "pose" / "odom_0[12].csv").string(), "--pose").size(), 2u);
-  EXPECT_THROW(ResolveStreamFiles((log.dir / "pose" / "nothing_*.csv").string(), "--pose"), InputError);
+  EXPECT_EQ(ResolveStreamFiles((log.dir / "pose" / "odom_0[12].csv").string(), "--pose").size(),
+            2u);
+  EXPECT_THROW(ResolveStreamFiles((log.dir / "pose" / "nothing_*.csv").string(), "--pose"),
+               InputError);
   fs::create_directories(log.dir / "empty");
   EXPECT_THROW(ResolveStreamFiles((log.dir / "empty").string(), "--pose"), InputError);
 }
@@ -455,7 +459,8 @@ TEST(LogImport, EpisodeColumnSplitsTrialsAndIdsStayDistinctAcrossFiles) {
   for (int i = 1; i <= 2; ++i) {  // each file: episode 0 for 1.5 s, then episode 1
     std::ostringstream c;
     c << "t,action,run\n";
-    for (int k = 0; k < 30; ++k) c << 0.1 * k << "," << log.labels[i - 1] << "," << (k < 15 ? 0 : 1) << "\n";
+    for (int k = 0; k < 30; ++k)
+      c << 0.1 * k << "," << log.labels[i - 1] << "," << (k < 15 ? 0 : 1) << "\n";
     test::WriteText(log.dir / "cmd" / ("trial_" + std::to_string(i) + ".csv"), c.str());
   }
   LogImportOptions o = TrialOptions(log);
@@ -470,7 +475,8 @@ TEST(LogImport, QuantileBinsWithStopsOnTheirOwn) {
   // Speeds: 0.05 .. 0.25 in the first 2 s (slow and fast halves), exactly 0 (stopped) after.
   std::ostringstream out;
   out << "time,speed\n";
-  for (int i = 0; i < 40; ++i) out << 0.1 * i << "," << (i < 10 ? 0.05 : i < 20 ? 0.25 : 0.0) << "\n";
+  for (int i = 0; i < 40; ++i)
+    out << 0.1 * i << "," << (i < 10 ? 0.05 : i < 20 ? 0.25 : 0.0) << "\n";
   test::WriteText(log.commands, out.str());
   LogImportOptions o = PlanarOptions(log);
   o.commands.columns = {"speed"};

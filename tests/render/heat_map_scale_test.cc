@@ -2,10 +2,9 @@
 // issue #11 (a peaked model as a black field, a spike setting the difference scale, panels with
 // their own scales, numeric axes where names belong, cut titles, faint dots, oversized windows).
 #include <gtest/gtest.h>
-
-#include <algorithm>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "render/density_grid.h"

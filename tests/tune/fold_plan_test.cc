@@ -26,7 +26,8 @@ TEST(ChooseFolds, LeaveOneEpisodeOutWhenEpisodesAreFew) {
   EXPECT_TRUE(plan.by_episode);
   EXPECT_EQ(plan.folds, 6);
   EXPECT_EQ(plan.episodes, 6);
-  EXPECT_NE(plan.reason.find("leave-one-episode-out (6 episodes"), std::string::npos) << plan.reason;
+  EXPECT_NE(plan.reason.find("leave-one-episode-out (6 episodes"), std::string::npos)
+      << plan.reason;
 }
 
 TEST(ChooseFolds, TenFoldsOfWholeEpisodesWhenThereAreMany) {
@@ -37,11 +38,13 @@ TEST(ChooseFolds, TenFoldsOfWholeEpisodesWhenThereAreMany) {
     std::vector<int> rows;
     for (int i = 0; i < 41; ++i) rows.push_back(i);
     return rows;
-  }()), 41);
+  }()),
+                     41);
   const FoldPlan plan = ChooseFolds(set, 0, true);
   EXPECT_TRUE(plan.by_episode);
   EXPECT_EQ(plan.folds, 10);
-  EXPECT_NE(plan.reason.find("10 folds of whole episodes (41 episodes, at most 10 folds)"), std::string::npos)
+  EXPECT_NE(plan.reason.find("10 folds of whole episodes (41 episodes, at most 10 folds)"),
+            std::string::npos)
       << plan.reason;
   CvOptions options;
   options.folds = 0;
