@@ -7,6 +7,7 @@
 #include <iostream>
 #include <memory>
 #include <nlohmann/json.hpp>
+#include <vector>
 
 #include "app/command.h"
 #include "app/dgmm_flags.h"
@@ -22,7 +23,8 @@ namespace {
 struct CvArgs {
   std::string path;
   double k = 0.7;
-  int folds = 10;
+  int folds = 0;  // 0: chosen from the data (unless --folds was given)
+  bool folds_given = false;
   int repeats = 10;
   std::uint64_t seed = 1;
   int threads = 0;
@@ -32,6 +34,7 @@ struct CvArgs {
   int em_n_init = 3;
   DgmmFlags dgmm;
   bool stratified = false;
+  bool with_terrain = false, without_terrain = false;
   std::vector<std::string> pose_dims, terrain_dims;
   bool json = false;
 };
@@ -45,22 +48,33 @@ nlohmann::json ScoreJson(const CvScore& s) {
           {"mean_components", s.mean_components}};
 }
 
-void RunCv(const CvArgs& args) {
-  if (!(args.k > 0) || !std::isfinite(args.k)) {
-    throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
-  }
-  if (args.folds < 2) throw MakeInputError("", "--folds", "must be >= 2");
-  if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
-  const SampleSet set =
-      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
-  WarnIfUnderdetermined(set, true, "cv");
-  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  RefuseMoreFoldsThanSamples(set, args.folds, args.path);
+// One row of the table: its JSON key, its label, its score, and why it was omitted ("" when it
+// was computed or not asked for).
+struct Row {
+  const char* key;
+  const char* label;
+  const CvScore* score;
+  const std::string* omitted;
+};
+
+std::vector<Row> Rows(const CvSummary& summary) {
+  static const std::string none;
+  return {{"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain, &none},
+          {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain, &none},
+          {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain,
+           &summary.em_without_terrain_omitted},
+          {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain,
+           &summary.em_with_terrain_omitted}};
+}
+
+CvOptions MakeCvOptions(const CvArgs& args, const SampleSet& set) {
   CvOptions options;
+  options.folds = CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
+  options.without_terrain = !args.with_terrain;
+  options.with_terrain = !args.without_terrain;
   options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
   options.dgmm.k = args.k;
   options.group_by_episode = !args.stratified;
-  options.folds = args.folds;
   options.repeats = args.repeats;
   options.seed = args.seed;
   options.threads = args.threads;
@@ -75,53 +89,51 @@ void RunCv(const CvArgs& args) {
                        {{"em_max_components", "--em-max-components"}, {"threads", "--threads"},
                         {"folds", "--folds"}, {"repeats", "--repeats"}, {"n_init", "--em-n-init"}});
   }
-  const CvSummary summary = CrossValidate(set, options);
+  return options;
+}
 
-  struct Row {
-    const char* key;
-    const char* label;
-    const CvScore* score;
-  };
-  const Row rows[] = {
-      {"dgmm_without_terrain", "DGMM without terrain", &summary.dgmm_without_terrain},
-      {"dgmm_with_terrain", "DGMM with terrain", &summary.dgmm_with_terrain},
-      {"em_bic_without_terrain", "EM-BIC without terrain", &summary.em_without_terrain},
-      {"em_bic_with_terrain", "EM-BIC with terrain", &summary.em_with_terrain}};
-  if (args.json) {
-    nlohmann::json out = {{"file", args.path},
-                          {"samples", summary.samples},
-                          {"commands", summary.commands},
-                          {"folds", summary.folds},
-                          {"repeats", summary.repeats},
-                          {"k", args.k},
-                          {"seed", args.seed},
-                          {"folds_by", summary.folds_by},
-                          {"dgmm_options", DgmmOptionsJson(options.dgmm)},
-                          {"shuffle_training", args.shuffle_training},
-                          {"has_terrain", summary.has_terrain},
-                          {"scored_per_repeat", summary.scored_per_repeat},
-                          {"unscored_per_repeat", summary.unscored_per_repeat},
-                          {"seconds", summary.seconds}};
-    for (const Row& row : rows) {
-      if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
-    }
-    std::cout << out.dump(2) << "\n";
-    return;
+nlohmann::json CvJson(const CvArgs& args, const CvOptions& options, const CvSummary& summary) {
+  nlohmann::json out = {{"file", args.path},
+                        {"samples", summary.samples},
+                        {"commands", summary.commands},
+                        {"folds", summary.folds},
+                        {"repeats", summary.repeats},
+                        {"k", args.k},
+                        {"seed", args.seed},
+                        {"folds_by", summary.folds_by},
+                        {"dgmm_options", DgmmOptionsJson(options.dgmm)},
+                        {"shuffle_training", args.shuffle_training},
+                        {"has_terrain", summary.has_terrain},
+                        {"scored_per_repeat", summary.scored_per_repeat},
+                        {"unscored_per_repeat", summary.unscored_per_repeat},
+                        {"seconds", summary.seconds}};
+  out["rows"] = nlohmann::json::object();
+  out["omitted_rows"] = nlohmann::json::object();
+  for (const Row& row : Rows(summary)) {
+    if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
+    if (!row.omitted->empty()) out["omitted_rows"][row.key] = *row.omitted;
   }
+  return out;
+}
+
+void PrintCvTable(const CvArgs& args, const CvSummary& summary) {
   std::cout << fmt::format(
-      "{}: {} samples, {} commands; {} x {}-fold cross-validation, k = {}, seed {} ({:.1f} s)\n"
+      "{}: {}, {}; {} x {}-fold cross-validation, k = {}, seed {} ({})\n"
       "folds: {}; DGMM: {} variant, covariance {}, S0 {}\n",
-      args.path, summary.samples, summary.commands, summary.repeats, summary.folds, args.k,
-      args.seed, summary.seconds, summary.folds_by, args.dgmm.variant, args.dgmm.covariance,
+      args.path, Plural(summary.samples, "sample"), Plural(summary.commands, "command"),
+      summary.repeats, summary.folds, args.k, args.seed, FormatSeconds(summary.seconds),
+      summary.folds_by, args.dgmm.variant, args.dgmm.covariance,
       fmt::format("{}", fmt::join(args.dgmm.init_cov, ",")));
   if (summary.unscored_per_repeat > 0) {
     std::cout << fmt::format(
-        "note: {} held-out samples per repeat not scored (their command has no other sample)\n",
+        "note: {} held-out samples per repeat not scored (their command has no sample outside "
+        "their fold, e.g. it was recorded in one episode)\n",
         summary.unscored_per_repeat);
   }
   std::cout << "held-out log-likelihood, summed over all validation folds of a repeat\n";
   std::cout << fmt::format("{:<24}{:>22}{:>12}{:>12}{:>10}\n", "model", "mean +- sd (repeats)",
                            "std. error", "per sample", "mean K");
+  const std::vector<Row> rows = Rows(summary);
   for (const Row& row : rows) {
     if (!row.score->evaluated) continue;
     const CvScore& s = *row.score;
@@ -130,7 +142,30 @@ void RunCv(const CvArgs& args) {
                              fmt::format("{:.1f} +- {:.1f}", s.mean, s.sd), s.standard_error,
                              s.mean_per_sample, k);
   }
+  for (const Row& row : rows) {
+    if (!row.omitted->empty()) std::cout << row.label << ": omitted, " << *row.omitted << "\n";
+  }
   if (!summary.has_terrain) std::cout << "(the set has no terrain: no with-terrain rows)\n";
+}
+
+void RunCv(const CvArgs& args) {
+  if (!(args.k > 0) || !std::isfinite(args.k)) {
+    throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
+  }
+  if (args.folds_given && args.folds < 2) {
+    throw MakeInputError("", "--folds", "must be >= 2 (omit --folds to choose from the data)");
+  }
+  if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
+  const SampleSet set = ReadSetToCrossValidate(args.path, args.pose_dims, args.terrain_dims,
+                                               args.with_terrain, args.without_terrain);
+  const CvOptions options = MakeCvOptions(args, set);
+  WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
+  const CvSummary summary = CrossValidate(set, options);
+  if (args.json) {
+    std::cout << CvJson(args, options, summary).dump(2) << "\n";
+    return;
+  }
+  PrintCvTable(args, summary);
 }
 
 void SetupCv(CLI::App& root) {
@@ -142,8 +177,9 @@ void SetupCv(CLI::App& root) {
   cmd->add_option("set", args->path, "Sample set (.h5)")->required();
   cmd->add_option("--k", args->k, "DGMM merge rate k > 0")->capture_default_str();
   cmd->add_option("--folds", args->folds,
-                  "Folds (whole episodes when the set has them, else stratified by command), >= 2")
-      ->capture_default_str();
+                  "Folds, >= 2 (whole episodes when the set has enough, else stratified by "
+                  "command); default: chosen from the data (leave-one-episode-out for up to 10 "
+                  "episodes, else 10 folds; stratified: at most the smallest command's samples)");
   cmd->add_option("--repeats", args->repeats, "Repeats with new folds")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed of folds and merges")->capture_default_str();
   cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")
@@ -156,6 +192,10 @@ void SetupCv(CLI::App& root) {
       ->capture_default_str();
   cmd->add_option("--em-n-init", args->em_n_init, "EM restarts per fit")->capture_default_str();
   AddDgmmFlags(cmd, &args->dgmm);
+  cmd->add_flag("--with-terrain", args->with_terrain,
+                "Only the with-terrain rows, p(x | c, z) (default: both)");
+  cmd->add_flag("--without-terrain", args->without_terrain,
+                "Only the without-terrain rows, p(x | c) (as fit --without-terrain)");
   cmd->add_flag("--stratified", args->stratified,
                 "Folds stratified by command even when the set has episodes (default: whole "
                 "episodes per fold when it has them)");
@@ -166,7 +206,10 @@ void SetupCv(CLI::App& root) {
                   "Terrain dimensions to condition on, by name (default: all)")
       ->delimiter(',');
   cmd->add_flag("--json", args->json, "Print JSON");
-  cmd->callback([args] { RunCv(*args); });
+  cmd->callback([args, cmd] {
+    args->folds_given = cmd->count("--folds") > 0;
+    RunCv(*args);
+  });
 }
 
 }  // namespace

@@ -101,4 +101,23 @@ DgmmOptions DgmmOptionsFromFlags(const DgmmFlags& f, int dim) {
   return o;
 }
 
+std::vector<std::string> NonDefaultDgmmFlags(const DgmmFlags& f) {
+  const DgmmFlags defaults;
+  std::vector<std::string> words;
+  if (f.variant != defaults.variant) words.insert(words.end(), {"--variant", f.variant});
+  if (f.covariance != defaults.covariance)
+    words.insert(words.end(), {"--covariance", f.covariance});
+  if (f.init_cov != defaults.init_cov) {
+    std::string joined;
+    for (const auto& v : f.init_cov) joined += (joined.empty() ? "" : ",") + v;
+    words.insert(words.end(), {"--init-cov", joined});
+  }
+  if (f.floor_option != nullptr && f.floor_option->count() > 0) {
+    words.insert(words.end(), {"--floor", fmt::format("{:.6g}", f.floor)});
+  } else if (f.floor_relative != defaults.floor_relative) {
+    words.insert(words.end(), {"--floor-relative", fmt::format("{:.6g}", f.floor_relative)});
+  }
+  return words;
+}
+
 }  // namespace dgmm::app

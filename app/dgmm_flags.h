@@ -28,4 +28,9 @@ void AddDgmmFlags(CLI::App* cmd, DgmmFlags* flags);
 // when the caller fits terrain). Throws InputError naming the flag.
 DgmmOptions DgmmOptionsFromFlags(const DgmmFlags& flags, int dim);
 
+// The flags in `flags` that differ from their defaults, as command-line words (e.g.
+// {"--covariance", "blend"}), except --init-scale and --prior-count (which `tune` prints with its
+// chosen values): printed recipes carry them so the recipe fits what was tuned.
+std::vector<std::string> NonDefaultDgmmFlags(const DgmmFlags& flags);
+
 }  // namespace dgmm::app

@@ -47,7 +47,7 @@ void Run(const EmArgs& args) {
   RefuseOutputThatIsAnInput(args.output, {args.set});
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const SampleSet set = ReadSampleSet(args.set);
-  WarnIfUnderdetermined(set, !args.without_terrain, "em");
+  WarnIfUnderdetermined(set, !args.without_terrain, "em", false);
   MotionModel model = ModelHeaderFor(set, !args.without_terrain);
   model.kind = "em";
   model.seed = args.em.seed;
@@ -124,10 +124,11 @@ void Run(const EmArgs& args) {
     std::cout << out.dump(2) << "\n";
     return;
   }
-  std::printf("fitted an EM mixture per command (%d components, %d restarts, seed %llu, d = %d) "
-              "on %lld samples in %.2f s\n",
-              args.em.components, args.em.n_init,
-              static_cast<unsigned long long>(args.em.seed), dim, samples, seconds);
+  std::printf("fitted an EM mixture per command (%s, %s, seed %llu, d = %d) on %s in %s\n",
+              Plural(args.em.components, "component").c_str(),
+              Plural(args.em.n_init, "restart").c_str(),
+              static_cast<unsigned long long>(args.em.seed), dim, Plural(samples, "sample").c_str(),
+              FormatSeconds(seconds).c_str());
   for (const auto& c : commands) {
     std::printf("  command %d '%s': %s\n", c["command"].get<int>(),
                 c["label"].get<std::string>().c_str(), c["report"].get<std::string>().c_str());

@@ -129,10 +129,9 @@ void Run(const FitArgs& args) {
     std::cout << out.dump(2) << "\n";
     return;
   }
-  std::printf(
-      "fitted a DGMM per command (k = %g, seed %llu, %s, d = %d) on %lld samples in %.2f s\n",
-      args.k, static_cast<unsigned long long>(args.seed), args.dgmm.variant.c_str(), model.dim(),
-      samples, seconds);
+  std::printf("fitted a DGMM per command (k = %g, seed %llu, %s, d = %d) on %s in %s\n", args.k,
+              static_cast<unsigned long long>(args.seed), args.dgmm.variant.c_str(), model.dim(),
+              Plural(samples, "sample").c_str(), FormatSeconds(seconds).c_str());
   const DgmmOptions& o = model.dgmm_options;
   std::printf("  covariance %s%s, S0 %s (diagonal %s), floor %.3g\n",
               CovarianceRuleName(o.covariance_rule),
@@ -143,9 +142,10 @@ void Run(const FitArgs& args) {
               fmt::format("{:.3g}", fmt::join(o.initial_covariance_diagonal, ", ")).c_str(),
               o.covariance_floor);
   for (const auto& c : commands) {
-    std::printf("  command %d '%s': %d components from %lld samples\n", c["command"].get<int>(),
-                c["label"].get<std::string>().c_str(), c["components"].get<int>(),
-                c["samples"].get<long long>());
+    std::printf("  command %d '%s': %s from %s\n", c["command"].get<int>(),
+                c["label"].get<std::string>().c_str(),
+                Plural(c["components"].get<int>(), "component").c_str(),
+                Plural(c["samples"].get<long long>(), "sample").c_str());
   }
   std::printf("wrote %s\n", args.output.c_str());
 }

@@ -171,8 +171,9 @@ void PrintModel(const json& j) {
               o["initial_covariance_rule"].get<std::string>().c_str(),
               j["covariance_floor"].get<double>(), j["seed"].get<unsigned long long>());
   for (const auto& c : j["commands"]) {
-    std::printf("    command %d '%s': %d components, total weight %g\n", c["command"].get<int>(),
-                c["label"].get<std::string>().c_str(), c["components"].get<int>(),
+    std::printf("    command %d '%s': %s, total weight %g\n", c["command"].get<int>(),
+                c["label"].get<std::string>().c_str(),
+                Plural(c["components"].get<int>(), "component").c_str(),
                 c["total_weight"].get<double>());
   }
   std::printf("  standardised: %s\n", j["standardized"].get<bool>() ? "yes" : "no");

@@ -27,6 +27,16 @@ int main(int argc, char** argv) {
   for (const auto& command : registry) command.setup(root);
   // After the subcommands: CLI11 copies the flag into subcommands created later.
   root.set_help_all_flag("--help-all", "Help for every subcommand");
+  // An unknown first word is an error even with --help, which CLI11 would answer with the main
+  // help and exit 0 (`dgmm tnue --help` must not look like success).
+  // (The top level has only flags, so the first word without a dash is the command.)
+  char** word = std::find_if(argv + 1, argv + argc, [](const char* a) { return a[0] != '-'; });
+  if (word != argv + argc &&
+      root.get_subcommands([word](CLI::App* sub) { return sub->check_name(*word); }).empty()) {
+    std::cerr << "dgmm: error: unknown command '" << std::string(*word).substr(0, 80) << "'"
+              << dgmm::app::DidYouMean(*word, root) << " (see dgmm --help)\n";
+    return 2;
+  }
   try {
     root.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
@@ -37,17 +47,6 @@ int main(int argc, char** argv) {
     return root.exit(e);
   } catch (const CLI::ParseError& e) {
     // One line, like every other user error (CLI11's own exit() adds a second line).
-    // CLI11 reports an unknown first word as a missing subcommand: name the word instead.
-    // (The top level has only flags, so the first word without a dash is the command.)
-    char** word = std::find_if(argv + 1, argv + argc, [](const char* a) { return a[0] != '-'; });
-    const bool unknown =
-        word != argv + argc &&
-        root.get_subcommands([word](CLI::App* sub) { return sub->check_name(*word); }).empty();
-    if (unknown) {
-      std::cerr << "dgmm: error: unknown command '" << std::string(*word).substr(0, 80)
-                << "' (see dgmm --help)\n";
-      return e.get_exit_code() != 0 ? e.get_exit_code() : 2;
-    }
     std::cerr << "dgmm: error: " << e.what() << " (see dgmm --help)\n";
     return e.get_exit_code() != 0 ? e.get_exit_code() : 2;
   } catch (const dgmm::InputError& e) {

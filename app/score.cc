@@ -49,11 +49,12 @@ void Run(const ScoreArgs& args) {
     std::cout << out.dump(2) << "\n";
     return;
   }
-  std::printf("total log-likelihood %.10g over %d samples, mean %.6f nats per sample\n",
-              s.total_log_likelihood, s.samples, s.mean_log_likelihood);
+  std::printf("total log-likelihood %.10g over %s, mean %.6f nats per sample\n",
+              s.total_log_likelihood, Plural(s.samples, "sample").c_str(), s.mean_log_likelihood);
   for (const auto& [id, c] : score.by_command) {
-    std::printf("  command %d '%s': %lld samples, total %.10g, mean %.6f\n", id, c.label.c_str(),
-                c.samples, c.total_log_likelihood, c.total_log_likelihood / c.samples);
+    std::printf("  command %d '%s': %s, total %.10g, mean %.6f\n", id, c.label.c_str(),
+                Plural(c.samples, "sample").c_str(), c.total_log_likelihood,
+                c.total_log_likelihood / c.samples);
   }
 }
 

@@ -18,6 +18,7 @@
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "render/chart.h"
+#include "render/display.h"
 #include "tune/dimensions.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -29,7 +30,8 @@ namespace {
 struct TuneKArgs {
   std::string path;
   bool with_terrain = false, without_terrain = false;
-  int folds = 10, repeats = 10;
+  int folds = 0, repeats = 10;  // folds 0: chosen from the data (unless --folds was given)
+  bool folds_given = false;
   std::uint64_t seed = 1;
   int threads = 0;
   double k_min = 1e-3, k_max = 10;
@@ -63,8 +65,9 @@ void WriteCurveCsv(const TuneKSummary& s, const std::string& path) {
 
 void PlotCurve(const TuneKSummary& s, const std::string& path) {
   LineChartSpec spec;
-  spec.title = fmt::format("tune-k: k = {:.3g}, held-out log-likelihood {:.1f} +- {:.1f}", s.k,
-                           s.log_likelihood, s.standard_error);
+  spec.title = fmt::format("tune: k = {:.3g}, held-out log-likelihood {:.1f} +- {:.1f}{}", s.k,
+                           s.log_likelihood, s.standard_error,
+                           s.plateau_spans_grid ? " (k not identifiable)" : "");
   spec.x_label = "merge rate k";
   spec.y_label = fmt::format("held-out log-likelihood ({} x {}-fold, {} terrain)", s.repeats,
                              s.folds, s.with_terrain ? "with" : "without");
@@ -96,6 +99,17 @@ void PlotCurve(const TuneKSummary& s, const std::string& path) {
       {},
       {}};
   spec.series = {cv, fit, chosen};
+  // The plateau as a band: its range of k at the best evaluation and at the best minus the
+  // tolerance (the evaluations between the two lines are equivalent).
+  if (s.plateau) {
+    const double top = s.best_evaluated_log_likelihood, bottom = top - s.plateau_tolerance;
+    spec.series.push_back(
+        {fmt::format("plateau: {}", s.PlateauMeaning()),
+         {s.plateau_k_lo, s.plateau_k_lo, s.plateau_k_hi, s.plateau_k_hi, s.plateau_k_lo},
+         {bottom, top, top, bottom, bottom},
+         {},
+         std::array<unsigned char, 3>{120, 120, 120}});
+  }
   RenderLineChart(spec, path);
 }
 
@@ -178,134 +192,128 @@ void PrintJoint(const TuneKSummary& s) {
             << "\n";
 }
 
-void RunTuneK(const TuneKArgs& args) {
-  if (args.with_terrain && args.without_terrain) {
-    throw MakeInputError("", "--with-terrain/--without-terrain", "give at most one");
+// The recommended settings as command-line words: --k, the tuned --init-scale and --prior-count
+// (or the user's when not tuned and not the default) and the user's other non-default DGMM flags.
+std::vector<std::string> RecommendedFlags(const TuneKSummary& s, const TuneKArgs& args) {
+  std::vector<std::string> words = {"--k", fmt::format("{:.6g}", s.k)};
+  const DgmmFlags defaults;
+  if (s.init_scale_tuned || args.dgmm.init_scale != defaults.init_scale) {
+    words.insert(words.end(),
+                 {"--init-scale",
+                  fmt::format("{:.6g}", s.init_scale_tuned ? s.init_scale : args.dgmm.init_scale)});
   }
-  // Unwritable output folders are reported before the long run, not after it.
-  for (const auto& [output, flag] :
-       {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
-    if (output.empty()) continue;
-    RefuseOutputThatIsAnInput(output, {args.path}, flag);
-    AtomicFile probe(output);
+  if (s.prior_count_tuned || args.dgmm.prior_count != defaults.prior_count) {
+    words.insert(words.end(), {"--prior-count",
+                               fmt::format("{:.6g}", s.prior_count_tuned ? s.prior_count
+                                                                         : args.dgmm.prior_count)});
   }
-  const SampleSet set =
-      SelectDimensions(ReadSampleSet(args.path), args.pose_dims, args.terrain_dims);
-  if (set.size() == 0) throw MakeInputError(args.path, "samples", "the set is empty");
-  if (args.folds < 2) throw MakeInputError(args.path, "--folds", "must be >= 2");
-  RefuseMoreFoldsThanSamples(set, args.folds, args.path);
-  WarnIfUnderdetermined(set, !args.without_terrain, "tune-k");
-  if (args.with_terrain && set.terrain_dim() == 0) {
-    throw MakeInputError(args.path, "z", "--with-terrain needs a set with terrain");
-  }
-  TuneKOptions options;
-  options.with_terrain = !args.without_terrain;
-  options.cv.folds = args.folds;
-  options.cv.repeats = args.repeats;
-  options.cv.seed = args.seed;
-  options.cv.threads = args.threads;
-  options.cv.shuffle_training = args.shuffle_training;
-  options.cv.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
-  options.cv.group_by_episode = !args.stratified;
-  options.plateau_tolerance = args.plateau_tolerance;
-  options.init_scales = args.init_scales;
-  options.prior_counts = args.prior_counts;
-  options.k_min = args.k_min;
-  options.k_max = args.k_max;
-  options.grid_points = args.grid_points;
-  options.refine_points = args.refine_points;
-  options.joint = !args.no_joint;
-  options.progress = [](int done, int total) {
-    if (total >= 0) {
-      ReportProgress("tune cross-validations", done, total);
-    } else if (ShowProgress()) {
-      std::fprintf(stderr, "\rtune cross-validations %d", done);
-    }
-  };
-  std::string error;
-  if (!options.IsValid(&error)) {
-    throw OptionsError(args.path, error,
-                       {{"k_min", "--k-min/--k-max"},
-                        {"grid_points", "--grid-points"},
-                        {"refine_points", "--refine-points"},
-                        {"plateau_tolerance", "--plateau-tolerance"},
-                        {"init_scales", "--init-scales"},
-                        {"prior_counts", "--prior-counts"},
-                        {"threads", "--threads"},
-                        {"folds", "--folds"},
-                        {"repeats", "--repeats"}});
-  }
-  const TuneKSummary s = TuneK(set, options);
-  const std::string folds_by = s.folds_by;
-  if (!args.curve_csv.empty()) WriteCurveCsv(s, args.curve_csv);
-  if (!args.plot.empty()) PlotCurve(s, args.plot);
+  const std::vector<std::string> other = NonDefaultDgmmFlags(args.dgmm);
+  words.insert(words.end(), other.begin(), other.end());
+  return words;
+}
 
-  if (args.json) {
-    nlohmann::json curve = nlohmann::json::array();
-    for (const auto& p : s.curve) {
-      curve.push_back({{"k", p.k},
-                       {"log_likelihood", p.log_likelihood},
-                       {"sd", p.sd},
-                       {"standard_error", p.standard_error},
-                       {"smoothed", s.Smoothed(p.k)},
-                       {"components", p.components},
-                       {"role", p.role}});
-    }
-    auto side = [](const std::vector<TuneKPoint>& pts) {
-      nlohmann::json a = nlohmann::json::array();
-      for (const auto& p : pts) {
-        a.push_back({{"init_scale", p.init_scale},
-                     {"prior_count", p.prior_count},
-                     {"log_likelihood", p.log_likelihood},
-                     {"standard_error", p.standard_error},
-                     {"components", p.components}});
-      }
-      return a;
-    };
-    nlohmann::json out = {
-        {"file", args.path},
-        {"k", s.k},
-        {"log_likelihood", s.log_likelihood},
-        {"standard_error", s.standard_error},
-        {"sd", s.sd},
-        {"with_terrain", s.with_terrain},
-        {"folds", s.folds},
-        {"repeats", s.repeats},
-        {"seed", args.seed},
-        {"samples", s.samples},
-        {"bracket", {s.bracket_lo, s.bracket_hi}},
-        {"at_grid_edge", s.at_grid_edge},
-        {"fit", {{"u0", s.u0}, {"a", s.a}, {"b", s.b}, {"c", s.c}, {"points", s.fit_points}}},
-        {"best_evaluated",
-         {{"k", s.best_evaluated_k}, {"log_likelihood", s.best_evaluated_log_likelihood}}},
-        {"curve", curve},
-        {"folds_by", folds_by},
-        {"plateau",
-         {{"flat", s.plateau},
-          {"k_range", {s.plateau_k_lo, s.plateau_k_hi}},
-          {"points", s.plateau_points},
-          {"tolerance", s.plateau_tolerance}}},
-        {"k_rule", s.k_rule},
-        {"components", s.components},
-        {"init_scale", s.init_scale_tuned ? nlohmann::json(s.init_scale) : nlohmann::json()},
-        {"init_scale_plateau", s.init_scale_plateau},
-        {"prior_count", s.prior_count_tuned ? nlohmann::json(s.prior_count) : nlohmann::json()},
-        {"prior_count_plateau", s.prior_count_plateau},
-        {"scale_curve", side(s.scale_curve)},
-        {"prior_curve", side(s.prior_curve)},
-        {"evaluations", s.evaluations},
-        {"cycles", s.cycles},
-        {"joint", JointJson(s.joint)},
-        {"start_dgmm_options", DgmmOptionsJson(options.cv.dgmm)},
-        {"seconds", s.seconds}};
-    std::cout << out.dump(2) << "\n";
-    return;
+// The two recipes `tune` prints: fit the recommended model, and cross-validate it with the same
+// folds, repeats and seed (its DGMM row reproduces the recommended log-likelihood).
+std::pair<std::string, std::string> Recipes(const TuneKSummary& s, const TuneKArgs& args) {
+  const std::string flags = fmt::format("{}", fmt::join(RecommendedFlags(s, args), " "));
+  const std::string terrain = s.with_terrain ? "" : " --without-terrain";
+  std::string fit =
+      fmt::format("dgmm fit {} {}{} --seed {} -o model.h5", args.path, flags, terrain, args.seed);
+  std::string cv = fmt::format("dgmm cv {} {}{}", args.path, flags, terrain);
+  if (args.folds_given) cv += fmt::format(" --folds {}", args.folds);
+  if (args.stratified) cv += " --stratified";
+  if (args.shuffle_training) cv += " --shuffle-training";
+  if (!args.pose_dims.empty()) cv += fmt::format(" --pose-dims {}", fmt::join(args.pose_dims, ","));
+  if (!args.terrain_dims.empty()) {
+    cv += fmt::format(" --terrain-dims {}", fmt::join(args.terrain_dims, ","));
   }
-  std::cout << fmt::format(
-      "{}: {} samples, {} x {}-fold, {} terrain, seed {}; {} cross-validations in {} cycle(s) "
-      "({:.1f} s)\n",
-      args.path, s.samples, s.repeats, s.folds, s.with_terrain ? "with" : "without", args.seed,
-      s.evaluations, s.cycles, s.seconds);
+  cv += fmt::format(" --repeats {} --seed {}", args.repeats, args.seed);
+  return {fit, cv};
+}
+
+nlohmann::json PointsJson(const std::vector<TuneKPoint>& pts, const TuneKSummary* s) {
+  nlohmann::json a = nlohmann::json::array();
+  for (const auto& p : pts) {
+    nlohmann::json point = {{"k", p.k},
+                            {"init_scale", p.init_scale},
+                            {"prior_count", p.prior_count},
+                            {"log_likelihood", p.log_likelihood},
+                            {"sd", p.sd},
+                            {"standard_error", p.standard_error},
+                            {"components", p.components},
+                            {"role", p.role}};
+    if (s) point["smoothed"] = s->Smoothed(p.k);
+    a.push_back(point);
+  }
+  return a;
+}
+
+// `tune --json` (documented in docs/log-import.md, "What tune reports"): what to use first
+// ("recommended"), then how each setting was searched.
+nlohmann::json TuneJson(const TuneKSummary& s, const TuneKArgs& args, const TuneKOptions& options) {
+  const auto [fit, cv] = Recipes(s, args);
+  auto or_null = [](bool tuned, double v) { return tuned ? nlohmann::json(v) : nlohmann::json(); };
+  return {{"file", args.path},
+          {"samples", s.samples},
+          {"with_terrain", s.with_terrain},
+          {"folds", s.folds},
+          {"folds_by", s.folds_by},
+          {"repeats", s.repeats},
+          {"seed", args.seed},
+          {"recommended",
+           {{"k", s.k},
+            {"init_scale", or_null(s.init_scale_tuned, s.init_scale)},
+            {"prior_count", or_null(s.prior_count_tuned, s.prior_count)},
+            {"log_likelihood", s.log_likelihood},
+            {"standard_error", s.standard_error},
+            {"sd", s.sd},
+            {"components_per_command", s.components},
+            {"flags", RecommendedFlags(s, args)},
+            {"fit_command", fit},
+            {"cv_command", cv}}},
+          {"k_search",
+           {{"grid", {{"k_min", s.k_min}, {"k_max", s.k_max}, {"points", options.grid_points}}},
+            {"best_grid_k", s.best_grid_k},
+            {"optimum_at_grid_edge", !s.grid_edge.empty()},
+            {"grid_edge", s.grid_edge.empty() ? nlohmann::json() : nlohmann::json(s.grid_edge)},
+            {"bracket", {s.bracket_lo, s.bracket_hi}},
+            {"quadratic_refinement",
+             {{"k_at_maximum", s.quadratic_k},
+              {"u0", s.u0},
+              {"a", s.a},
+              {"b", s.b},
+              {"c", s.c},
+              {"points", s.fit_points},
+              {"fit_report", s.fit_report},
+              {"maximise_report", s.maximise_report}}},
+            {"best_evaluated",
+             {{"k", s.best_evaluated_k}, {"log_likelihood", s.best_evaluated_log_likelihood}}},
+            {"plateau",
+             {{"flat", s.plateau},
+              {"k_range", {s.plateau_k_lo, s.plateau_k_hi}},
+              {"points", s.plateau_points},
+              {"tolerance", s.plateau_tolerance},
+              {"spans_whole_grid", s.plateau_spans_grid},
+              {"meaning", s.PlateauMeaning()}}},
+            {"rule", s.k_rule},
+            {"curve", PointsJson(s.curve, &s)}}},
+          {"init_scale_search",
+           {{"tuned", s.init_scale_tuned},
+            {"plateau", s.init_scale_plateau},
+            {"curve", PointsJson(s.scale_curve, nullptr)}}},
+          {"prior_count_search",
+           {{"tuned", s.prior_count_tuned},
+            {"plateau", s.prior_count_plateau},
+            {"curve", PointsJson(s.prior_curve, nullptr)}}},
+          {"joint", JointJson(s.joint)},
+          {"evaluations", s.evaluations},
+          {"cycles", s.cycles},
+          {"start_dgmm_options", DgmmOptionsJson(options.cv.dgmm)},
+          {"seconds", s.seconds}};
+}
+
+// The k step, f and nu0 steps as text.
+void PrintSearch(const TuneKSummary& s) {
   // The coordinate steps' choice (the joint step's start when it ran; the final choice below).
   TuneKPoint cyclic = s.joint.start;
   if (!s.joint.run) {
@@ -314,7 +322,6 @@ void RunTuneK(const TuneKArgs& args) {
     cyclic.prior_count = s.prior_count;
   }
   std::cout << "last k step (at the coordinate steps' S0 scale and nu0):\n";
-  std::cout << "folds: " << folds_by << "\n";
   std::cout << fmt::format("{:>12}{:>16}{:>12}{:>14}{:>10}  {}\n", "k", "log-likelihood",
                            "std. error", "smoothed", "mean K", "");
   for (const auto& p : s.curve) {
@@ -323,15 +330,26 @@ void RunTuneK(const TuneKArgs& args) {
                              p.role);
   }
   std::cout << fmt::format(
-      "bracket [{:.4g}, {:.4g}]{}; quadratic fit on {} points\n", s.bracket_lo, s.bracket_hi,
-      s.at_grid_edge ? " (best grid point at the edge: widen --k-min/--k-max)" : "", s.fit_points);
+      "bracket [{:.4g}, {:.4g}]; quadratic refinement on {} points: maximum at "
+      "k = {:.4g}\n",
+      s.bracket_lo, s.bracket_hi, s.fit_points, s.quadratic_k);
   if (s.plateau) {
+    // The meaning names the range itself unless the plateau is the whole grid.
+    const std::string range = s.plateau_spans_grid
+                                  ? fmt::format(", k from {:.4g} to {:.4g} (the whole grid)",
+                                                s.plateau_k_lo, s.plateau_k_hi)
+                                  : "";
     std::cout << fmt::format(
-        "PLATEAU: {} evaluations within {:.3g} of the best, k from {:.4g} to {:.4g} are "
-        "equivalent; k = {:.5g} is the simplest model there, not a sharp optimum\n",
-        s.plateau_points, s.plateau_tolerance, s.plateau_k_lo, s.plateau_k_hi, cyclic.k);
+        "PLATEAU: {} evaluations within {:.3g} of the best{}: {}: k = {:.5g}\n", s.plateau_points,
+        s.plateau_tolerance, range, s.PlateauMeaning(), cyclic.k);
   } else {
     std::cout << "k: " << s.k_rule << "\n";
+  }
+  if (!s.grid_edge.empty() && !s.plateau_spans_grid) {
+    std::cout << fmt::format(
+        "k at the {} end of the grid [{:.4g}, {:.4g}]: the optimum may lie "
+        "beyond it (widen {})\n",
+        s.grid_edge, s.k_min, s.k_max, s.grid_edge == "low" ? "--k-min" : "--k-max");
   }
   auto print_side = [](const char* name, const std::vector<TuneKPoint>& pts, bool scale) {
     for (const auto& p : pts) {
@@ -352,16 +370,84 @@ void RunTuneK(const TuneKArgs& args) {
         "prior pseudo-count nu0 = {:.3g}{}\n", cyclic.prior_count,
         s.prior_count_plateau ? " (PLATEAU: simplest of the equivalent values)" : "");
   }
+}
+
+TuneKOptions MakeTuneOptions(const TuneKArgs& args, const SampleSet& set) {
+  TuneKOptions options;
+  options.with_terrain = !args.without_terrain;
+  options.cv.folds = CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
+  options.cv.repeats = args.repeats;
+  options.cv.seed = args.seed;
+  options.cv.threads = args.threads;
+  options.cv.shuffle_training = args.shuffle_training;
+  options.cv.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
+  options.cv.group_by_episode = !args.stratified;
+  options.plateau_tolerance = args.plateau_tolerance;
+  options.init_scales = args.init_scales;
+  options.prior_counts = args.prior_counts;
+  options.k_min = args.k_min;
+  options.k_max = args.k_max;
+  options.grid_points = args.grid_points;
+  options.refine_points = args.refine_points;
+  options.joint = !args.no_joint;
+  options.progress = [](int done, int total) {
+    ReportProgress("tune cross-validations", done, total);
+  };
+  std::string error;
+  if (!options.IsValid(&error)) {
+    throw OptionsError(args.path, error,
+                       {{"k_min", "--k-min/--k-max"},
+                        {"grid_points", "--grid-points"},
+                        {"refine_points", "--refine-points"},
+                        {"plateau_tolerance", "--plateau-tolerance"},
+                        {"init_scales", "--init-scales"},
+                        {"prior_counts", "--prior-counts"},
+                        {"threads", "--threads"},
+                        {"folds", "--folds"},
+                        {"repeats", "--repeats"}});
+  }
+  return options;
+}
+
+void RunTuneK(const TuneKArgs& args) {
+  if (args.folds_given && args.folds < 2) {
+    throw MakeInputError(args.path, "--folds",
+                         "must be >= 2 (omit --folds to choose from the data)");
+  }
+  // Unwritable output folders are reported before the long run, not after it.
+  for (const auto& [output, flag] :
+       {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
+    if (output.empty()) continue;
+    RefuseOutputThatIsAnInput(output, {args.path}, flag);
+    AtomicFile probe(output);
+  }
+  if (!args.plot.empty()) RequireDisplay();  // before the long run, not after it
+  const SampleSet set = ReadSetToCrossValidate(args.path, args.pose_dims, args.terrain_dims,
+                                               args.with_terrain, args.without_terrain);
+  const TuneKOptions options = MakeTuneOptions(args, set);
+  WarnIfUnderdetermined(set, !args.without_terrain, "tune", true);
+  const TuneKSummary s = TuneK(set, options);
+  if (!args.curve_csv.empty()) WriteCurveCsv(s, args.curve_csv);
+  if (!args.plot.empty()) PlotCurve(s, args.plot);
+  if (args.json) {
+    std::cout << TuneJson(s, args, options).dump(2) << "\n";
+    return;
+  }
+  std::cout << fmt::format("{}: {}, {} x {}-fold, {} terrain, seed {}; {} in {} ({})\n", args.path,
+                           Plural(s.samples, "sample"), s.repeats, s.folds,
+                           s.with_terrain ? "with" : "without", args.seed,
+                           Plural(s.evaluations, "cross-validation"), Plural(s.cycles, "cycle"),
+                           FormatSeconds(s.seconds));
+  std::cout << "folds: " << s.folds_by << "\n";
+  PrintSearch(s);
   PrintJoint(s);
   std::cout << fmt::format(
       "chosen k = {:.5g}: held-out log-likelihood {:.2f} +- {:.2f} (s.e.), {:.2f} Gaussians per "
       "command\n",
       s.k, s.log_likelihood, s.standard_error, s.components);
-  std::cout << fmt::format(
-      "fit with: dgmm fit {} --k {:.5g}{}{}{} -o model.h5\n", args.path, s.k,
-      s.init_scale_tuned ? fmt::format(" --init-scale {:g}", s.init_scale) : "",
-      s.prior_count_tuned ? fmt::format(" --prior-count {:g}", s.prior_count) : "",
-      s.with_terrain ? "" : " --without-terrain");
+  const auto [fit, cv] = Recipes(s, args);
+  std::cout << "fit with: " << fit << "\n";
+  std::cout << "cross-validate with: " << cv << "\n";
 }
 
 void SetupTuneK(CLI::App& root) {
@@ -374,7 +460,8 @@ void SetupTuneK(CLI::App& root) {
   cmd->add_option("set", args->path, "Sample set (.h5)")->required();
   cmd->add_flag("--with-terrain", args->with_terrain, "Maximise p(x | c, z) (the default)");
   cmd->add_flag("--without-terrain", args->without_terrain, "Maximise p(x | c)");
-  cmd->add_option("--folds", args->folds, "Folds, >= 2")->capture_default_str();
+  cmd->add_option("--folds", args->folds,
+                  "Folds, >= 2 (default: chosen from the data, as dgmm cv)");
   cmd->add_option("--repeats", args->repeats, "Repeats")->capture_default_str();
   cmd->add_option("--seed", args->seed, "Seed (the same folds and merges for every k)")
       ->capture_default_str();
@@ -412,7 +499,10 @@ void SetupTuneK(CLI::App& root) {
   cmd->add_flag("--no-joint", args->no_joint,
                 "Skip the joint Ceres step after the coordinate cycles");
   cmd->add_flag("--json", args->json, "Print JSON");
-  cmd->callback([args] { RunTuneK(*args); });
+  cmd->callback([args, cmd] {
+    args->folds_given = cmd->count("--folds") > 0;
+    RunTuneK(*args);
+  });
 }
 
 }  // namespace

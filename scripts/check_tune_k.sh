@@ -35,10 +35,10 @@ echo "check_tune_k: $set_path, $repeats x $folds-fold, seed $seed, ${terrain_fla
 # The grid over k is run at tune's final S0 scale and prior pseudo-count.
 read -r -a tuned < <(python3 -c '
 import json, sys
-t = json.load(open(sys.argv[1]))
+t = json.load(open(sys.argv[1]))["recommended"]
 flags = []
-if t.get("init_scale") is not None: flags += ["--init-scale", repr(t["init_scale"])]
-if t.get("prior_count") is not None: flags += ["--prior-count", repr(t["prior_count"])]
+if t["init_scale"] is not None: flags += ["--init-scale", repr(t["init_scale"])]
+if t["prior_count"] is not None: flags += ["--prior-count", repr(t["prior_count"])]
 print(" ".join(flags))' "$work/tune.json")
 python3 - "$k_min" "$k_max" "$grid" > "$work/grid.txt" <<'EOF'
 import math, sys
@@ -54,6 +54,7 @@ python3 - "$work" "$row" "${JSON_OUT:-}" <<'EOF'
 import glob, json, os, sys
 work, row, json_out = sys.argv[1], sys.argv[2], sys.argv[3]
 tune = json.load(open(os.path.join(work, "tune.json")))
+rec = tune["recommended"]
 grid = []
 for path in glob.glob(os.path.join(work, "cv_*.json")):
     cv = json.load(open(path))
@@ -63,24 +64,24 @@ best = max(grid, key=lambda g: g[1])
 print(f"{'k':>12} {'held-out LL':>14} {'std. error':>11}")
 for k, ll, se in grid:
     print(f"{k:12.5g} {ll:14.2f} {se:11.2f}{'  <- grid best' if (k, ll, se) == best else ''}")
-gap = best[1] - tune["log_likelihood"]
-plateau = tune["plateau"]
+gap = best[1] - rec["log_likelihood"]
+plateau = tune["k_search"]["plateau"]
 if plateau["flat"]:
     print(f"tune reported a PLATEAU: k in [{plateau['k_range'][0]:.4g}, {plateau['k_range'][1]:.4g}] "
           f"within {plateau['tolerance']:.3g} of the best; it chose the simplest model there")
 ok = gap <= best[2]
-print(f"tune-k: k = {tune['k']:.5g}, held-out LL {tune['log_likelihood']:.2f} +- "
-      f"{tune['standard_error']:.2f} ({len(tune['curve'])} evaluations, {tune['seconds']:.1f} s)")
+print(f"tune-k: k = {rec['k']:.5g}, held-out LL {rec['log_likelihood']:.2f} +- "
+      f"{rec['standard_error']:.2f} ({len(tune['k_search']['curve'])} evaluations, {tune['seconds']:.1f} s)")
 print(f"grid best: k = {best[0]:.5g}, held-out LL {best[1]:.2f} +- {best[2]:.2f} "
       f"({len(grid)} evaluations)")
 print(f"gap to the grid's best: {gap:.2f} nats; one standard error: {best[2]:.2f} -> "
       f"{'PASS' if ok else 'FAIL'}")
 if json_out:
-    json.dump({"tune_k": {"k": tune["k"], "log_likelihood": tune["log_likelihood"],
-                          "standard_error": tune["standard_error"],
-                          "evaluations": len(tune["curve"]), "seconds": tune["seconds"]},
+    json.dump({"tune_k": {"k": rec["k"], "log_likelihood": rec["log_likelihood"],
+                          "standard_error": rec["standard_error"],
+                          "evaluations": len(tune["k_search"]["curve"]), "seconds": tune["seconds"]},
                "grid_best": {"k": best[0], "log_likelihood": best[1], "standard_error": best[2]},
                "grid_points": len(grid), "gap": gap, "pass": ok, "plateau": plateau,
-               "init_scale": tune.get("init_scale"), "prior_count": tune.get("prior_count")}, open(json_out, "w"), indent=2)
+               "init_scale": rec["init_scale"], "prior_count": rec["prior_count"]}, open(json_out, "w"), indent=2)
 sys.exit(0 if ok else 1)
 EOF

@@ -16,7 +16,13 @@ out=${DGMM_DEMO_OUT:-$root/out/demo}
 mkdir -p "$out"
 # Rendering needs an X display: use the one we have, else a virtual one.
 if [ -n "${DISPLAY:-}" ]; then render=(); else render=(xvfb-run -a -s "-screen 0 1920x1080x24"); fi
-step() { printf '\n== %s\n' "$*"; }
+# Each step's own time (apt and build excluded), printed when the next step starts and at the end.
+last_step="" last_start=$SECONDS demo_start=$SECONDS
+step() {
+  [ -n "$last_step" ] && printf '   (%s: %d s)\n' "$last_step" $((SECONDS - last_start))
+  last_step=$1 last_start=$SECONDS
+  printf '\n== %s\n' "$*"
+}
 
 step "Old Faithful: import (standardised), DGMM k=0.7, EM 2 components x 10 restarts"
 "$dgmm" import "$root/datasets/old_faithful.csv" -o "$out/old_faithful.h5" \
@@ -36,14 +42,10 @@ step "Simulated robot: paper protocol on the 18 degree slope (390 samples)"
 "$dgmm" simulate --protocol paper --seed 1 -o "$out/robot_390.h5"
 "${render[@]}" "$dgmm" tune-k "$out/robot_390.h5" --folds 5 --repeats 2 --seed 1 \
   --curve-csv "$out/tune_k_curve.csv" --plot "$out/tune_k_curve.png" --json > "$out/tune_k.json"
-# k, the S0 scale and the prior pseudo-count tune chose, as fit flags (null: not tuned).
+# k, the S0 scale and the prior pseudo-count tune chose, as fit flags.
 read -r -a tuned <<< "$(/usr/bin/python3 -c '
 import json, sys
-t = json.load(open(sys.argv[1]))
-flags = ["--k", repr(t["k"])]
-if t.get("init_scale") is not None: flags += ["--init-scale", repr(t["init_scale"])]
-if t.get("prior_count") is not None: flags += ["--prior-count", repr(t["prior_count"])]
-print(" ".join(flags))' "$out/tune_k.json")"
+print(" ".join(json.load(open(sys.argv[1]))["recommended"]["flags"]))' "$out/tune_k.json")"
 echo "tune chose ${tuned[*]} (curve: $out/tune_k_curve.png)"
 "$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_terrain.h5" "${tuned[@]}" --seed 1
 "$dgmm" fit "$out/robot_390.h5" -o "$out/robot_dgmm_no_terrain.h5" "${tuned[@]}" --seed 1 --without-terrain
@@ -61,6 +63,7 @@ step "Sim vs real: a shipped pair (the 'real' robot slips downhill; the sim does
   --sim-config "$root/datasets/sim2real/configs/nominal.json" -o "$out/sim2real" --seed 1 --legacy-resim
 
 step "Done. Results in $out"
+echo "demo steps took $((SECONDS - demo_start)) s in all (apt and build excluded)"
 ls "$out"
 echo "Figure 3 heat maps: $out/figure3_em_vs_dgmm.png"
 echo "Sim-vs-real report: $out/sim2real/report.html"

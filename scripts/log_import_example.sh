@@ -21,17 +21,20 @@ cd "$root"
 "$dgmm" info "$out/walk.h5"
 
 # 2. k, the S0 scale and the prior strength with the best cross-validated held-out
-#    log-likelihood; the "fit with:" line carries all three as fit flags.
+#    log-likelihood; tune's last two lines are the commands to run next.
 "$dgmm" tune "$out/walk.h5" --folds 5 --repeats 2 --seed 1 | tee "$out/tune.txt"
-settings=$(sed -n 's/^fit with: dgmm fit .* \(--k .*\) -o model.h5$/\1/p' "$out/tune.txt")
-[ -n "$settings" ] || { echo "log_import_example: no 'fit with:' line from tune" >&2; exit 1; }
-read -r -a tuned <<< "$settings"
+fit=$(sed -n 's/^fit with: dgmm //p' "$out/tune.txt")
+cv=$(sed -n 's/^cross-validate with: dgmm //p' "$out/tune.txt")
+[ -n "$fit" ] && [ -n "$cv" ] || { echo "log_import_example: tune printed no recipe" >&2; exit 1; }
 
-# 3. Cross-validation at those settings (DGMM and EM-BIC, with and without terrain).
-"$dgmm" cv "$out/walk.h5" "${tuned[@]}" --folds 5 --repeats 2 --seed 1 | tee "$out/cv.txt"
+# 3. Cross-validation at those settings (DGMM and EM-BIC, with and without terrain), as printed.
+# shellcheck disable=SC2086  # the printed line is split into words, as a shell would
+"$dgmm" $cv | tee "$out/cv.txt"
 
-# 4. The model, and a heat map of p(dx, dy | command) per command with the samples on top.
-"$dgmm" fit "$out/walk.h5" "${tuned[@]}" --seed 1 -o "$out/walk_dgmm.h5"
+# 4. The model (as printed, written to $out), and a heat map of p(dx, dy | command) per command
+#    with the samples on top.
+# shellcheck disable=SC2086
+"$dgmm" ${fit% -o model.h5} -o "$out/walk_dgmm.h5"
 for command in forward back left right turn_left turn_right stop; do
   "$dgmm" render "$out/walk_dgmm.h5" --command "$command" --x-dim dx --y-dim dy --marginalise \
     --data "$out/walk.h5" --size 640x520 -o "$out/heat_$command.png"

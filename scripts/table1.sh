@@ -44,15 +44,11 @@ work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
 common=(--folds "$folds" --repeats "$repeats" --seed "$seed")
 
-# Reads "--k K --init-scale F --prior-count NU" from a tune JSON.
+# Reads the recommended flags ("--k K --init-scale F --prior-count NU ...") from a tune JSON.
 tuned_flags() {
   python3 -c '
 import json, sys
-t = json.load(open(sys.argv[1]))
-flags = ["--k", repr(t["k"])]
-if t.get("init_scale") is not None: flags += ["--init-scale", repr(t["init_scale"])]
-if t.get("prior_count") is not None: flags += ["--prior-count", repr(t["prior_count"])]
-print(" ".join(flags))' "$1"
+print(" ".join(json.load(open(sys.argv[1]))["recommended"]["flags"]))' "$1"
 }
 report=(--folds "$folds" --repeats "$repeats" --seed "$report_seed")
 # Grids of the S0 scale f and the prior pseudo-count nu0 (the library defaults).

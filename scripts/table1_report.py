@@ -21,8 +21,18 @@ v1 = {r: load("cv_v1", r) for r in roles}
 literal = {r: load("cv_literal", r) for r in roles}
 planar = {r: load("cv_planar", r) for r in roles}
 vertical = {r: load("cv_vertical", r) for r in roles}
-tune = {r: load("tune", r) for r in roles}
-tune_without = {r: load("tune_without", r) for r in roles}
+def flat_tune(t):
+    """A `dgmm tune --json` with the recommended settings and the k plateau at the top level."""
+    rec = t["recommended"]
+    t.update({key: rec[key] for key in ("k", "init_scale", "prior_count", "log_likelihood",
+                                        "standard_error")})
+    t["components"] = rec["components_per_command"]
+    t["plateau"] = t["k_search"]["plateau"]
+    return t
+
+
+tune = {r: flat_tune(load("tune", r)) for r in roles}
+tune_without = {r: flat_tune(load("tune_without", r)) for r in roles}
 fmt = lambda m, s: f"{m:.1f} ± {s:.1f}"
 
 

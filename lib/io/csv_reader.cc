@@ -148,7 +148,7 @@ bool CsvTable::IsNumericColumn(int col) const {
   return true;
 }
 
-CsvTable ReadCsv(const std::string& path, char delimiter) {
+CsvTable ReadCsv(const std::string& path, char delimiter, bool has_header) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) {
     throw MakeInputError(path, "", "is a folder, expected a CSV file");
@@ -166,13 +166,19 @@ CsvTable ReadCsv(const std::string& path, char delimiter) {
     if (line_no == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);  // UTF-8 BOM
     if (Trim(line).empty()) continue;
     auto fields = SplitRecord(line, delimiter, path, line_no);
+    if (table.header.empty() && !has_header) {
+      for (size_t i = 1; i <= fields.size(); ++i) table.header.push_back(std::to_string(i));
+    }
     if (table.header.empty()) {
       table.header = std::move(fields);
     } else {
       table.records.push_back({line_no, std::move(fields)});
     }
   }
-  if (table.header.empty()) throw MakeInputError(path, "", "empty file (expected a header row)");
+  if (table.header.empty()) {
+    throw MakeInputError(path, "",
+                         has_header ? "empty file (expected a header row)" : "empty file");
+  }
   return table;
 }
 
@@ -232,13 +238,22 @@ double UnitToSi(const std::string& unit) {
 
 std::map<std::string, double> ParseUnits(const std::vector<std::string>& items) {
   std::map<std::string, double> units;
+  std::map<std::string, std::string> names;  // as given, for the message
   for (const std::string& item : items) {
     const size_t eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size()) {
       throw MakeInputError("", "--units",
                            "'" + item + "' is not COLUMN=UNIT (e.g. yaw=deg,x=mm; comma-separated)");
     }
-    units[Trim(item.substr(0, eq))] = UnitToSi(Trim(item.substr(eq + 1)));
+    const std::string column = Trim(item.substr(0, eq)), unit = Trim(item.substr(eq + 1));
+    const double factor = UnitToSi(unit);
+    const auto [it, fresh] = units.try_emplace(column, factor);
+    if (!fresh && it->second != factor) {
+      throw MakeInputError("", "--units",
+                           "column '" + column + "' is given two different units (" +
+                               names[column] + " and " + unit + "); give one");
+    }
+    names[column] = unit;
   }
   return units;
 }

@@ -36,8 +36,9 @@ std::string EchoCell(const std::string& text);
 
 // Reads `path` with fields separated by `delimiter` ("quoted" fields may hold it; "" is a quote).
 // Lines may end in \n, \r\n or a lone \r. InputError for a missing/unreadable/empty file, a
-// folder, or an unterminated quote.
-CsvTable ReadCsv(const std::string& path, char delimiter = ',');
+// folder, or an unterminated quote. has_header false: every row is data and the columns are
+// named by position, "1", "2", ... (from the first row's field count).
+CsvTable ReadCsv(const std::string& path, char delimiter = ',', bool has_header = true);
 
 // "," ";" "tab" (or "\t") "|" " " -> the character; InputError naming --delimiter otherwise.
 char ParseDelimiter(const std::string& text);
@@ -50,7 +51,7 @@ bool ParseFiniteNumber(const std::string& cell, double* value, std::string* prob
 double UnitToSi(const std::string& unit);
 
 // "col=unit" items (e.g. {"yaw=deg", "x=mm"}) -> column -> factor to SI. InputError for an item
-// without '=' or with an unknown unit.
+// without '=', an unknown unit, or a column given two different units (x=mm,x=m).
 std::map<std::string, double> ParseUnits(const std::vector<std::string>& items);
 
 // Invalid rows: refuse (rethrow the row's InputError, which names file and line) unless

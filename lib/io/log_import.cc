@@ -1,6 +1,5 @@
 #include "io/log_import.h"
 
-#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -10,19 +9,12 @@
 #include <set>
 
 #include "io/csv_reader.h"
+#include "io/log_files.h"
+#include "io/log_time_series.h"
 #include "util/error.h"
 
 namespace dgmm {
 namespace {
-
-using Interval = std::pair<double, double>;  // [begin, end] in seconds
-
-// A parsed numeric stream: strictly increasing times (s) and one vector per column (SI units).
-struct Series {
-  std::string path;
-  std::vector<double> t;
-  std::vector<std::vector<double>> values;  // columns x rows
-};
 
 std::string Filename(const std::string& path) {
   return std::filesystem::path(path).filename().string();
@@ -33,107 +25,61 @@ double Unit(const LogImportOptions& o, const std::string& column) {
   return it == o.units.end() ? 1.0 : it->second;
 }
 
-// Reads a stream's time and value columns; rows with bad cells or times that do not increase
+std::string FormatNumber(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", std::abs(v) < 1e-12 ? 0.0 : v);
+  return buf;
+}
+
+// The time of record r (the index-th data row) in seconds: index / rate_hz when the stream has a
+// rate, else its time column; InputError when it does not increase past `previous`.
+double RowTime(const CsvTable& table, const CsvRecord& r, size_t index, int col,
+               const LogStream& stream, const std::string& path, double unit,
+               const std::vector<double>& previous) {
+  if (stream.rate_hz > 0) return static_cast<double>(index) / stream.rate_hz;
+  const double t = table.Number(r, col) * unit;
+  if (!previous.empty() && t <= previous.back()) {
+    throw MakeInputError(path,
+                         "line " + std::to_string(r.line) + ", column '" + stream.time_column + "'",
+                         "time does not increase (expected rows sorted by time)");
+  }
+  return t;
+}
+
+// Reads a stream file's time and value columns; rows with bad cells or times that do not increase
 // are invalid (refused or dropped by `invalid`).
-Series ReadSeries(const LogStream& stream, const LogImportOptions& o, InvalidRows* invalid,
-                  long long* rows) {
-  const CsvTable table = ReadCsv(stream.path, o.delimiter);
-  const int time_col = table.Column(stream.time_column);
+Series ReadSeries(const std::string& path, const LogStream& stream, const LogImportOptions& o,
+                  InvalidRows* invalid, long long* rows) {
+  const CsvTable table = ReadCsv(path, o.delimiter, o.has_header);
+  const int time_col = stream.rate_hz > 0 ? -1 : table.Column(stream.time_column);
   std::vector<int> cols;
   for (const auto& c : stream.columns) cols.push_back(table.Column(c));
   Series s;
-  s.path = stream.path;
+  s.path = path;
   s.values.resize(cols.size());
-  const double time_unit = Unit(o, stream.time_column);
-  for (const CsvRecord& r : table.records) {
+  for (size_t i = 0; i < table.records.size(); ++i) {
+    const CsvRecord& r = table.records[i];
     try {
       table.CheckFieldCount(r);
-      const double t = table.Number(r, time_col) * time_unit;
-      if (!s.t.empty() && t <= s.t.back()) {
-        throw MakeInputError(stream.path,
-                             "line " + std::to_string(r.line) + ", column '" + stream.time_column + "'",
-                             "time does not increase (expected rows sorted by time)");
-      }
+      const double t =
+          RowTime(table, r, i, time_col, stream, path, Unit(o, stream.time_column), s.t);
       std::vector<double> v;
       for (size_t j = 0; j < cols.size(); ++j) v.push_back(table.Number(r, cols[j]) * Unit(o, stream.columns[j]));
       s.t.push_back(t);
       for (size_t j = 0; j < cols.size(); ++j) s.values[j].push_back(v[j]);
     } catch (const InputError& e) {
-      invalid->Handle(stream.path, e.what());
+      invalid->Handle(path, e.what());
     }
   }
-  *rows = static_cast<long long>(table.records.size());
-  if (s.t.size() < 2) throw MakeInputError(stream.path, "", "fewer than 2 valid rows");
+  *rows += static_cast<long long>(table.records.size());
+  if (s.t.size() < 2) throw MakeInputError(path, "", "fewer than 2 valid rows");
   return s;
 }
 
-// Replaces an angle series by its continuous version: each step is the shortest arc.
-void Unwrap(std::vector<double>* a) {
-  for (size_t i = 1; i < a->size(); ++i) {
-    const double step = std::remainder((*a)[i] - (*a)[i - 1], 2 * std::numbers::pi);
-    (*a)[i] = (*a)[i - 1] + step;
-  }
-}
-
-// Index i with t[i] <= time <= t[i+1] and the fraction between them (time inside [t0, tn]).
-std::pair<size_t, double> Bracket(const std::vector<double>& t, double time) {
-  size_t i = std::upper_bound(t.begin(), t.end(), time) - t.begin();
-  i = std::clamp<size_t>(i == 0 ? 0 : i - 1, 0, t.size() - 2);
-  const double f = std::clamp((time - t[i]) / (t[i + 1] - t[i]), 0.0, 1.0);
-  return {i, f};
-}
-
-double Lerp(const std::vector<double>& v, std::pair<size_t, double> b) {
-  return v[b.first] + b.second * (v[b.first + 1] - v[b.first]);
-}
-
-double MedianInterval(const std::vector<double>& t) {
-  std::vector<double> d;
-  for (size_t i = 1; i < t.size(); ++i) d.push_back(t[i] - t[i - 1]);
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
-}
-
-// Runs of the stream with no pause longer than gap_s.
-std::vector<Interval> Runs(const std::vector<double>& t, double gap_s) {
-  std::vector<Interval> runs;
-  size_t start = 0;
-  for (size_t i = 1; i <= t.size(); ++i) {
-    if (i == t.size() || t[i] - t[i - 1] > gap_s) {
-      if (i - 1 > start) runs.push_back({t[start], t[i - 1]});
-      start = i;
-    }
-  }
-  return runs;
-}
-
-std::vector<Interval> Intersect(const std::vector<Interval>& a, const std::vector<Interval>& b) {
-  std::vector<Interval> out;
-  size_t i = 0, j = 0;
-  while (i < a.size() && j < b.size()) {
-    const double lo = std::max(a[i].first, b[j].first), hi = std::min(a[i].second, b[j].second);
-    if (hi > lo) out.push_back({lo, hi});
-    (a[i].second < b[j].second) ? ++i : ++j;
-  }
-  return out;
-}
-
-// Rz(yaw) Ry(pitch) Rx(roll) as a quaternion.
-Eigen::Quaterniond FromRpy(double roll, double pitch, double yaw) {
-  return Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
-         Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
-         Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
-}
-
-// <roll, pitch, yaw> of R = Rz(yaw) Ry(pitch) Rx(roll), pitch in [-pi/2, pi/2].
-Eigen::Vector3d ToRpy(const Eigen::Matrix3d& r) {
-  return {std::atan2(r(2, 1), r(2, 2)), std::asin(std::clamp(-r(2, 0), -1.0, 1.0)),
-          std::atan2(r(1, 0), r(0, 0))};
-}
-
-// The command stream: per valid row its time, the command key (numbers, bin centres or label
-// codes) and label, and its episode id.
+// The command stream of one trial: per valid row its time, the command key (numbers, bin centres
+// or label codes), its label and its episode id (from the episode column, else 0).
 struct CommandRows {
+  std::string path;
   std::vector<double> t;
   std::vector<std::vector<double>> key;
   std::vector<std::string> label;
@@ -141,307 +87,378 @@ struct CommandRows {
   std::vector<std::vector<std::string>> text;  // per row, per column: the label text or ""
 };
 
-std::string FormatNumber(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.4g", std::abs(v) < 1e-12 ? 0.0 : v);
-  return buf;
+// What all trials share about the command columns: which are numeric (decided by the first file)
+// and the codes of text labels, so that one label is one command in every trial.
+struct CommandColumns {
+  std::vector<int> numeric;  // -1 unknown yet, 0 text, 1 numbers
+  std::vector<std::map<std::string, int>> codes;
+};
+
+// The command keys of one row; InputError for an empty label.
+std::vector<double> RowKey(const CsvTable& table, const CsvRecord& r, const std::vector<int>& cols,
+                           const LogImportOptions& o, const std::string& path,
+                           CommandColumns* shared, std::vector<std::string>* text) {
+  std::vector<double> key;
+  for (size_t j = 0; j < cols.size(); ++j) {
+    const std::string& cell = r.fields[cols[j]];
+    const bool numeric = shared->numeric[j] == 1;
+    text->push_back(numeric ? "" : cell);
+    if (numeric) {
+      key.push_back(table.Number(r, cols[j]) * Unit(o, o.commands.columns[j]));
+      continue;
+    }
+    if (cell.empty()) {
+      throw MakeInputError(
+          path, "line " + std::to_string(r.line) + ", column '" + o.commands.columns[j] + "'",
+          "empty command label");
+    }
+    key.push_back(shared->codes[j]
+                      .try_emplace(cell, static_cast<int>(shared->codes[j].size()))
+                      .first->second);
+  }
+  return key;
 }
 
-CommandRows ReadCommands(const LogImportOptions& o, InvalidRows* invalid, long long* rows,
-                         std::vector<std::string>* warnings) {
+CommandRows ReadCommands(const std::string& path, const LogImportOptions& o, CommandColumns* shared,
+                         InvalidRows* invalid, long long* rows) {
   const LogStream& s = o.commands;
-  const CsvTable table = ReadCsv(s.path, o.delimiter);
-  const int time_col = table.Column(s.time_column);
+  const CsvTable table = ReadCsv(path, o.delimiter, o.has_header);
+  const int time_col = s.rate_hz > 0 ? -1 : table.Column(s.time_column);
   const int episode_col = o.episode_column.empty() ? -1 : table.Column(o.episode_column);
   std::vector<int> cols;
-  std::vector<bool> numeric;
-  for (const auto& c : s.columns) {
-    cols.push_back(table.Column(c));
-    numeric.push_back(table.IsNumericColumn(cols.back()));
+  for (size_t j = 0; j < s.columns.size(); ++j) {
+    cols.push_back(table.Column(s.columns[j]));
+    const int numeric = table.IsNumericColumn(cols.back()) ? 1 : 0;
+    if (shared->numeric[j] < 0) shared->numeric[j] = numeric;
+    if (shared->numeric[j] != numeric) {
+      throw MakeInputError(path, "column '" + s.columns[j] + "'",
+                           numeric ? "numbers here but text labels in an earlier file"
+                                   : "text labels here but numbers in an earlier file");
+    }
   }
-  std::vector<std::map<std::string, int>> codes(cols.size());
   CommandRows out;
-  std::vector<std::vector<double>> raw;  // numeric values before binning
-  for (const CsvRecord& r : table.records) {
+  out.path = path;
+  for (size_t i = 0; i < table.records.size(); ++i) {
+    const CsvRecord& r = table.records[i];
     try {
       table.CheckFieldCount(r);
-      const double t = table.Number(r, time_col) * Unit(o, s.time_column);
-      if (!out.t.empty() && t <= out.t.back()) {
-        throw MakeInputError(s.path, "line " + std::to_string(r.line) + ", column '" + s.time_column + "'",
-                             "time does not increase (expected rows sorted by time)");
-      }
-      std::vector<double> key;
+      const double t = RowTime(table, r, i, time_col, s, path, Unit(o, s.time_column), out.t);
       std::vector<std::string> text;
-      for (size_t j = 0; j < cols.size(); ++j) {
-        const std::string& cell = r.fields[cols[j]];
-        text.push_back(numeric[j] ? "" : cell);
-        if (numeric[j]) {
-          key.push_back(table.Number(r, cols[j]) * Unit(o, s.columns[j]));
-        } else {
-          if (cell.empty()) {
-            throw MakeInputError(s.path, "line " + std::to_string(r.line) + ", column '" + s.columns[j] + "'",
-                                 "empty command label");
-          }
-          key.push_back(codes[j].try_emplace(cell, static_cast<int>(codes[j].size())).first->second);
-        }
-      }
+      std::vector<double> key = RowKey(table, r, cols, o, path, shared, &text);
       int episode = 0;
       if (episode_col >= 0) {
         const double e = table.Number(r, episode_col);
         if (e != std::floor(e) || std::abs(e) > 2e9) {
-          throw MakeInputError(s.path, "line " + std::to_string(r.line) + ", column '" + o.episode_column + "'",
-                               "episode id must be an integer");
+          throw MakeInputError(
+              path, "line " + std::to_string(r.line) + ", column '" + o.episode_column + "'",
+              "episode id must be an integer");
         }
         episode = static_cast<int>(e);
       }
       out.t.push_back(t);
-      out.key.push_back(key);
-      out.text.push_back(text);
+      out.key.push_back(std::move(key));
+      out.text.push_back(std::move(text));
       out.episode.push_back(episode);
     } catch (const InputError& e) {
-      invalid->Handle(s.path, e.what());
+      invalid->Handle(path, e.what());
     }
   }
-  *rows = static_cast<long long>(table.records.size());
-  if (out.t.empty()) throw MakeInputError(s.path, "", "no valid command rows");
-  // Numeric columns: bin (centres) when asked; labels are the (binned) values.
-  for (size_t j = 0; j < cols.size(); ++j) {
-    if (!numeric[j]) continue;
-    if (o.bins == 0) {
-      std::set<double> distinct;
-      for (const auto& k : out.key) distinct.insert(k[j]);
-      if (distinct.size() > 20 && distinct.size() * 10 > out.key.size()) {
-        warnings->push_back("command column '" + s.columns[j] + "' has " +
-                            std::to_string(distinct.size()) + " distinct values in " +
-                            std::to_string(out.key.size()) +
-                            " rows: continuous values? bin them with --bins");
-      }
-    }
-    double lo = out.key[0][j], hi = lo;
-    for (const auto& k : out.key) lo = std::min(lo, k[j]), hi = std::max(hi, k[j]);
-    const double width = (hi - lo) / std::max(o.bins, 1);
-    for (auto& k : out.key) {
-      if (o.bins > 0 && width > 0) {
-        const int b = std::min(static_cast<int>((k[j] - lo) / width), o.bins - 1);
-        k[j] = lo + (b + 0.5) * width;
-      }
-    }
-  }
-  for (size_t i = 0; i < out.t.size(); ++i) {
-    std::string label;
-    for (size_t j = 0; j < cols.size(); ++j) {
-      label += (j ? "," : "") + (numeric[j] ? FormatNumber(out.key[i][j]) : out.text[i][j]);
-    }
-    out.label.push_back(cols.empty() ? "all" : label);
-  }
+  *rows += static_cast<long long>(table.records.size());
+  if (out.t.empty()) throw MakeInputError(path, "", "no valid command rows");
   return out;
 }
 
-}  // namespace
-
-bool LogImportOptions::IsValid(std::string* error) const {
-  auto fail = [&](const std::string& m) { *error = m; return false; };
-  if (commands.path.empty()) return fail("--commands: a command stream is required");
-  if (pose.path.empty()) return fail("--pose: a pose stream is required");
-  if (pose.columns.size() != 3 && pose.columns.size() != 6) {
-    return fail("--pose-cols: " + std::to_string(pose.columns.size()) +
-                " columns, expected 3 (x,y,yaw) or 6 (x,y,z,roll,pitch,yaw)");
-  }
-  if (commands.columns.empty() && episode_column.empty() && commands.path.empty()) {
-    return fail("--command-cols: none chosen");
-  }
-  if (!attitude.path.empty() && attitude.columns.empty()) {
-    return fail("--terrain-cols: none chosen for the attitude stream");
-  }
-  if (!(gap_s >= 0) || !std::isfinite(gap_s)) return fail("--gap: expected seconds >= 0");
-  if (!(window_s >= 0) || !std::isfinite(window_s)) return fail("--window: expected seconds >= 0");
-  if (!(min_duration_s >= 0) || !std::isfinite(min_duration_s)) return fail("--min-duration: expected seconds >= 0");
-  if (bins < 0) return fail("--bins: expected >= 0");
-  return true;
-}
-
-std::string LogImportSummary::BriefReport() const {
-  char buf[512];
-  std::snprintf(buf, sizeof buf,
-                "%d samples from %d episodes (%d command segments, %d shorter than %.3g s skipped; "
-                "gap %.3g s); rows: %lld commands, %lld pose, %lld attitude, %lld dropped",
-                samples, episodes, segments, short_segments, min_duration_s, gap_s, command_rows,
-                pose_rows, attitude_rows, dropped_rows);
-  return buf;
-}
-
-SampleSet ImportLog(const LogImportOptions& o, LogImportSummary* summary_out) {
-  std::string error;
-  if (!o.IsValid(&error)) throw InputError(error);
-  LogImportSummary summary;
-  InvalidRows invalid(o.drop_invalid);
-  {
-    std::set<std::string> known = {o.commands.time_column, o.pose.time_column, o.episode_column};
-    for (const auto* s : {&o.commands, &o.pose, &o.attitude}) known.insert(s->columns.begin(), s->columns.end());
-    if (!o.attitude.path.empty()) known.insert(o.attitude.time_column);
-    for (const auto& [column, factor] : o.units) {
-      if (!known.count(column)) {
-        throw MakeInputError("", "--units", "column '" + column + "' is not a selected column");
+// Numeric command columns of every trial: binned when asked (io/command_bins.h, over all trials
+// at once), else a warning when they look continuous. Then each row's label.
+void KeyCommands(const LogImportOptions& o, const CommandColumns& shared,
+                 std::vector<CommandRows>* trials, std::vector<std::string>* warnings) {
+  const bool binning = o.bins.bins > 0 || !o.bins.edges.empty();
+  for (size_t j = 0; j < o.commands.columns.size(); ++j) {
+    if (shared.numeric[j] != 1) continue;
+    std::vector<double> values;
+    for (const CommandRows& c : *trials) {
+      for (const auto& k : c.key) values.push_back(k[j]);
+    }
+    if (binning) {
+      const std::vector<double> binned = BinCommandValues(values, o.bins);
+      size_t i = 0;
+      for (CommandRows& c : *trials) {
+        for (auto& k : c.key) k[j] = binned[i++];
       }
+      continue;
+    }
+    const std::set<double> distinct(values.begin(), values.end());
+    if (distinct.size() > 20 && distinct.size() * 10 > values.size()) {
+      warnings->push_back("command column '" + o.commands.columns[j] + "' has " +
+                          std::to_string(distinct.size()) + " distinct values in " +
+                          std::to_string(values.size()) +
+                          " rows: continuous values? bin them with --bins N (quantiles; zero is "
+                          "its own command) or --bin-edges");
     }
   }
-  const CommandRows commands = ReadCommands(o, &invalid, &summary.command_rows, &summary.warnings);
-  Series pose = ReadSeries(o.pose, o, &invalid, &summary.pose_rows);
-  const bool six_dof = pose.values.size() == 6;
-  for (size_t j = six_dof ? 3 : 2; j < pose.values.size(); ++j) Unwrap(&pose.values[j]);
-  const bool has_attitude = !o.attitude.path.empty();
-  Series attitude;
-  if (has_attitude) {
-    attitude = ReadSeries(o.attitude, o, &invalid, &summary.attitude_rows);
-    for (auto& column : attitude.values) Unwrap(&column);
+  for (CommandRows& c : *trials) {
+    for (size_t i = 0; i < c.t.size(); ++i) {
+      std::string label;
+      for (size_t j = 0; j < o.commands.columns.size(); ++j) {
+        label +=
+            (j ? "," : "") + (shared.numeric[j] == 1 ? FormatNumber(c.key[i][j]) : c.text[i][j]);
+      }
+      c.label.push_back(o.commands.columns.empty() ? "all" : label);
+    }
   }
+}
 
-  // Episodes: sensor coverage without pauses longer than the gap, from the first command on;
-  // with an episode column, also split where the id changes.
-  double slowest = MedianInterval(pose.t);
-  if (has_attitude) slowest = std::max(slowest, MedianInterval(attitude.t));
-  summary.gap_s = o.gap_s > 0 ? o.gap_s : 10 * slowest;
-  summary.min_duration_s =
-      std::max(o.min_duration_s > 0 ? o.min_duration_s : 2 * MedianInterval(pose.t), o.window_s);
-  std::vector<Interval> coverage = Runs(pose.t, summary.gap_s);
-  if (has_attitude) coverage = Intersect(coverage, Runs(attitude.t, summary.gap_s));
-  std::vector<Interval> command_spans;
-  for (size_t i = 0, start = 0; i < commands.t.size(); ++i) {
-    const bool last = i + 1 == commands.t.size() || commands.episode[i + 1] != commands.episode[i];
-    if (!last) continue;
-    // Without an episode column, the last command holds to the end of the sensor coverage.
-    const double end = o.episode_column.empty() ? std::numeric_limits<double>::infinity()
-                                                : commands.t[i];
-    command_spans.push_back({commands.t[start], end});
-    start = i + 1;
-  }
-  const std::vector<Interval> episodes = Intersect(coverage, command_spans);
-  if (episodes.empty()) {
-    throw MakeInputError(o.commands.path, "time",
-                         "the command, pose and attitude streams do not overlap in time (check "
-                         "their time columns and --units)");
-  }
+// The pose and attitude of one trial, angles unwrapped.
+struct TrialStreams {
+  Series pose, attitude;
+  bool six_dof = false, has_attitude = false;
+};
 
+TrialStreams ReadStreams(const LogTrial& trial, const LogImportOptions& o, InvalidRows* invalid,
+                         LogImportSummary* summary) {
+  TrialStreams s;
+  s.pose = ReadSeries(trial.pose, o.pose, o, invalid, &summary->pose_rows);
+  s.six_dof = s.pose.values.size() == 6;
+  for (size_t j = s.six_dof ? 3 : 2; j < s.pose.values.size(); ++j) Unwrap(&s.pose.values[j]);
+  s.has_attitude = !trial.attitude.empty();
+  if (s.has_attitude) {
+    s.attitude = ReadSeries(trial.attitude, o.attitude, o, invalid, &summary->attitude_rows);
+    for (auto& column : s.attitude.values) Unwrap(&column);
+  }
+  return s;
+}
+
+// The samples as they are cut: pose changes, terrain, command table, episode and step.
+struct SampleSink {
   SampleSet set;
   std::map<std::vector<double>, int> command_ids;
   std::vector<std::vector<double>> table_rows;
-  std::vector<double> xs, zs;
-  std::vector<int> sample_command, sample_episode, sample_step;
-  std::set<std::string> all_labels(commands.label.begin(), commands.label.end()), used_labels;
-  auto add_sample = [&](size_t row, double t0, double t1, int episode, int step) {
-    const auto b0 = Bracket(pose.t, t0), b1 = Bracket(pose.t, t1);
-    if (six_dof) {
-      const Eigen::Vector3d p0(Lerp(pose.values[0], b0), Lerp(pose.values[1], b0), Lerp(pose.values[2], b0));
-      const Eigen::Vector3d p1(Lerp(pose.values[0], b1), Lerp(pose.values[1], b1), Lerp(pose.values[2], b1));
-      auto rotation = [&](std::pair<size_t, double> b) {
-        auto q = [&](size_t i) { return FromRpy(pose.values[3][i], pose.values[4][i], pose.values[5][i]); };
-        return q(b.first).slerp(b.second, q(b.first + 1));  // shortest arc
-      };
-      const Eigen::Quaterniond q0 = rotation(b0), q1 = rotation(b1);
-      const Eigen::Vector3d dp = q0.conjugate() * (p1 - p0);
-      const Eigen::Vector3d drpy = ToRpy((q0.conjugate() * q1).toRotationMatrix());
-      xs.insert(xs.end(), {dp.x(), dp.y(), dp.z(), drpy.x(), drpy.y(), drpy.z()});
-    } else {
-      const double yaw0 = Lerp(pose.values[2], b0);
-      const double dx = Lerp(pose.values[0], b1) - Lerp(pose.values[0], b0);
-      const double dy = Lerp(pose.values[1], b1) - Lerp(pose.values[1], b0);
-      xs.insert(xs.end(), {std::cos(yaw0) * dx + std::sin(yaw0) * dy,
-                           -std::sin(yaw0) * dx + std::cos(yaw0) * dy,
-                           Lerp(pose.values[2], b1) - yaw0});
-    }
-    if (has_attitude) {
-      const auto ba = Bracket(attitude.t, t0);
-      for (const auto& column : attitude.values) zs.push_back(std::remainder(Lerp(column, ba), 2 * std::numbers::pi));
-    }
-    auto [it, fresh] = command_ids.try_emplace(commands.key[row], static_cast<int>(table_rows.size()));
-    if (fresh) {
-      table_rows.push_back(commands.key[row]);
-      set.command_labels.push_back(commands.label[row]);
-    }
-    used_labels.insert(commands.label[row]);
-    sample_command.push_back(it->second);
-    sample_episode.push_back(episode);
-    sample_step.push_back(step);
-  };
+  std::vector<double> xs, zs, durations;
+  std::vector<int> command, episode, step;
+  std::set<std::string> used_labels;
 
-  // Durations within a quarter of the pose sampling interval of a window count as that window
-  // (time stamps are rounded and jitter; the pose cannot tell them apart).
-  const double tolerance = 0.25 * MedianInterval(pose.t);
-  std::map<int, int> steps_so_far;
-  for (size_t e = 0; e < episodes.size(); ++e) {
-    const auto [a, b] = episodes[e];
+  // The pose change over [t0, t1] in the body frame at t0 (and the terrain at t0) for `row`.
+  void Add(const CommandRows& c, size_t row, const TrialStreams& s, double t0, double t1,
+           int episode_id, int step_in_episode, bool per_second);
+};
+
+void SampleSink::Add(const CommandRows& c, size_t row, const TrialStreams& s, double t0, double t1,
+                     int episode_id, int step_in_episode, bool per_second) {
+  const Series& pose = s.pose;
+  // The duration the pose change covers (the pose is held at the stream's ends).
+  const double duration =
+      std::clamp(t1, pose.t.front(), pose.t.back()) - std::clamp(t0, pose.t.front(), pose.t.back());
+  const size_t first = xs.size();
+  const Eigen::VectorXd dx = BodyFramePoseChange(pose, t0, t1);
+  xs.insert(xs.end(), dx.data(), dx.data() + dx.size());
+  if (per_second) {
+    for (size_t i = first; i < xs.size(); ++i) xs[i] /= std::max(duration, 1e-12);
+  }
+  if (s.has_attitude) {
+    const auto ba = Bracket(s.attitude.t, t0);
+    for (const auto& column : s.attitude.values)
+      zs.push_back(std::remainder(Lerp(column, ba), 2 * std::numbers::pi));
+  }
+  auto [it, fresh] = command_ids.try_emplace(c.key[row], static_cast<int>(table_rows.size()));
+  if (fresh) {
+    table_rows.push_back(c.key[row]);
+    set.command_labels.push_back(c.label[row]);
+  }
+  used_labels.insert(c.label[row]);
+  command.push_back(it->second);
+  episode.push_back(episode_id);
+  step.push_back(step_in_episode);
+  durations.push_back(duration);
+}
+
+// The time scales every trial shares: median pose interval, and the automatic gap, minimum
+// duration and tolerance derived from it.
+struct TimeScales {
+  double pose_dt = 0, gap = 0, min_duration = 0, tolerance = 0;
+};
+
+TimeScales MakeTimeScales(const std::vector<TrialStreams>& streams, const LogImportOptions& o) {
+  std::vector<double> pose_dt, attitude_dt;
+  for (const TrialStreams& s : streams) {
+    pose_dt.push_back(MedianInterval(s.pose.t));
+    if (s.has_attitude) attitude_dt.push_back(MedianInterval(s.attitude.t));
+  }
+  TimeScales ts;
+  ts.pose_dt = Median(pose_dt);
+  const double slowest = std::max(ts.pose_dt, Median(attitude_dt));
+  ts.gap = o.gap_s > 0 ? o.gap_s : 10 * slowest;
+  ts.min_duration = std::max(o.min_duration_s > 0 ? o.min_duration_s : 2 * ts.pose_dt, o.window_s);
+  ts.tolerance = o.time_tolerance_s > 0 ? o.time_tolerance_s : 0.5 * ts.pose_dt;
+  return ts;
+}
+
+// The episodes of one trial: sensor coverage without pauses longer than the gap, from the first
+// command on; with an episode column, also split where the id changes.
+std::vector<Interval> TrialEpisodes(const CommandRows& c, const TrialStreams& s,
+                                    const LogImportOptions& o, double gap) {
+  std::vector<Interval> coverage = Runs(s.pose.t, gap);
+  if (s.has_attitude) coverage = Intersect(coverage, Runs(s.attitude.t, gap));
+  std::vector<Interval> command_spans;
+  for (size_t i = 0, start = 0; i < c.t.size(); ++i) {
+    const bool last = i + 1 == c.t.size() || c.episode[i + 1] != c.episode[i];
+    if (!last) continue;
+    // Without an episode column, the last command holds to the end of the sensor coverage.
+    const double end = o.episode_column.empty() ? std::numeric_limits<double>::infinity() : c.t[i];
+    command_spans.push_back({c.t[start], end});
+    start = i + 1;
+  }
+  return Intersect(coverage, command_spans);
+}
+
+// Command rows whose hold [t_i, t_{i+1}) meets no episode: logged while the pose (or attitude)
+// was not.
+long long RowsOutside(const CommandRows& c, const std::vector<Interval>& episodes) {
+  long long outside = 0;
+  for (size_t i = 0; i < c.t.size(); ++i) {
+    const double hi = i + 1 < c.t.size() ? c.t[i + 1] : std::numeric_limits<double>::infinity();
+    const bool meets = std::any_of(episodes.begin(), episodes.end(), [&](const Interval& e) {
+      return c.t[i] < e.second && hi > e.first;
+    });
+    outside += !meets;
+  }
+  return outside;
+}
+
+// Where a trial's samples go: episode ids (per trial, per gap or per episode-column value).
+struct EpisodeIds {
+  bool several_trials = false;
+  int trial = 0;
+  std::map<std::pair<int, int>, int>* by_column;  // (trial, column id) -> global id
+  int next_gap_episode = 0;
+  int Id(const LogImportOptions& o, const CommandRows& c, size_t row) {
+    if (!o.episode_column.empty()) {
+      if (!several_trials) return c.episode[row];
+      return by_column->try_emplace({trial, c.episode[row]}, static_cast<int>(by_column->size()))
+          .first->second;
+    }
+    return several_trials ? trial : next_gap_episode++;
+  }
+};
+
+// One command segment [start, end]: skipped when too short, else one sample or whole windows.
+void CutSegment(const CommandRows& c, size_t row, const TrialStreams& s, double start, double end,
+                int episode_id, int* step, const LogImportOptions& o, const TimeScales& ts,
+                LogImportSummary* summary, SampleSink* sink) {
+  constexpr double kRelativeEpsilon = 1e-9;
+  // Each end of a window may lie up to the tolerance beyond the data (the pose held there): a
+  // segment one pose interval short of a window still makes it at the default tolerance.
+  const double slack = 2 * ts.tolerance;
+  const double length = end - start;
+  ++summary->segments;
+  const double window = o.window_s > 0 ? o.window_s : length;
+  const int windows =
+      length + slack < ts.min_duration
+          ? 0
+          : static_cast<int>(std::floor((length + slack) / window + kRelativeEpsilon));
+  if (windows == 0) ++summary->short_segments;
+  for (int w = 0; w < windows; ++w) {
+    sink->Add(c, row, s, start + w * window, std::min(end, start + (w + 1) * window), episode_id,
+              (*step)++, o.per_second);
+  }
+  if (o.window_s <= 0) return;
+  const double remainder = length - windows * window;
+  if (remainder > slack) {
+    if (windows > 0) ++summary->remainders;
+    const double shortfall = window - remainder;
+    if (shortfall <= 2 * ts.pose_dt) {
+      ++summary->near_miss_remainders;
+      summary->largest_near_miss_s = std::max(summary->largest_near_miss_s, shortfall);
+    }
+  }
+}
+
+// Cuts one trial's episodes at command changes (and into windows).
+void CutTrial(const CommandRows& c, const TrialStreams& s, const std::vector<Interval>& episodes,
+              const LogImportOptions& o, const TimeScales& ts, EpisodeIds* ids,
+              std::map<int, int>* steps_so_far, LogImportSummary* summary, SampleSink* sink) {
+  for (const auto& [a, b] : episodes) {
     // Command row in force at a (a row issued before a logging gap is stale: then the episode
     // starts at its first command row), then each change of the command key until b.
-    const auto after = std::upper_bound(commands.t.begin(), commands.t.end(), a);
-    size_t row = static_cast<size_t>(after - commands.t.begin());
+    const auto after = std::upper_bound(c.t.begin(), c.t.end(), a);
+    size_t row = static_cast<size_t>(after - c.t.begin());
     double start = a;
-    if (row > 0 && commands.t[row - 1] >= a - summary.gap_s) {
+    if (row > 0 && c.t[row - 1] >= a - ts.gap) {
       --row;
     } else {
-      if (row >= commands.t.size() || commands.t[row] >= b) continue;
-      start = commands.t[row];
+      if (row >= c.t.size() || c.t[row] >= b) continue;
+      start = c.t[row];
     }
-    const int episode_id = o.episode_column.empty() ? static_cast<int>(e) : commands.episode[row];
-    int& step = steps_so_far[episode_id];
+    const int episode_id = ids->Id(o, c, row);
+    int& step = (*steps_so_far)[episode_id];
     while (start < b) {
       size_t next = row + 1;
-      while (next < commands.t.size() && commands.t[next] < b && commands.key[next] == commands.key[row]) ++next;
-      const double end = next < commands.t.size() ? std::min(commands.t[next], b) : b;
-      ++summary.segments;
-      if (end - start < summary.min_duration_s - tolerance) {
-        ++summary.short_segments;
-      } else if (o.window_s > 0) {
-        const int windows = static_cast<int>(std::floor((end - start + tolerance) / o.window_s));
-        for (int w = 0; w < windows; ++w) {
-          add_sample(row, start + w * o.window_s, std::min(end, start + (w + 1) * o.window_s),
-                     episode_id, step++);
-        }
-      } else {
-        add_sample(row, start, end, episode_id, step++);
-      }
-      if (next >= commands.t.size() || commands.t[next] >= b) break;
+      while (next < c.t.size() && c.t[next] < b && c.key[next] == c.key[row]) ++next;
+      const double end = next < c.t.size() ? std::min(c.t[next], b) : b;
+      CutSegment(c, row, s, start, end, episode_id, &step, o, ts, summary, sink);
+      if (next >= c.t.size() || c.t[next] >= b) break;
       row = next;
       start = end;
     }
   }
-  summary.episodes = static_cast<int>(episodes.size());
-  summary.samples = static_cast<int>(sample_command.size());
-  summary.dropped_rows = invalid.total();
-  summary.dropped_report = invalid.Report();
-  for (const auto& label : all_labels) {
-    if (!used_labels.count(label)) summary.unmatched_commands.push_back(label);
-  }
-  if (summary_out) *summary_out = summary;
-  if (summary.samples == 0) {
-    throw MakeInputError(o.commands.path, "",
-                         "no samples: every command segment was shorter than " +
-                             FormatNumber(summary.min_duration_s) +
-                             " s (continuous commands need --bins) (" + summary.BriefReport() + ")");
-  }
+}
 
+// Warnings about the samples' durations: unequal durations make pose changes incomparable.
+void CheckDurations(const std::vector<double>& durations, const LogImportOptions& o,
+                    const TimeScales& ts, LogImportSummary* summary) {
+  if (durations.empty()) return;
+  const auto [lo, hi] = std::minmax_element(durations.begin(), durations.end());
+  summary->min_window_s = *lo;
+  summary->max_window_s = *hi;
+  summary->median_window_s = Median(durations);
+  // Windows shortened by up to the tolerance at each end are expected; more than that is not.
+  const double expected = std::max(2 * ts.tolerance, 0.02 * summary->median_window_s) * 1.01;
+  if (o.per_second || *hi - *lo <= expected) return;
+  summary->warnings.push_back(
+      "samples last from " + FormatNumber(*lo) + " to " + FormatNumber(*hi) + " s (median " +
+      FormatNumber(summary->median_window_s) +
+      " s) and the pose change grows with duration: cut equal windows with --window S, or divide "
+      "by the duration with --per-second");
+}
+
+void CheckUnits(const LogImportOptions& o) {
+  std::set<std::string> known = {o.commands.time_column, o.pose.time_column, o.episode_column};
+  for (const auto* s : {&o.commands, &o.pose, &o.attitude})
+    known.insert(s->columns.begin(), s->columns.end());
+  if (!o.attitude.path.empty()) known.insert(o.attitude.time_column);
+  for (const auto& [column, factor] : o.units) {
+    if (!known.count(column)) {
+      throw MakeInputError("", "--units", "column '" + column + "' is not a selected column");
+    }
+  }
+}
+
+// The set from the sink: command table, x (and z), names and units, episodes, metadata.
+SampleSet Assemble(SampleSink& sink, const LogImportOptions& o, const std::vector<LogTrial>& trials,
+                   const LogImportSummary& summary, bool six_dof, int terrain_dims) {
+  SampleSet set = std::move(sink.set);
   const Eigen::Index n = summary.samples, dc = static_cast<Eigen::Index>(o.commands.columns.size());
   set.command_dim_names = o.commands.columns;
-  set.commands.resize(static_cast<Eigen::Index>(table_rows.size()), dc);
-  for (size_t r = 0; r < table_rows.size(); ++r) {
-    for (Eigen::Index c = 0; c < dc; ++c) set.commands(r, c) = table_rows[r][c];
+  set.commands.resize(static_cast<Eigen::Index>(sink.table_rows.size()), dc);
+  for (size_t r = 0; r < sink.table_rows.size(); ++r) {
+    for (Eigen::Index c = 0; c < dc; ++c) set.commands(r, c) = sink.table_rows[r][c];
   }
-  set.command = Eigen::Map<Eigen::VectorXi>(sample_command.data(), n);
+  set.command = Eigen::Map<Eigen::VectorXi>(sink.command.data(), n);
   using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  set.x = Eigen::Map<RowMatrix>(xs.data(), n, six_dof ? 6 : 3);
+  set.x = Eigen::Map<RowMatrix>(sink.xs.data(), n, six_dof ? 6 : 3);
+  const std::string rate = o.per_second ? "/s" : "";
   if (six_dof) {
     set.x_names = {"dx", "dy", "dz", "droll", "dpitch", "dyaw"};
-    set.x_units = {"m", "m", "m", "rad", "rad", "rad"};
+    set.x_units = {"m" + rate, "m" + rate, "m" + rate, "rad" + rate, "rad" + rate, "rad" + rate};
   } else {
     set.x_names = {"dx", "dy", "dyaw"};
-    set.x_units = {"m", "m", "rad"};
+    set.x_units = {"m" + rate, "m" + rate, "rad" + rate};
   }
-  if (has_attitude) {
-    set.z = Eigen::Map<RowMatrix>(zs.data(), n, static_cast<Eigen::Index>(attitude.values.size()));
+  if (terrain_dims > 0) {
+    set.z = Eigen::Map<RowMatrix>(sink.zs.data(), n, terrain_dims);
     // "pitch_deg" converted to radians is stored as "pitch".
     for (const std::string& name : o.attitude.columns) {
       std::string stored = name;
-      for (const char* suffix : {"_deg", "_rad"}) {
-        const std::string sfx = suffix;
+      for (const std::string sfx : {"_deg", "_rad"}) {
         if (o.units.count(name) && name.size() > sfx.size() &&
             name.compare(name.size() - sfx.size(), sfx.size(), sfx) == 0) {
           stored = name.substr(0, name.size() - sfx.size());
@@ -449,17 +466,162 @@ SampleSet ImportLog(const LogImportOptions& o, LogImportSummary* summary_out) {
       }
       set.z_names.push_back(stored);
     }
-    set.z_units.assign(attitude.values.size(), "rad");
+    set.z_units.assign(terrain_dims, "rad");
   }
-  set.episode = Eigen::Map<Eigen::VectorXi>(sample_episode.data(), n);
-  set.step = Eigen::Map<Eigen::VectorXi>(sample_step.data(), n);
+  set.episode = Eigen::Map<Eigen::VectorXi>(sink.episode.data(), n);
+  set.step = Eigen::Map<Eigen::VectorXi>(sink.step.data(), n);
   set.source = o.source;
-  std::string files = Filename(o.commands.path) + "," + Filename(o.pose.path);
-  if (has_attitude) files += "," + Filename(o.attitude.path);
+  std::string files = Filename(trials[0].commands) + "," + Filename(trials[0].pose);
+  if (!trials[0].attitude.empty()) files += "," + Filename(trials[0].attitude);
+  if (trials.size() > 1) files += " and " + std::to_string(trials.size() - 1) + " more trials";
   set.metadata["imported_from"] = files;
   set.metadata["log_window_s"] = o.window_s > 0 ? FormatNumber(o.window_s) : "command segments";
   set.metadata["log_gap_s"] = FormatNumber(summary.gap_s);
-  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError(o.commands.path, "", e);
+  if (o.per_second) set.metadata["log_per_second"] = "pose changes divided by window duration";
+  return set;
+}
+
+}  // namespace
+
+bool LogImportOptions::IsValid(std::string* error) const {
+  auto fail = [&](const std::string& m) {
+    *error = m;
+    return false;
+  };
+  if (commands.path.empty()) return fail("--commands: a command stream is required");
+  if (pose.path.empty()) return fail("--pose: a pose stream is required");
+  if (pose.columns.size() != 3 && pose.columns.size() != 6) {
+    return fail("--pose-cols: " + std::to_string(pose.columns.size()) +
+                " columns, expected 3 (x,y,yaw) or 6 (x,y,z,roll,pitch,yaw)");
+  }
+  if (!attitude.path.empty() && attitude.columns.empty()) {
+    return fail("--terrain-cols: none chosen for the attitude stream");
+  }
+  if (attitude.path.empty() && !attitude.columns.empty()) {
+    return fail("--terrain-cols: given without an --attitude stream to read them from");
+  }
+  if (!(gap_s >= 0) || !std::isfinite(gap_s)) return fail("--gap: expected seconds >= 0");
+  if (!(window_s >= 0) || !std::isfinite(window_s)) return fail("--window: expected seconds >= 0");
+  if (!(min_duration_s >= 0) || !std::isfinite(min_duration_s))
+    return fail("--min-duration: expected seconds >= 0");
+  for (const auto& [stream, flag] : {std::pair{&commands, "--commands-rate"},
+                                     {&pose, "--pose-rate"},
+                                     {&attitude, "--attitude-rate"}}) {
+    if (!(stream->rate_hz >= 0) || !std::isfinite(stream->rate_hz)) {
+      return fail(std::string(flag) + ": expected rows per second >= 0");
+    }
+  }
+  if (!(time_tolerance_s >= 0) || !std::isfinite(time_tolerance_s)) {
+    return fail("--time-tolerance: expected seconds >= 0");
+  }
+  if (window_s > 0 && 2 * time_tolerance_s >= window_s) {
+    return fail(
+        "--time-tolerance: must be shorter than half the --window (it applies at each end)");
+  }
+  return bins.IsValid(error);
+}
+
+std::string LogImportSummary::BriefReport() const {
+  char buf[512];
+  std::snprintf(
+      buf, sizeof buf,
+      "%d samples from %d episodes%s (%d command segments, %d shorter than %.3g s skipped; "
+      "gap %.3g s); rows: %lld commands, %lld pose, %lld attitude, %lld dropped",
+      samples, episodes, trials > 1 ? (" in " + std::to_string(trials) + " trials").c_str() : "",
+      segments, short_segments, min_duration_s, gap_s, command_rows, pose_rows, attitude_rows,
+      dropped_rows);
+  return buf;
+}
+
+std::string LogImportSummary::WindowReport() const {
+  std::string dropped;
+  auto add = [&](long long n, const std::string& what) {
+    if (n > 0) dropped += (dropped.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  };
+  add(short_segments, "command segments shorter than " + FormatNumber(min_duration_s) + " s");
+  add(remainders, "segment remainders shorter than a window");
+  add(commands_outside_coverage, "command rows outside the pose" +
+                                     std::string(attitude_rows > 0 ? "/attitude" : "") +
+                                     " coverage");
+  add(trials_without_overlap, "trials whose streams do not overlap in time");
+  add(dropped_rows, "invalid rows");
+  std::string out = "windows: " + std::to_string(samples) +
+                    " kept; dropped: " + (dropped.empty() ? "none" : dropped);
+  if (near_miss_remainders > 0) {
+    out += "; " + std::to_string(near_miss_remainders) +
+           " of them fell short of a window by at most " + FormatNumber(largest_near_miss_s) +
+           " s (time tolerance " + FormatNumber(time_tolerance_s) +
+           " s at each end of a window; keep them with --time-tolerance " +
+           FormatNumber(0.5 * largest_near_miss_s * 1.01) + ")";
+  }
+  return out;
+}
+
+SampleSet ImportLog(const LogImportOptions& o, LogImportSummary* summary_out) {
+  std::string error;
+  if (!o.IsValid(&error)) throw InputError(error);
+  CheckUnits(o);
+  LogImportSummary summary;
+  InvalidRows invalid(o.drop_invalid);
+  const std::vector<LogTrial> trials = PairTrials(
+      ResolveStreamFiles(o.commands.path, "--commands"), ResolveStreamFiles(o.pose.path, "--pose"),
+      o.attitude.path.empty() ? std::vector<std::string>{}
+                              : ResolveStreamFiles(o.attitude.path, "--attitude"));
+  summary.trials = static_cast<int>(trials.size());
+  // Commands of every trial first (labels and bins are shared), then the sensor streams.
+  CommandColumns shared{std::vector<int>(o.commands.columns.size(), -1),
+                        std::vector<std::map<std::string, int>>(o.commands.columns.size())};
+  std::vector<CommandRows> commands;
+  for (const LogTrial& t : trials) {
+    commands.push_back(ReadCommands(t.commands, o, &shared, &invalid, &summary.command_rows));
+  }
+  KeyCommands(o, shared, &commands, &summary.warnings);
+  std::vector<TrialStreams> streams;
+  for (const LogTrial& t : trials) streams.push_back(ReadStreams(t, o, &invalid, &summary));
+  const TimeScales ts = MakeTimeScales(streams, o);
+  summary.gap_s = ts.gap;
+  summary.min_duration_s = ts.min_duration;
+  summary.time_tolerance_s = ts.tolerance;
+
+  SampleSink sink;
+  std::map<std::pair<int, int>, int> by_column;
+  std::map<int, int> steps_so_far;
+  for (size_t i = 0; i < trials.size(); ++i) {
+    const std::vector<Interval> episodes = TrialEpisodes(commands[i], streams[i], o, ts.gap);
+    summary.episodes += trials.size() > 1 && o.episode_column.empty() && !episodes.empty()
+                            ? 1
+                            : static_cast<int>(episodes.size());
+    summary.commands_outside_coverage += RowsOutside(commands[i], episodes);
+    summary.trials_without_overlap += episodes.empty();
+    EpisodeIds ids{trials.size() > 1, static_cast<int>(i), &by_column};
+    CutTrial(commands[i], streams[i], episodes, o, ts, &ids, &steps_so_far, &summary, &sink);
+  }
+  if (summary.episodes == 0) {
+    throw MakeInputError(trials[0].commands, "time",
+                         "the command, pose and attitude streams do not overlap in time (check "
+                         "their time columns and --units)");
+  }
+  summary.samples = static_cast<int>(sink.command.size());
+  summary.dropped_rows = invalid.total();
+  summary.dropped_report = invalid.Report();
+  std::set<std::string> all_labels;
+  for (const CommandRows& c : commands) all_labels.insert(c.label.begin(), c.label.end());
+  for (const auto& label : all_labels) {
+    if (!sink.used_labels.count(label)) summary.unmatched_commands.push_back(label);
+  }
+  CheckDurations(sink.durations, o, ts, &summary);
+  if (summary_out) *summary_out = summary;
+  if (summary.samples == 0) {
+    throw MakeInputError(trials[0].commands, "",
+                         "no samples: every command segment was shorter than " +
+                             FormatNumber(summary.min_duration_s) +
+                             " s (continuous commands need --bins) (" + summary.WindowReport() +
+                             ")");
+  }
+  SampleSet set =
+      Assemble(sink, o, trials, summary, streams[0].six_dof,
+               streams[0].has_attitude ? static_cast<int>(o.attitude.columns.size()) : 0);
+  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError(trials[0].commands, "", e);
   return set;
 }
 

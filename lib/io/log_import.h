@@ -2,21 +2,26 @@
 // Time-stamped robot logs -> a sample set. Several CSV streams (commands, pose, attitude), each
 // with its own time column and units, are joined by time: the command is held from one command
 // row to the next (zero-order hold), the pose and attitude are interpolated (linear for positions,
-// shortest arc for angles). Episodes come from logging gaps (or an episode column), samples from
-// cutting each episode at command changes and optionally into fixed windows. See docs/log-import.md.
+// shortest arc for angles). A stream may be one file or one file per trial (a folder or a glob,
+// io/log_files.h); each trial is joined on its own. Episodes come from trials, logging gaps or an
+// episode column, samples from cutting each episode at command changes and optionally into fixed
+// windows. See docs/log-import.md.
 #include <map>
 #include <string>
 #include <vector>
 
 #include "core/sample_set.h"
+#include "io/command_bins.h"
 
 namespace dgmm {
 
-// One CSV stream: its file, its time column and the value columns taken from it.
+// One CSV stream: its file (or folder or glob pattern), its time column and the value columns.
 struct LogStream {
   std::string path;
   std::string time_column = "t";
   std::vector<std::string> columns;
+  // > 0: the stream has no time column; data row i (from 0) is at t = i / rate_hz in each file.
+  double rate_hz = 0;
 };
 
 struct LogImportOptions {
@@ -28,14 +33,26 @@ struct LogImportOptions {
   // Optional attitude (IMU): columns are the terrain angles (e.g. pitch, roll) read at the start
   // of each sample. Empty path: no terrain.
   LogStream attitude;
-  std::string episode_column;  // in the commands stream; empty: episodes from gaps only
+  // In the commands stream; empty: one episode per trial file, split further at logging gaps
+  // (a single file: episodes from gaps only).
+  std::string episode_column;
   // A pause longer than gap_s between consecutive pose or attitude rows ends an episode;
   // 0: 10 x the slower of the two streams' median sampling interval.
   double gap_s = 0;
   double window_s = 0;        // > 0: cut each command segment into windows of this length
   double min_duration_s = 0;  // shorter segments are skipped; 0: 2 pose sampling intervals
-  int bins = 0;               // > 0: numeric command columns binned into this many equal bins
+  // Each end of a window may lie this long beyond the data of its segment (the pose held at the
+  // last row): a window whose pose rows end one sample short of it is kept (and its duration
+  // says so). 0: half the median pose interval.
+  double time_tolerance_s = 0;
+  // Numeric command columns binned into a few commands (io/command_bins.h; a zero is its own
+  // command). bins.bins == 0 and no edges: every distinct value is a command.
+  CommandBinOptions bins;
+  // Divide each pose change by its window's duration (rates, m/s and rad/s): for samples of
+  // unequal duration (e.g. one sample per command segment).
+  bool per_second = false;
   char delimiter = ',';
+  bool has_header = true;  // false: no header row; columns are named by position "1", "2", ...
   bool drop_invalid = false;               // skip (and count) invalid rows instead of refusing
   std::map<std::string, double> units;     // column -> factor to SI (csv_reader.h ParseUnits)
   std::string source = "real";
@@ -45,17 +62,30 @@ struct LogImportOptions {
 };
 
 struct LogImportSummary {
+  int trials = 0;  // file sets (1 when every stream is one file)
   long long command_rows = 0, pose_rows = 0, attitude_rows = 0;
   long long dropped_rows = 0;
   std::vector<std::string> dropped_report;  // one line per file
-  double gap_s = 0, min_duration_s = 0;  // the values used (automatic choices; >= the window)
+  // The values used (automatic choices; min_duration_s >= the window).
+  double gap_s = 0, min_duration_s = 0, time_tolerance_s = 0;
   int episodes = 0;
   int segments = 0;        // command segments inside episodes
   int short_segments = 0;  // skipped: shorter than min_duration_s (or than one window)
-  int samples = 0;
+  int samples = 0;         // windows kept
+  // Time not turned into samples, by reason: segment remainders shorter than a window (and how
+  // many of them fell short by at most two pose intervals, with the largest such shortfall, the
+  // --time-tolerance that would keep them), and command rows outside the pose/attitude coverage.
+  int remainders = 0, near_miss_remainders = 0;
+  double largest_near_miss_s = 0;
+  long long commands_outside_coverage = 0;
+  int trials_without_overlap = 0;  // trials whose streams do not overlap in time
+  // Durations of the samples (s): they differ when samples are whole command segments.
+  double min_window_s = 0, median_window_s = 0, max_window_s = 0;
   std::vector<std::string> unmatched_commands;  // in the command stream but in no sample
-  std::vector<std::string> warnings;            // e.g. continuous commands without --bins
+  std::vector<std::string> warnings;  // e.g. continuous commands without --bins, unequal durations
   std::string BriefReport() const;
+  // "windows: 187 kept; dropped: ..." by reason, one line.
+  std::string WindowReport() const;
 };
 
 // Throws InputError naming file, line and column for bad input (unless drop_invalid for bad

@@ -5,19 +5,22 @@
 #include <vtkChartHistogram2D.h>
 #include <vtkColorLegend.h>
 #include <vtkColorTransferFunction.h>
-#include <vtkDiscretizableColorTransferFunction.h>
 #include <vtkContextScene.h>
 #include <vtkContourFilter.h>
+#include <vtkDiscretizableColorTransferFunction.h>
 #include <vtkDoubleArray.h>
 #include <vtkFloatArray.h>
 #include <vtkPlotLine.h>
 #include <vtkPlotPoints.h>
 #include <vtkPolyData.h>
-#include <vtkTable.h>
+#include <vtkRenderWindow.h>
 #include <vtkStringArray.h>
+#include <vtkTable.h>
 #include <vtkTextProperty.h>
+#include <vtkTextRenderer.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "render/heat_map_chart.h"
@@ -216,6 +219,61 @@ struct RenderedPanel {
   PlotLayout layout;
 };
 
+// Width in pixels of the widest line of `text` drawn with `property` at `font_size`.
+double MeasuredWidth(vtkTextProperty* property, const std::string& text, int font_size, int dpi) {
+  auto probe = vtkSmartPointer<vtkTextProperty>::New();
+  probe->ShallowCopy(property);
+  probe->SetFontSize(font_size);
+  int box[4] = {0, 0, 0, 0};
+  if (!vtkTextRenderer::GetInstance()->GetBoundingBox(probe, text, box, dpi)) {
+    return TextWidthPx(text, font_size);
+  }
+  return box[1] - box[0] + 1;
+}
+
+// Category labels of the x axis that overlap their neighbours are wrapped and, if need be, set
+// in a smaller font (FitCategoryLabels), measured with the axis' own font; returns true when it
+// changed them (the chart must be drawn again).
+bool FitXCategories(vtkChartHistogram2D* chart, const HeatMapSpec& spec, int dpi) {
+  if (spec.x_categories.empty()) return false;
+  vtkAxis* axis = chart->GetAxis(vtkAxis::BOTTOM);
+  vtkTextProperty* property = axis->GetLabelProperties();
+  const double block = (chart->GetPoint2()[0] - chart->GetPoint1()[0]) /
+                       static_cast<double>(spec.x_categories.size());
+  constexpr double kGapPx = 6;  // between neighbouring labels
+  constexpr int kMinFontSize = 8;
+  const int size = property->GetFontSize();
+  const FittedLabels fitted = FitCategoryLabels(
+      spec.x_categories, block - kGapPx, size, std::min(size, kMinFontSize),
+      [&](const std::string& text, int font) { return MeasuredWidth(property, text, font, dpi); });
+  if (fitted.labels == spec.x_categories && fitted.font_size == size) return false;
+  property->SetFontSize(fitted.font_size);
+  SetCategories(axis, fitted.labels, spec.background.range.x_min, spec.background.range.x_max);
+  return true;
+}
+
+// Where the x axis' category labels landed: per label its pixel box (left, right, bottom, top),
+// measured with the axis' font, centred on its tick below the plot.
+std::vector<std::array<double, 4>> XTickBoxes(vtkChartHistogram2D* chart, const PlotLayout& layout,
+                                              int dpi) {
+  std::vector<std::array<double, 4>> boxes;
+  vtkAxis* axis = chart->GetAxis(vtkAxis::BOTTOM);
+  vtkStringArray* labels = axis->GetTickLabels();
+  vtkDoubleArray* positions = axis->GetTickPositions();
+  if (labels == nullptr || positions == nullptr) return boxes;
+  vtkTextProperty* property = axis->GetLabelProperties();
+  for (vtkIdType k = 0; k < labels->GetNumberOfValues(); ++k) {
+    const std::string text = labels->GetValue(k);
+    int box[4] = {0, 0, 0, 0};
+    vtkTextRenderer::GetInstance()->GetBoundingBox(property, text, box, dpi);
+    const double width = box[1] - box[0] + 1, height = box[3] - box[2] + 1;
+    const double centre = layout.ToPixel(positions->GetValue(k), layout.range.y_min).x();
+    boxes.push_back(
+        {centre - width / 2, centre + width / 2, layout.bottom - 5 - height, layout.bottom - 5});
+  }
+  return boxes;
+}
+
 RenderedPanel RenderPanel(const HeatMapSpec& spec) {
   if (std::string problem = spec.Validate(); !problem.empty()) {
     throw MakeInputError("", "heat map", problem);
@@ -225,7 +283,11 @@ RenderedPanel RenderPanel(const HeatMapSpec& spec) {
   view->GetScene()->AddItem(chart);
   RenderedPanel out;
   out.image = CaptureView(view);
+  // The plot's width is known once drawn: labels too wide for their block are refitted.
+  const int dpi = view->GetRenderWindow()->GetDPI();
+  if (FitXCategories(chart, spec, dpi)) out.image = CaptureView(view);
   out.layout = render_internal::ChartLayout(chart, spec);
+  if (!spec.x_categories.empty()) out.layout.x_tick_boxes = XTickBoxes(chart, out.layout, dpi);
   return out;
 }
 
@@ -439,6 +501,7 @@ std::vector<PlotLayout> RenderHeatMapRow(const std::vector<HeatMapSpec>& panels,
     RenderedPanel panel = RenderPanel(spec);
     panel.layout.left += offset;
     panel.layout.right += offset;
+    for (auto& box : panel.layout.x_tick_boxes) box[0] += offset, box[1] += offset;
     offset += spec.width;
     images.push_back(panel.image);
     layouts.push_back(panel.layout);

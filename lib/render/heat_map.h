@@ -79,6 +79,10 @@ struct PlotLayout {
   // What was drawn: axis titles, the title lines and the colour scale's range and kind.
   std::string x_title, y_title, title;
   std::vector<std::string> x_ticks, y_ticks;  // tick labels when category axes were drawn
+  // With x categories: each label's box as drawn (left, right, bottom, top in pixels, measured
+  // with the axis font); labels too wide for their block are wrapped or set smaller so that
+  // neighbouring boxes do not overlap.
+  std::vector<std::array<double, 4>> x_tick_boxes;
   int title_font_size = 0;
   double color_min = 0, color_max = 0;
   HeatMapSpec::ColorScale color_scale = HeatMapSpec::ColorScale::kLinear;

@@ -15,6 +15,7 @@
 #include <sstream>
 #include <thread>
 
+#include "tune/fold_plan.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -80,8 +81,9 @@ MotionModel FitEmModel(const SampleSet& train, const MotionModel& header, bool t
   return model;
 }
 
+// em_for[terrain]: fit and score the EM baseline for that terrain setting.
 FoldResult RunFold(const SampleSet& set, const std::vector<int>& fold_of, int repeat, int fold,
-                   const CvOptions& options, bool has_terrain) {
+                   const CvOptions& options, bool has_terrain, std::array<bool, 2> em_for) {
   const std::uint64_t seed = DeriveSeed(options.seed, repeat, fold, 1);
   std::vector<int> train_rows, valid_rows;
   for (int i = 0; i < set.size(); ++i) (fold_of[i] == fold ? valid_rows : train_rows).push_back(i);
@@ -111,9 +113,11 @@ FoldResult RunFold(const SampleSet& set, const std::vector<int>& fold_of, int re
     }
     MotionModel em_model;
     const int em_variant = terrain ? kEmWith : kEmWithout;
-    if (options.em_baseline) {
+    if (em_for[terrain]) {
+      int commands = 0;
       em_model = FitEmModel(train, dgmm_model, terrain, options, DeriveSeed(seed, 3, terrain),
-                            &result.components[em_variant], &result.em_commands);
+                            &result.components[em_variant], &commands);
+      result.em_commands = commands;  // the same commands for either terrain setting
     }
     int unscored = 0;
     for (int i : valid_rows) {
@@ -123,16 +127,61 @@ FoldResult RunFold(const SampleSet& set, const std::vector<int>& fold_of, int re
       }
       result.per_sample[terrain ? kDgmmWith : kDgmmWithout].push_back(
           HeldOut(dgmm_model, set, i, terrain) - jacobian);
-      if (options.em_baseline) {
+      if (em_for[terrain]) {
         result.per_sample[em_variant].push_back(HeldOut(em_model, set, i, terrain) - jacobian);
       }
     }
     result.unscored = unscored;
   }
-  if (options.em_baseline && options.without_terrain && options.with_terrain && has_terrain) {
-    result.em_commands /= 2;  // counted once per terrain setting
-  }
   return result;
+}
+
+// Why the EM-BIC row over d dimensions is omitted: in some training fold a command has fewer
+// samples than the d + d(d+1)/2 parameters of one full-covariance Gaussian, so unregularised EM
+// fits noise (near-singular covariances, held-out log-likelihoods of -1e5 and worse); "" when
+// every command has enough in every training fold.
+std::string EmUnderdetermined(const SampleSet& set, const std::vector<std::vector<int>>& fold_of,
+                              int folds, int d) {
+  const int parameters = d + d * (d + 1) / 2;
+  std::map<int, int> total;
+  for (int i = 0; i < set.size(); ++i) ++total[set.command(i)];
+  int worst_command = -1, worst = parameters;
+  for (const std::vector<int>& assignment : fold_of) {
+    for (int f = 0; f < folds; ++f) {
+      std::map<int, int> train = total;
+      for (int i = 0; i < set.size(); ++i) train[set.command(i)] -= assignment[i] == f;
+      for (const auto& [c, n] : train) {
+        if (n > 0 && n < worst) worst = n, worst_command = c;
+      }
+    }
+  }
+  if (worst_command < 0) return "";
+  const std::string name = worst_command < static_cast<int>(set.command_labels.size())
+                               ? "'" + set.command_labels[worst_command] + "'"
+                               : std::to_string(worst_command);
+  return "command " + name + " has " + std::to_string(worst) +
+         " training samples in a fold, fewer than the " + std::to_string(parameters) +
+         " parameters of one full-covariance Gaussian in d = " + std::to_string(d) +
+         " (unregularised EM would fit noise)";
+}
+
+// em_for[terrain]: whether the EM baseline runs for that terrain setting (asked for, and every
+// command has enough training samples in every fold; else the reason goes to *summary).
+std::array<bool, 2> EmRowsToRun(const SampleSet& set, const std::vector<std::vector<int>>& fold_of,
+                                const CvOptions& options, CvSummary* summary) {
+  std::array<bool, 2> em_for = {false, false};
+  if (!options.em_baseline) return em_for;
+  for (bool terrain : {false, true}) {
+    if (terrain ? !(options.with_terrain && summary->has_terrain) : !options.without_terrain) {
+      continue;
+    }
+    const int d = set.pose_dim() + (terrain ? set.terrain_dim() : 0);
+    std::string& why =
+        terrain ? summary->em_with_terrain_omitted : summary->em_without_terrain_omitted;
+    why = EmUnderdetermined(set, fold_of, options.folds, d);
+    em_for[terrain] = why.empty();
+  }
+  return em_for;
 }
 
 double SampleSd(const std::vector<double>& v) {
@@ -193,7 +242,9 @@ bool CvOptions::IsValid(std::string* error) const {
   };
   std::string dgmm_error;
   if (!dgmm.IsValid(&dgmm_error)) return fail(dgmm_error);
-  if (folds < 2) return fail("folds must be >= 2, got " + std::to_string(folds));
+  if (folds < 0 || folds == 1) {
+    return fail("folds must be >= 2 (or 0: chosen from the data), got " + std::to_string(folds));
+  }
   if (repeats < 1) return fail("repeats must be >= 1, got " + std::to_string(repeats));
   if (!without_terrain && !with_terrain) return fail("nothing to evaluate (no terrain setting)");
   if (em_baseline) {
@@ -241,7 +292,6 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
 
   CvSummary summary;
   summary.samples = set.size();
-  summary.folds = options.folds;
   summary.repeats = options.repeats;
   summary.has_terrain = set.terrain_dim() > 0;
   std::vector<int> distinct(set.command.data(), set.command.data() + set.size());
@@ -250,30 +300,20 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
       static_cast<int>(std::unique(distinct.begin(), distinct.end()) - distinct.begin());
 
   // Fold assignments first (serially), then every (repeat, fold) task on the worker threads.
-  int episodes = 0;
-  if (set.has_sequence()) {
-    std::vector<int> ids(set.episode.data(), set.episode.data() + set.size());
-    std::sort(ids.begin(), ids.end());
-    episodes = static_cast<int>(std::unique(ids.begin(), ids.end()) - ids.begin());
-  }
-  const bool by_episode = options.group_by_episode && episodes >= options.folds;
-  if (by_episode) {
-    summary.folds_by = "episodes (" + std::to_string(episodes) + " whole episodes)";
-  } else if (!options.group_by_episode) {
-    summary.folds_by = "stratified by command (asked)";
-  } else if (!set.has_sequence()) {
-    summary.folds_by = "stratified by command (the set has no episode data)";
-  } else {
-    summary.folds_by = "stratified by command (only " + std::to_string(episodes) +
-                       " episodes for " + std::to_string(options.folds) + " folds)";
-  }
+  const FoldPlan plan = ChooseFolds(set, options.folds, options.group_by_episode);
+  summary.folds = plan.folds;
+  summary.folds_by = plan.reason;
+  const bool by_episode = plan.by_episode;
+  CvOptions planned = options;
+  planned.folds = plan.folds;
   std::vector<std::vector<int>> fold_of(options.repeats);
   for (int r = 0; r < options.repeats; ++r) {
     std::mt19937_64 rng(DeriveSeed(options.seed, r, 0, 0));
-    fold_of[r] = by_episode ? EpisodeFolds(set.episode, options.folds, rng)
-                            : StratifiedFolds(set.command, options.folds, rng);
+    fold_of[r] = by_episode ? EpisodeFolds(set.episode, planned.folds, rng)
+                            : StratifiedFolds(set.command, planned.folds, rng);
   }
-  const int tasks = options.repeats * options.folds;
+  const std::array<bool, 2> em_for = EmRowsToRun(set, fold_of, planned, &summary);
+  const int tasks = options.repeats * planned.folds;
   std::vector<FoldResult> results(tasks);
   std::atomic<int> next{0}, done{0};
   std::mutex mutex;
@@ -281,8 +321,8 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
   auto worker = [&] {
     for (int t; (t = next.fetch_add(1)) < tasks;) {
       try {
-        results[t] = RunFold(set, fold_of[t / options.folds], t / options.folds, t % options.folds,
-                             options, summary.has_terrain);
+        results[t] = RunFold(set, fold_of[t / planned.folds], t / planned.folds, t % planned.folds,
+                             options, summary.has_terrain, em_for);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mutex);
         if (!failure) failure = std::current_exception();
@@ -309,13 +349,13 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
   double components_total[kVariants] = {0, 0, 0, 0};
   int em_commands = 0, dgmm_commands = 0;
   for (int v = 0; v < kVariants; ++v) {
-    scores[v]->per_fold = Eigen::MatrixXd::Zero(options.repeats, options.folds);
+    scores[v]->per_fold = Eigen::MatrixXd::Zero(options.repeats, planned.folds);
   }
   for (int r = 0; r < options.repeats; ++r) {
     std::array<std::vector<double>, kVariants> all;
     int unscored = 0;
-    for (int f = 0; f < options.folds; ++f) {
-      const FoldResult& fr = results[r * options.folds + f];
+    for (int f = 0; f < planned.folds; ++f) {
+      const FoldResult& fr = results[r * planned.folds + f];
       unscored += fr.unscored;
       em_commands += fr.em_commands;
       dgmm_commands += fr.dgmm_commands;
@@ -362,6 +402,11 @@ std::string CvSummary::BriefReport() const {
   row("DGMM with terrain", dgmm_with_terrain);
   row("EM-BIC without terrain", em_without_terrain);
   row("EM-BIC with terrain", em_with_terrain);
+  if (!em_without_terrain_omitted.empty()) {
+    out << "; EM-BIC without terrain omitted: " << em_without_terrain_omitted;
+  }
+  if (!em_with_terrain_omitted.empty())
+    out << "; EM-BIC with terrain omitted: " << em_with_terrain_omitted;
   return out.str();
 }
 

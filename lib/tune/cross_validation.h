@@ -38,6 +38,8 @@ std::uint64_t DeriveSeed(std::uint64_t seed, std::uint64_t a, std::uint64_t b = 
 struct CvOptions {
   // DGMM settings (k, variant, initial covariance, floor); with_terrain and seed are set per fold.
   DgmmOptions dgmm;
+  // 0: chosen from the data (tune/fold_plan.h ChooseFolds: leave-one-episode-out for few
+  // episodes); >= 2: that many.
   int folds = 10;
   int repeats = 10;
   // Base seed: repeat r's fold assignment and fold f's merge decisions draw from
@@ -47,9 +49,9 @@ struct CvOptions {
   // false (default): each training fold streams its samples in the set's recorded order, as the
   // robot produced them (ADDSAMPLE is order dependent). true: shuffled per (repeat, fold).
   bool shuffle_training = false;
-  // true (default): when the set has episode data with at least `folds` episodes, folds hold
-  // whole episodes (EpisodeFolds), so windows of one drive never fall on both sides; otherwise
-  // (or when false) stratified by command (StratifiedFolds).
+  // true (default): when the set has episode data with at least `folds` episodes (two for
+  // automatic folds), folds hold whole episodes (EpisodeFolds), so windows of one drive never fall
+  // on both sides; otherwise (or when false) stratified by command (StratifiedFolds).
   bool group_by_episode = true;
   // Which rows of the table to compute. With terrain needs a set with terrain (else skipped).
   bool without_terrain = true;
@@ -96,10 +98,13 @@ struct CvSummary {
   int scored_per_repeat = 0;
   int unscored_per_repeat = 0;
   bool has_terrain = false;
-  // How the folds were made, stated in every report: "episodes (E whole episodes)" or
-  // "stratified by command" with the reason when episodes were not used.
+  // How the folds were made and why, stated in every report (FoldPlan::reason), e.g.
+  // "leave-one-episode-out (6 episodes)" or "5 folds stratified by command (asked)".
   std::string folds_by;
   CvScore dgmm_without_terrain, dgmm_with_terrain, em_without_terrain, em_with_terrain;
+  // Non-empty when that EM-BIC row was asked for but omitted, and why (a command with fewer
+  // training samples than the parameters of one full-covariance Gaussian: EM would fit noise).
+  std::string em_without_terrain_omitted, em_with_terrain_omitted;
   double seconds = 0;  // wall time
   std::string BriefReport() const;
 };

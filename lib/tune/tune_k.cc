@@ -6,6 +6,7 @@
 #include <cassert>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 #include <tuple>
 
@@ -192,7 +193,9 @@ TuneKPoint ChooseK(const TuneKOptions& options, TuneEvaluator& evaluate, TuneKSu
   for (int i = 1; i < options.grid_points; ++i) {
     if (points[i].log_likelihood > points[best].log_likelihood) best = i;
   }
-  summary->at_grid_edge = best == 0 || best == options.grid_points - 1;
+  summary->k_min = options.k_min;
+  summary->k_max = options.k_max;
+  summary->best_grid_k = points[best].k;
   const double lo = u_min + std::max(best - 1, 0) * step;
   const double hi = u_min + std::min(best + 1, options.grid_points - 1) * step;
   summary->bracket_lo = std::exp(lo);
@@ -203,13 +206,17 @@ TuneKPoint ChooseK(const TuneKOptions& options, TuneEvaluator& evaluate, TuneKSu
         evaluate(std::exp(lo + (hi - lo) * j / (options.refine_points + 1.0)), "refine"));
   }
   FitAndMaximise(points, summary->bracket_lo, summary->bracket_hi, scale, summary);
+  summary->quadratic_k = summary->k;
   // Plateau rule: several evaluations equivalent to the best -> the simplest of them.
   summary->plateau_tolerance = evaluate.Tolerance(points);
+  summary->plateau_tolerance_is_se = !(options.plateau_tolerance > 0);
   const Plateau plateau = FindPlateau(points, summary->plateau_tolerance);
   summary->plateau = plateau.flat;
   summary->plateau_k_lo = plateau.k_lo;
   summary->plateau_k_hi = plateau.k_hi;
   summary->plateau_points = static_cast<int>(plateau.members.size());
+  summary->plateau_spans_grid = plateau.flat && plateau.k_lo <= options.k_min * (1 + 1e-9) &&
+                                plateau.k_hi >= options.k_max * (1 - 1e-9);
   TuneKPoint chosen;
   if (plateau.flat) {
     chosen = points[plateau.simplest];
@@ -335,6 +342,16 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
   }
   if (options.joint) JointStep(options, tune_scale, tune_prior, evaluate, &chosen, &summary);
   summary.k = chosen.k;
+  {
+    // The chosen k at an end of the grid, else the best grid point at one (either end).
+    auto at_low = [&](double k) { return k <= options.k_min * (1 + 1e-9); };
+    auto at_high = [&](double k) { return k >= options.k_max * (1 - 1e-9); };
+    summary.grid_edge = at_low(summary.k)              ? "low"
+                        : at_high(summary.k)           ? "high"
+                        : at_low(summary.best_grid_k)  ? "low"
+                        : at_high(summary.best_grid_k) ? "high"
+                                                       : "";
+  }
   summary.init_scale = chosen.init_scale;
   summary.prior_count = chosen.prior_count;
   summary.log_likelihood = chosen.log_likelihood;
@@ -346,13 +363,27 @@ TuneKSummary TuneK(const SampleSet& set, const TuneKOptions& options) {
   return summary;
 }
 
+std::string TuneKSummary::PlateauMeaning() const {
+  if (!plateau) return "";
+  const std::string within = plateau_tolerance_is_se
+                                 ? std::string("within 1 SE")
+                                 : "within " + ShortNumber(plateau_tolerance) + " nats of the best";
+  if (plateau_spans_grid) {
+    return "k not identifiable from this data, smallest model " + within + " chosen";
+  }
+  char range[64];
+  std::snprintf(range, sizeof range, "k from %.4g to %.4g", plateau_k_lo, plateau_k_hi);
+  return range + (" equally good " + within + ", smallest model there chosen");
+}
+
 std::string TuneKSummary::BriefReport() const {
   std::ostringstream out;
   out << "k = " << k << ": held-out log-likelihood " << log_likelihood << " +- " << standard_error
       << " (" << repeats << " x " << folds << "-fold, " << (with_terrain ? "with" : "without")
       << " terrain); bracket [" << bracket_lo << ", " << bracket_hi << "]"
-      << (at_grid_edge ? " at the edge of the grid" : "") << "; " << curve.size()
-      << " evaluations of k; k chosen by " << k_rule << "; " << evaluations
+      << (grid_edge.empty() ? "" : "; k at the " + grid_edge + " end of the grid") << "; "
+      << curve.size() << " evaluations of k; k chosen by " << k_rule
+      << (plateau ? " (" + PlateauMeaning() + ")" : "") << "; " << evaluations
       << " cross-validations in " << cycles << " cycle(s)";
   if (init_scale_tuned) {
     out << "; S0 scale " << init_scale << (init_scale_plateau ? " (simplest of a plateau)" : "");

@@ -117,12 +117,18 @@ struct TuneKSummary {
   double standard_error = 0;
   double sd = 0;
   bool with_terrain = true;
-  // Bracket around the best grid point (k units); at_grid_edge when it is the first or last.
+  // Bracket around the best grid point (k units).
   double bracket_lo = 0, bracket_hi = 0;
-  bool at_grid_edge = false;
-  // The fitted smooth curve q(u) = a + b (u - u0) + c (u - u0)^2, u = log k, c < 0.
+  // The fitted smooth curve q(u) = a + b (u - u0) + c (u - u0)^2, u = log k, c < 0, and its
+  // maximiser over the bracket (the quadratic refinement; k is it unless the plateau rule chose).
   double u0 = 0, a = 0, b = 0, c = 0;
   int fit_points = 0;
+  double quadratic_k = 0;
+  double k_min = 0, k_max = 0;  // the coarse grid's ends
+  double best_grid_k = 0;       // the best point of the last coarse grid
+  // Where the chosen k sits: "low" or "high" when at (within 1e-9 of) an end of the grid or when
+  // the best grid point is that end, else "" (the optimum may lie beyond the grid).
+  std::string grid_edge;
   double Smoothed(double k) const;
   // Best evaluation of all (grid, refine, chosen).
   double best_evaluated_k = 0, best_evaluated_log_likelihood = 0;
@@ -131,6 +137,12 @@ struct TuneKSummary {
   double plateau_k_lo = 0, plateau_k_hi = 0, plateau_tolerance = 0;
   int plateau_points = 0;
   std::string k_rule;  // how k was chosen, one sentence
+  // True when the plateau reaches both ends of the grid: the data cannot tell k apart.
+  bool plateau_spans_grid = false;
+  bool plateau_tolerance_is_se = true;  // the tolerance is one standard error (the default)
+  // What the plateau means, one sentence ("" without one), e.g. "k not identifiable from this data,
+  // smallest model within 1 SE chosen".
+  std::string PlateauMeaning() const;
   // The coordinate steps: chosen f and nu0 (0 when not tuned) and whether each was a plateau.
   double init_scale = 0, prior_count = 0;
   bool init_scale_tuned = false, prior_count_tuned = false;

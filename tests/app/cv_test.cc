@@ -91,8 +91,10 @@ TEST(TuneKCommand, ChoosesKInsideTheBracketAndWritesTheCurve) {
                                "4", "--refine-points", "1", "--curve-csv", csv, "--json"});
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
-  const double k = j["k"];
-  const bool plateau = j["plateau"]["flat"];
+  const auto& rec = j["recommended"];
+  const auto& search = j["k_search"];
+  const double k = rec["k"];
+  const bool plateau = search["plateau"]["flat"];
   // The joint step's record; when it moved the choice, k is a member of its plateau.
   const auto& joint = j["joint"];
   ASSERT_TRUE(joint.is_object()) << r.out;
@@ -100,20 +102,22 @@ TEST(TuneKCommand, ChoosesKInsideTheBracketAndWritesTheCurve) {
     EXPECT_TRUE(joint.contains(field)) << field;
   }
   EXPECT_LE(joint["start"]["log_likelihood"].get<double>(),
-            j["log_likelihood"].get<double>() + joint["tolerance"].get<double>());
+            rec["log_likelihood"].get<double>() + joint["tolerance"].get<double>());
   if (joint["start"]["k"].get<double>() != k) {
     EXPECT_GE(k, joint["plateau"]["k_range"][0].get<double>());
     EXPECT_LE(k, joint["plateau"]["k_range"][1].get<double>());
   } else if (plateau) {  // k is the simplest member of the plateau, which is stated with its range
-    EXPECT_GE(k, j["plateau"]["k_range"][0].get<double>());
-    EXPECT_LE(k, j["plateau"]["k_range"][1].get<double>());
-    EXPECT_NE(j["k_rule"].get<std::string>().find("plateau"), std::string::npos);
+    EXPECT_GE(k, search["plateau"]["k_range"][0].get<double>());
+    EXPECT_LE(k, search["plateau"]["k_range"][1].get<double>());
+    EXPECT_NE(search["rule"].get<std::string>().find("plateau"), std::string::npos);
+    EXPECT_FALSE(search["plateau"]["meaning"].get<std::string>().empty());
   } else {
-    EXPECT_GE(k, j["bracket"][0].get<double>() * (1 - 1e-9));
-    EXPECT_LE(k, j["bracket"][1].get<double>() * (1 + 1e-9));
+    EXPECT_GE(k, search["bracket"][0].get<double>() * (1 - 1e-9));
+    EXPECT_LE(k, search["bracket"][1].get<double>() * (1 + 1e-9));
+    EXPECT_DOUBLE_EQ(k, search["quadratic_refinement"]["k_at_maximum"].get<double>());
   }
   // Grid and refinement, plus the chosen k's own evaluation unless it came from the plateau.
-  EXPECT_EQ(j["curve"].size(), 4u + 1u + (plateau ? 0u : 1u));
+  EXPECT_EQ(search["curve"].size(), 4u + 1u + (plateau ? 0u : 1u));
   EXPECT_FALSE(j["folds_by"].get<std::string>().empty());
   std::ifstream in(csv);
   std::string header;

@@ -39,7 +39,7 @@ TEST(ImportLogCommand, ShippedLogRefusedAtTheFirstNanThenImportedWithDropInvalid
   EXPECT_NE(r.err.find("dropped"), std::string::npos) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["episodes"], 6);  // six sessions between logging gaps
-  EXPECT_GT(j["dropped_rows"].get<int>(), 0);
+  EXPECT_GT(j["dropped"]["invalid_rows"].get<int>(), 0);
   const SampleSet set = ReadSampleSet((dir / "walk.h5").string());
   EXPECT_EQ(set.num_commands(), 7);
   EXPECT_EQ(set.x_names, (std::vector<std::string>{"dx", "dy", "dyaw"}));
@@ -106,6 +106,79 @@ TEST(ListOptions, RenderLabelsTakeOneCommaSeparatedValue) {
   r = RunDgmm({"render", "--diff", "a.h5", "b.h5", "--labels", "A", "-o", (dir / "x.png").string()});
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find("--labels"), std::string::npos) << r.err;
+}
+
+}  // namespace
+}  // namespace dgmm::test
+
+namespace dgmm::test {
+namespace {
+
+// The bundled public log (datasets/f1tenth, CC0): a folder per trial, headerless CSVs, no time
+// column (40 Hz), 41 three-second trials of 15 commands; the pose ends one sample short of a
+// whole second after the first command row.
+std::vector<std::string> CarArgs(const std::string& out) {
+  const std::string root = SourcePath("datasets/f1tenth").string();
+  return {"import-log",
+          "--commands",
+          root + "/measurement_*/input.csv",
+          "--command-cols",
+          "1,2",
+          "--pose",
+          root + "/measurement_*/trajectory.csv",
+          "--pose-cols",
+          "1,2,3",
+          "--no-header",
+          "--rate",
+          "40",
+          "--window",
+          "1",
+          "-o",
+          out};
+}
+
+TEST(ImportLogCommand, FolderOfTrialsFromAPublicLog) {
+  const fs::path dir = MakeTempDir("import_log_trials");
+  std::vector<std::string> args = CarArgs((dir / "car.h5").string());
+  args.push_back("--json");
+  const RunResult r = RunDgmm(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["trials"], 41);
+  EXPECT_EQ(j["episodes"], 41);
+  EXPECT_EQ(j["commands"].size(), 15u);
+  // Three 1-s windows per trial (the first one a sample short, kept by the tolerance): 123.
+  EXPECT_EQ(j["windows_kept"], 123);
+  EXPECT_EQ(j["dropped"]["short_segments"], 44);  // the 0.025 s rows before each command
+  EXPECT_TRUE(j["warnings"].empty()) << j["warnings"];
+  const SampleSet set = ReadSampleSet((dir / "car.h5").string());
+  EXPECT_EQ(set.size(), 123);
+  EXPECT_EQ(set.terrain_dim(), 0);
+  // Text output: the kept/dropped line.
+  const RunResult text = RunDgmm(CarArgs((dir / "car2.h5").string()));
+  EXPECT_NE(text.out.find("windows: 123 kept; dropped: 44 command segments shorter than 1 s"),
+            std::string::npos)
+      << text.out;
+}
+
+TEST(ImportLogCommand, ContradictoryOptionsAreRefused) {
+  const fs::path dir = MakeTempDir("import_log_contradictions");
+  const std::string out = (dir / "car.h5").string();
+  std::vector<std::vector<std::string>> cases;
+  cases.push_back(CarArgs(out));
+  cases.back().insert(cases.back().end(), {"--time-col", "t"});  // a rate and a time column
+  cases.push_back(CarArgs(out));
+  cases.back().insert(cases.back().end(), {"--units", "1=mm,1=m"});  // two units for one column
+  cases.push_back(CarArgs(out));
+  cases.back().insert(cases.back().end(), {"--bins", "3", "--bin-edges", "0.1"});
+  cases.push_back(CarArgs(out));
+  cases.back().insert(cases.back().end(), {"--terrain-cols", "1"});  // no attitude stream
+  for (const auto& args : cases) {
+    const RunResult r = RunDgmm(args);
+    EXPECT_EQ(r.exit_code, 2) << args.back() << ": " << r.err;
+    EXPECT_EQ(CountLines(r.err), 1) << r.err;
+    EXPECT_FALSE(fs::exists(out));
+  }
 }
 
 }  // namespace

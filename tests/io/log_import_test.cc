@@ -8,13 +8,16 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
-#include <fstream>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <numbers>
+#include <set>
 #include <sstream>
 
+#include "io/command_bins.h"
 #include "io/csv_reader.h"
+#include "io/log_files.h"
 #include "tests/io/io_test_util.h"
 #include "util/error.h"
 
@@ -191,7 +194,7 @@ TEST(LogImport, ContinuousCommandsBinned) {
   EXPECT_EQ(ImportLog(o, &summary).num_commands(), 40);
   ASSERT_EQ(summary.warnings.size(), 1u);
   EXPECT_NE(summary.warnings[0].find("--bins"), std::string::npos) << summary.warnings[0];
-  o.bins = 2;
+  o.bins.bins = 2;
   const SampleSet s = ImportLog(o, &summary);
   ASSERT_EQ(s.num_commands(), 2);
   EXPECT_EQ(s.size(), 2);
@@ -284,8 +287,236 @@ TEST(LogImport, OptionsAndUnitsChecked) {
   EXPECT_THROW(ImportLog(o), InputError);
   EXPECT_THROW(ParseUnits({"yaw=degrees"}), InputError);
   EXPECT_THROW(ParseUnits({"yaw"}), InputError);
+  // Contradictory units for one column are refused (issue #24); the same unit twice is harmless.
+  EXPECT_THROW(ParseUnits({"x=mm", "x=m"}), InputError);
+  EXPECT_EQ(ParseUnits({"x=mm", "x=mm"}).at("x"), 1e-3);
   EXPECT_THROW(ParseDelimiter("::"), InputError);
   EXPECT_EQ(ParseDelimiter("tab"), '\t');
+}
+
+}  // namespace
+}  // namespace dgmm
+
+namespace dgmm {
+namespace {
+
+// A folder of short trials as a small vehicle's logger writes them: per trial a command file
+// (one label, rows at 10 Hz from 0 to 2.9 s) and a pose file (30 Hz from 0 to 2.9667 s: one
+// sample short of 3 s), driving straight at speed v(label) along heading h(trial).
+struct TrialLog {
+  fs::path dir;
+  std::vector<std::string> labels;
+};
+
+double TrialSpeed(const std::string& label) {
+  return label == "slow" ? 0.1 : label == "fast" ? 0.3 : 0.0;
+}
+
+TrialLog WriteTrialFolder(const std::string& name, int trials, double pose_end = 2.9667,
+                          double speed_scale_per_trial = 0) {
+  TrialLog log{test::TestDir() / name, {}};
+  fs::create_directories(log.dir / "cmd");
+  fs::create_directories(log.dir / "pose");
+  const char* cycle[] = {"slow", "fast", "stop"};
+  for (int i = 0; i < trials; ++i) {
+    const std::string label = cycle[i % 3];
+    log.labels.push_back(label);
+    const double heading = 0.5 * i, v = TrialSpeed(label) * (1 + speed_scale_per_trial * i);
+    char cmd[64], pose[64];
+    std::snprintf(cmd, sizeof cmd, "cmd/trial_%d.csv", i + 1);
+    std::snprintf(pose, sizeof pose, "pose/odom_%02d.csv", i + 1);
+    std::ostringstream c, p;
+    c << "t,action\n";
+    for (int k = 0; k < 30; ++k) c << 0.1 * k << "," << label << "\n";
+    test::WriteText(log.dir / cmd, c.str());
+    p.precision(10);
+    p << "t,x,y,yaw\n";
+    for (int k = 0; k / 30.0 <= pose_end + 1e-9; ++k) {
+      const double t = k / 30.0;
+      p << t << "," << 5 + v * t * std::cos(heading) << "," << -2 + v * t * std::sin(heading) << ","
+        << heading << "\n";
+    }
+    test::WriteText(log.dir / pose, p.str());
+  }
+  return log;
+}
+
+LogImportOptions TrialOptions(const TrialLog& log) {
+  LogImportOptions o;
+  o.commands = {(log.dir / "cmd").string(), "t", {"action"}};
+  o.pose = {(log.dir / "pose" / "odom_*.csv").string(), "t", {"x", "y", "yaw"}};
+  return o;
+}
+
+TEST(LogFiles, TrialKeysNeverSplitANumber) {
+  EXPECT_EQ(TrialKeys({"a/cmd_07.csv", "a/cmd_10.csv"}), (std::vector<std::string>{"7", "10"}));
+  EXPECT_EQ(TrialKeys({"trial_1.csv", "trial_10.csv", "trial_2.csv"}),
+            (std::vector<std::string>{"1", "10", "2"}));
+  EXPECT_EQ(TrialKeys({"runs/left/pose.csv", "runs/right/pose.csv"}),
+            (std::vector<std::string>{"left", "right"}));
+  EXPECT_EQ(TrialKeys({"only.csv"}), (std::vector<std::string>{""}));
+}
+
+TEST(LogFiles, PairTrialsByNameAndNameTheFileWithoutAPartner) {
+  const auto trials = PairTrials({"c/cmd_2.csv", "c/cmd_10.csv", "c/cmd_1.csv"},
+                                 {"p/pose_01.csv", "p/pose_02.csv", "p/pose_10.csv"}, {});
+  ASSERT_EQ(trials.size(), 3u);
+  EXPECT_EQ(trials[0].name, "1");
+  EXPECT_EQ(trials[0].pose, "p/pose_01.csv");
+  EXPECT_EQ(trials[2].commands, "c/cmd_10.csv");
+  EXPECT_EQ(trials[2].pose, "p/pose_10.csv");
+  try {
+    PairTrials({"c/cmd_1.csv", "c/cmd_2.csv", "c/cmd_3.csv"}, {"p/pose_1.csv", "p/pose_2.csv"}, {});
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("cmd_3.csv"), std::string::npos) << m;
+    EXPECT_NE(m.find("--pose"), std::string::npos) << m;
+    EXPECT_NE(m.find("trial '3'"), std::string::npos) << m;
+  }
+}
+
+TEST(LogFiles, FoldersAndGlobsResolveToSortedCsvFiles) {
+  const TrialLog log = WriteTrialFolder("resolve", 3);
+  test::WriteText(log.dir / "cmd" / "notes.txt", "not a log\n");
+  const auto folder = ResolveStreamFiles((log.dir / "cmd").string(), "--commands");
+  EXPECT_EQ(folder.size(), 3u);
+  EXPECT_TRUE(std::is_sorted(folder.begin(), folder.end()));
+  EXPECT_EQ(ResolveStreamFiles((log.dir / "pose" / "odom_0[12].csv").string(), "--pose").size(),
+            2u);
+  EXPECT_THROW(ResolveStreamFiles((log.dir / "pose" / "nothing_*.csv").string(), "--pose"),
+               InputError);
+  fs::create_directories(log.dir / "empty");
+  EXPECT_THROW(ResolveStreamFiles((log.dir / "empty").string(), "--pose"), InputError);
+}
+
+TEST(LogImport, FolderOfTrialsOneEpisodePerFile) {
+  const TrialLog log = WriteTrialFolder("trials", 7);
+  LogImportOptions o = TrialOptions(log);
+  o.window_s = 3.0;
+  LogImportSummary summary;
+  const SampleSet s = ImportLog(o, &summary);
+  // The pose ends one sample (1/30 s) short of the 3 s window: kept at the default tolerance
+  // (half a pose interval at each end), one sample per trial.
+  ASSERT_EQ(s.size(), 7) << summary.WindowReport();
+  EXPECT_EQ(summary.trials, 7);
+  EXPECT_EQ(summary.episodes, 7);
+  EXPECT_NEAR(summary.time_tolerance_s, 0.5 / 30, 1e-9);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(s.episode[i], i);
+    EXPECT_EQ(s.command_labels[s.command[i]], log.labels[i]);
+    // Straight ahead in the body frame, over the 2.9667 s the pose covers.
+    EXPECT_NEAR(s.x(i, 0), TrialSpeed(log.labels[i]) * (2.9 + 2.0 / 30), kTol) << i;
+    EXPECT_NEAR(s.x(i, 1), 0.0, kTol);
+  }
+  EXPECT_EQ(s.num_commands(), 3);
+  EXPECT_NE(summary.WindowReport().find("windows: 7 kept; dropped: none"), std::string::npos)
+      << summary.WindowReport();
+  // Without the tolerance (a tiny explicit one) every window is dropped, and the report says by
+  // how little and which --time-tolerance keeps them.
+  o.time_tolerance_s = 1e-4;
+  try {
+    ImportLog(o, &summary);
+    FAIL() << "expected no samples";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("7 command segments shorter than 3 s"), std::string::npos) << m;
+    const size_t at = m.find("--time-tolerance ");
+    ASSERT_NE(at, std::string::npos) << m;
+    // The suggested tolerance keeps them.
+    o.time_tolerance_s = std::stod(m.substr(at + 17));
+    EXPECT_EQ(ImportLog(o).size(), 7) << o.time_tolerance_s;
+  }
+}
+
+TEST(LogImport, UnequalDurationsWarnOrBecomeRates) {
+  // Trials of different lengths, one sample per trial (no window): durations differ.
+  const TrialLog log = WriteTrialFolder("durations", 6);
+  test::WriteText(log.dir / "pose" / "odom_02.csv", [] {
+    std::ostringstream p;
+    p << "t,x,y,yaw\n";
+    for (int k = 0; k <= 45; ++k) p << k / 30.0 << "," << 5 + 0.3 * k / 30.0 << ",-2,0\n";  // 1.5 s
+    return p.str();
+  }());
+  LogImportOptions o = TrialOptions(log);
+  LogImportSummary summary;
+  SampleSet s = ImportLog(o, &summary);
+  ASSERT_EQ(s.size(), 6);
+  EXPECT_NEAR(summary.min_window_s, 1.5, 1e-9);
+  ASSERT_EQ(summary.warnings.size(), 1u);
+  EXPECT_NE(summary.warnings[0].find("--per-second"), std::string::npos) << summary.warnings[0];
+  o.per_second = true;
+  s = ImportLog(o, &summary);
+  EXPECT_TRUE(summary.warnings.empty());
+  EXPECT_EQ(s.x_units[0], "m/s");
+  for (int i = 0; i < s.size(); ++i) {
+    EXPECT_NEAR(s.x(i, 0), TrialSpeed(log.labels[i]), kTol) << i;  // speeds, whatever the length
+  }
+}
+
+TEST(LogImport, EpisodeColumnSplitsTrialsAndIdsStayDistinctAcrossFiles) {
+  const TrialLog log = WriteTrialFolder("episode_col", 2);
+  for (int i = 1; i <= 2; ++i) {  // each file: episode 0 for 1.5 s, then episode 1
+    std::ostringstream c;
+    c << "t,action,run\n";
+    for (int k = 0; k < 30; ++k)
+      c << 0.1 * k << "," << log.labels[i - 1] << "," << (k < 15 ? 0 : 1) << "\n";
+    test::WriteText(log.dir / "cmd" / ("trial_" + std::to_string(i) + ".csv"), c.str());
+  }
+  LogImportOptions o = TrialOptions(log);
+  o.episode_column = "run";
+  const SampleSet s = ImportLog(o);
+  std::set<int> ids(s.episode.data(), s.episode.data() + s.size());
+  EXPECT_EQ(ids.size(), 4u);  // (file 1, 0), (file 1, 1), (file 2, 0), (file 2, 1)
+}
+
+TEST(LogImport, QuantileBinsWithStopsOnTheirOwn) {
+  const PlanarLog log = WritePlanarLog("quantile_bins");
+  // Speeds: 0.05 .. 0.25 in the first 2 s (slow and fast halves), exactly 0 (stopped) after.
+  std::ostringstream out;
+  out << "time,speed\n";
+  for (int i = 0; i < 40; ++i)
+    out << 0.1 * i << "," << (i < 10 ? 0.05 : i < 20 ? 0.25 : 0.0) << "\n";
+  test::WriteText(log.commands, out.str());
+  LogImportOptions o = PlanarOptions(log);
+  o.commands.columns = {"speed"};
+  o.bins.bins = 2;
+  SampleSet s = ImportLog(o);
+  // Two bins of the moving rows, and the stop rows as their own command: three commands.
+  ASSERT_EQ(s.num_commands(), 3) << s.command_labels.size();
+  EXPECT_EQ(s.command_labels, (std::vector<std::string>{"0.05", "0.25", "0"}));
+  // Equal widths over [0, 0.25] with the stops inside would have put 0 and 0.05 together.
+  o.bins.zero_is_own_bin = false;
+  o.bins.rule = CommandBinOptions::Rule::kWidth;
+  s = ImportLog(o);
+  EXPECT_EQ(s.num_commands(), 2);
+  // Explicit edges.
+  o.bins = CommandBinOptions{};
+  o.bins.edges = {0.1};
+  s = ImportLog(o);
+  EXPECT_EQ(s.command_labels, (std::vector<std::string>{"0.05", "0.25", "0"}));
+  o.bins.bins = 3;
+  std::string error;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("--bin-edges"), std::string::npos) << error;
+}
+
+TEST(CommandBins, QuantilesKeepEqualValuesTogetherAndLabelsOccur) {
+  CommandBinOptions o;
+  o.bins = 3;
+  const std::vector<double> v = {0, 0, 0.1, 0.1, 0.1, 0.1, 0.2, 0.3, 0.4, 0.5, 0, -0.2};
+  const std::vector<double> b = BinCommandValues(v, o);
+  ASSERT_EQ(b.size(), v.size());
+  EXPECT_EQ(b[0], 0.0);
+  EXPECT_EQ(b[10], 0.0);
+  for (int i = 2; i < 6; ++i) EXPECT_EQ(b[i], b[2]);  // the run of 0.1 is not split
+  std::set<double> labels(b.begin(), b.end());
+  EXPECT_LE(labels.size(), 4u);  // three bins of moving values and the stop
+  for (double l : labels) {
+    EXPECT_TRUE(l == 0.0 || std::find(v.begin(), v.end(), l) != v.end() ||
+                std::abs(l - 0.35) < 1e-12 || std::abs(l - 0.45) < 1e-12)
+        << l;
+  }
 }
 
 }  // namespace

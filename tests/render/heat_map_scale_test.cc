@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "render/density_grid.h"
@@ -127,6 +128,78 @@ TEST(HeatMapScale, CategoryAxesAndAxisTitlesAreDrawn) {
   EXPECT_EQ(l.y_ticks, spec.y_categories);
   EXPECT_EQ(l.x_title, "terrain region");
   EXPECT_EQ(l.y_title, "command");
+}
+
+// The sim2real deficit map's layout (lib/sim2real/figures.cc): a 640-pixel panel with a colour
+// bar and three terrain regions named on two lines. Before issue #24 the second lines ("pitch
+// -8.9 deg, roll -11.2 deg", ~160 px in the axis font) overlapped their neighbours.
+TEST(HeatMapScale, CategoryLabelsOfNeighboursDoNotOverlap) {
+  HeatMapSpec spec;
+  spec.background = SampleGrid([](double x, double y) { return x - y; }, {0, 3, 0, 4}, 48, 64);
+  spec.palette = HeatMapSpec::Palette::kDiverging;
+  spec.x_categories = {"right side up\npitch -8.9 deg, roll -11.2 deg",
+                       "left side up\npitch -4.5 deg, roll +14.2 deg",
+                       "nose down\npitch +15.7 deg, roll -3.7 deg"};
+  spec.y_categories = {"+0.5,+0.5,+0.5", "0,0,-0.5", "-0.5,0,0", "-0.5,-0.5,-0.5"};
+  spec.x_label = "terrain region (k-means of the terrain z)";
+  spec.y_label = "command";
+  spec.width = 640;
+  spec.height = 420;
+  for (bool row : {false, true}) {
+    std::vector<PlotLayout> layouts;
+    if (row) {
+      layouts = RenderHeatMapRow({spec, spec}, Png("label_row.png").string());
+    } else {
+      layouts = {RenderHeatMap(spec, Png("labels.png").string())};
+    }
+    for (const PlotLayout& l : layouts) {
+      ASSERT_EQ(l.x_tick_boxes.size(), 3u);
+      for (size_t i = 0; i < l.x_tick_boxes.size(); ++i) {
+        const auto& box = l.x_tick_boxes[i];
+        EXPECT_GT(box[1] - box[0], 20) << "a measured label has a width";
+        EXPECT_GE(box[0], 0);
+        EXPECT_LE(box[1], l.width);
+        if (i + 1 < l.x_tick_boxes.size()) {
+          EXPECT_LT(box[1], l.x_tick_boxes[i + 1][0])
+              << "label " << i << " overlaps label " << i + 1 << ": " << l.x_ticks[i];
+        }
+      }
+      // Every word of every name is still there (wrapped, perhaps in a smaller font).
+      for (size_t i = 0; i < spec.x_categories.size(); ++i) {
+        std::string drawn = l.x_ticks[i], given = spec.x_categories[i];
+        std::replace(drawn.begin(), drawn.end(), '\n', ' ');
+        std::replace(given.begin(), given.end(), '\n', ' ');
+        EXPECT_EQ(drawn, given);
+      }
+    }
+  }
+}
+
+TEST(HeatMapScale, FitCategoryLabelsWrapsThenShrinks) {
+  auto width = [](const std::string& text, int size) { return TextWidthPx(text, size); };
+  // Fits as it is: unchanged.
+  FittedLabels f = FitCategoryLabels({"flat", "uphill"}, 100, 12, 8, width);
+  EXPECT_TRUE(f.fits);
+  EXPECT_EQ(f.labels, (std::vector<std::string>{"flat", "uphill"}));
+  EXPECT_EQ(f.font_size, 12);
+  // Too wide on one line: wrapped at spaces, font kept.
+  f = FitCategoryLabels({"pitch -8.9 deg, roll -11.2 deg"}, 110, 12, 8, width);
+  EXPECT_TRUE(f.fits);
+  EXPECT_EQ(f.font_size, 12);
+  EXPECT_NE(f.labels[0].find('\n'), std::string::npos);
+  for (size_t start = 0, end; start <= f.labels[0].size(); start = end + 1) {
+    end = f.labels[0].find('\n', start);
+    if (end == std::string::npos) end = f.labels[0].size();
+    EXPECT_LE(width(f.labels[0].substr(start, end - start), 12), 110);
+  }
+  // A single word too wide at 12 pt: a smaller font.
+  f = FitCategoryLabels({"downhill-sideways"}, 90, 12, 8, width);
+  EXPECT_TRUE(f.fits);
+  EXPECT_LT(f.font_size, 12);
+  // Nothing fits: the smallest font, reported as not fitting.
+  f = FitCategoryLabels({"an-unbreakable-very-long-region-name"}, 40, 12, 8, width);
+  EXPECT_FALSE(f.fits);
+  EXPECT_EQ(f.font_size, 8);
 }
 
 TEST(HeatMapScale, LongTitlesFitTheImage) {

@@ -65,7 +65,7 @@ TEST(EpisodeFolds, CrossValidationUsesThemWhenTheSetHasEpisodes) {
   set.step.resize(set.size());
   for (int i = 0; i < set.size(); ++i) set.episode(i) = i / 6, set.step(i) = i % 6;
   const CvSummary by_episode = CrossValidate(set, options);
-  EXPECT_EQ(by_episode.folds_by.rfind("episodes", 0), 0u) << by_episode.folds_by;
+  EXPECT_NE(by_episode.folds_by.find("whole episodes"), std::string::npos) << by_episode.folds_by;
   options.group_by_episode = false;
   EXPECT_NE(CrossValidate(set, options).folds_by.find("stratified"), std::string::npos);
 }
@@ -172,7 +172,23 @@ TEST(CrossValidate, FewerSamplesThanFoldsAndSingletonCommands) {
   EXPECT_EQ(cv.unscored_per_repeat, 1);  // the singleton has no training sample when held out
   EXPECT_EQ(cv.scored_per_repeat, set.size() - 1);
   EXPECT_TRUE(std::isfinite(cv.dgmm_with_terrain.mean));
-  EXPECT_TRUE(std::isfinite(cv.em_without_terrain.mean));
+  // Three training samples of a command in d = 2 (5 parameters per Gaussian): no EM rows, and
+  // the reason names the command and the counts.
+  EXPECT_FALSE(cv.em_without_terrain.evaluated);
+  EXPECT_FALSE(cv.em_with_terrain.evaluated);
+  EXPECT_NE(cv.em_without_terrain_omitted.find("fewer than the 5 parameters"), std::string::npos)
+      << cv.em_without_terrain_omitted;
+  EXPECT_NE(cv.em_with_terrain_omitted.find("d = 4"), std::string::npos)
+      << cv.em_with_terrain_omitted;
+}
+
+TEST(CrossValidate, EmRowsKeptWhenEveryCommandHasEnoughTrainingSamples) {
+  const SampleSet set = test::MakeTerrainSet(2, 30, 1.0, 5);  // 24 training samples, 14 parameters
+  const CvSummary cv = CrossValidate(set, SmallOptions());
+  EXPECT_TRUE(cv.em_without_terrain.evaluated);
+  EXPECT_TRUE(cv.em_with_terrain.evaluated);
+  EXPECT_TRUE(cv.em_without_terrain_omitted.empty());
+  EXPECT_TRUE(cv.em_with_terrain_omitted.empty());
 }
 
 TEST(CrossValidate, WithoutTerrainInTheSetSkipsTheTerrainRows) {
