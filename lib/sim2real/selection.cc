@@ -59,11 +59,16 @@ bool SelectionOptions::IsValid(std::string* error) const {
 
 std::vector<int> MakeFolds(const FitProblem& fp, const std::vector<int>& rows, int folds,
                            std::mt19937_64& rng) {
+  return MakeFolds(fp.episode, fp.command, rows, folds, rng);
+}
+
+std::vector<int> MakeFolds(const std::vector<int>& episode, const std::vector<int>& command,
+                           const std::vector<int>& rows, int folds, std::mt19937_64& rng) {
   // Episodes (by original id) per command, in order of first appearance, then shuffled.
   std::map<int, std::vector<int>> episodes_of_command;
   std::set<int> seen;
   for (int i : rows) {
-    if (seen.insert(fp.episode[i]).second) episodes_of_command[fp.command[i]].push_back(fp.episode[i]);
+    if (seen.insert(episode[i]).second) episodes_of_command[command[i]].push_back(episode[i]);
   }
   std::map<int, int> fold_of_episode;
   int offset = 0;
@@ -73,7 +78,7 @@ std::vector<int> MakeFolds(const FitProblem& fp, const std::vector<int>& rows, i
     offset += static_cast<int>(eps.size());
   }
   std::vector<int> fold(rows.size());
-  for (size_t k = 0; k < rows.size(); ++k) fold[k] = fold_of_episode[fp.episode[rows[k]]];
+  for (size_t k = 0; k < rows.size(); ++k) fold[k] = fold_of_episode[episode[rows[k]]];
   return fold;
 }
 
@@ -264,11 +269,16 @@ BootstrapResult Bootstrap(const FitProblem& fp, const SelectionResult& selection
     return rows;
   };
   SelectionOptions quick = options;
+  std::vector<int> count(fp.library.size(), 0);
   for (int b = 0; b < options.bootstrap_selection; ++b) {
     std::vector<int> rows = resample();
     std::vector<int> fold = MakeFolds(fp, rows, options.folds, rng);
     SelectionResult r = ForwardSelect(fp, rows, fold, quick);
-    for (int e : r.selected) out.inclusion[e] += 1.0 / options.bootstrap_selection;
+    for (int e : r.selected) ++count[e];
+    out.selections.push_back(r.selected);
+  }
+  for (size_t e = 0; e < count.size() && options.bootstrap_selection > 0; ++e) {
+    out.inclusion[e] = static_cast<double>(count[e]) / options.bootstrap_selection;
   }
   const size_t k = selection.selected.size();
   std::vector<std::vector<std::vector<double>>> draws(k);

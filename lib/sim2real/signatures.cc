@@ -1,148 +1,15 @@
 #include "sim2real/signatures.h"
 
-#include <atomic>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 #include <map>
-#include <mutex>
-#include <thread>
 
-#include "sim/sim_config.h"
 #include "util/error.h"
-#if DGMM_SIM2REAL_HAVE_IO
-#include "io/sample_set_io.h"
-#include "util/atomic_file.h"
-#endif
 
 namespace dgmm::sim2real {
 namespace {
 
-#if DGMM_SIM2REAL_HAVE_IO
-constexpr bool kHaveIo = true;
-#else
-constexpr bool kHaveIo = false;
-#endif
-
-constexpr const char* kCacheVersion = "dgmm-knob-sim-v1";
-
-std::uint64_t Fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
-
 Eigen::Vector4d Phi(double pitch, double roll, double first) { return {1.0, pitch, roll, first}; }
 
 }  // namespace
-
-bool SignatureOptions::IsValid(std::string* error) const {
-  if (placements < 1 || threads < 1 || !(slope_ridge >= 0)) {
-    if (error) *error = "placements >= 1, threads >= 1, slope_ridge >= 0";
-    return false;
-  }
-  return true;
-}
-
-std::string DefaultCacheDir() {
-  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/dgmm";
-  if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/dgmm";
-  return "";
-}
-
-std::string SimulationKey(const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                          int placements, const std::vector<sim::Knob>& knobs,
-                          const std::vector<sim::KnobValue>& values) {
-  std::string text = kCacheVersion;
-  text += "\n" + sim::RobotMjcfText(config) + "\n" + sim::SimConfigToJson(config) + "\n" +
-          sim::ProtocolName(protocol) + "\n" + std::to_string(seed) + "\n" + std::to_string(placements);
-  for (const auto& v : values) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "=%.17g", v.value);
-    text += "\n" + knobs.at(v.knob).name + buf;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(Fnv1a(text)));
-  return hex;
-}
-
-SimulationBatch SimulateBatch(const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                              const std::vector<sim::Knob>& knobs,
-                              const std::vector<SimulationRequest>& requests, const SignatureOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw MakeInputError("", "signature options", error);
-  namespace fs = std::filesystem;
-  const auto start = std::chrono::steady_clock::now();
-  SimulationBatch batch;
-  batch.sets.resize(requests.size());
-  const std::string dir = options.cache_dir.empty() ? DefaultCacheDir() : options.cache_dir;
-  const bool use_cache = kHaveIo && !dir.empty() && dir != "-";
-  if (use_cache) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-  }
-  std::vector<std::string> paths(requests.size());
-  std::vector<size_t> todo;
-  for (size_t r = 0; r < requests.size(); ++r) {
-    if (use_cache) {
-      paths[r] = (fs::path(dir) / (SimulationKey(config, protocol, seed, options.placements, knobs,
-                                                 requests[r].values) + ".h5")).string();
-#if DGMM_SIM2REAL_HAVE_IO
-      if (fs::exists(paths[r])) {
-        try {
-          batch.sets[r] = ReadSampleSet(paths[r]);
-          ++batch.from_cache;
-          continue;
-        } catch (const std::exception&) {
-          // A damaged cache entry is simulated again and overwritten.
-        }
-      }
-#endif
-    }
-    todo.push_back(r);
-  }
-  sim::ProtocolOptions po;
-  po.protocol = protocol;
-  po.seed = seed;
-  po.placements = options.placements;
-  std::atomic<size_t> next{0};
-  std::mutex mu;
-  std::string failure;
-  auto worker = [&] {
-    for (size_t t = next++; t < todo.size(); t = next++) {
-      const size_t r = todo[t];
-      try {
-        SampleSet set = sim::SimulateWithKnobs(config, po, knobs, requests[r].values);
-#if DGMM_SIM2REAL_HAVE_IO
-        if (use_cache) {
-          try {
-            AtomicFile file(paths[r]);
-            WriteSampleSet(set, file.temp_path().string());
-            file.Commit();
-          } catch (const std::exception&) {
-            // The cache is an optimisation: a read-only folder only costs time.
-          }
-        }
-#endif
-        batch.sets[r] = std::move(set);
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(mu);
-        if (failure.empty()) failure = e.what();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  const int n_threads = std::min<int>(options.threads, static_cast<int>(todo.size()));
-  for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  if (!failure.empty()) throw MakeInputError("--sim-config", "", "re-simulation failed: " + failure);
-  batch.simulated = static_cast<int>(todo.size());
-  batch.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return batch;
-}
 
 PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbed,
                              const SampleSet& table, double slope_ridge) {

@@ -1,4 +1,4 @@
-#include "sim2real/synthetic.h"
+#include "tests/sim2real/synthetic.h"
 
 #include <algorithm>
 #include <cmath>
