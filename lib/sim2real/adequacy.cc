@@ -106,6 +106,8 @@ void TestFit(const AnalysisInputs& in, const Baseline& base, const Refinement& r
   std::mt19937_64 rng(options.seed + 7);
   out->after = LocateModel(in, base, out->residuals, corrected, false, options.locate, rng);
   for (const auto& g : out->after.significant) {
+    if (!(g.deficit > 0)) continue;  // the correction beats the ceiling there: not a mismatch it leaves
+    out->remaining.push_back(g);
     out->doubts.push_back("mismatch remains after the correction in " + g.label +
                           Fmt(" (%.2f nats per sample below the ceiling, q %.2g)", g.deficit, g.q_value));
   }

@@ -49,6 +49,7 @@ struct EffectDriftTest {
 struct Adequacy {
   Eigen::MatrixXd residuals;          // whitened real residuals of the corrected model (n x dx)
   LocateSummary after;                // locate on the corrected model
+  std::vector<Region> remaining;      // its significant regions where it is below the ceiling
   double ll_corrected = 0;
   double shortfall = 0, shortfall_se = 0;  // ceiling - corrected, nats per real sample
   double gap_closed = NAN, gap_closed_se = NAN;

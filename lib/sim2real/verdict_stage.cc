@@ -154,7 +154,7 @@ Verdict ComposeVerdict(const Baseline& base, const CandidateSet& set, const Refi
   const bool session_drift = adequacy.total_drift.drifting, step_varies = adequacy.total_step_variation.drifting;
   if (session_drift) AddUnique(&v.structured_in, "session order");
   if (step_varies) AddUnique(&v.structured_in, "step");
-  for (const auto& g : adequacy.after.significant) AddUnique(&v.structured_in, g.label);
+  for (const auto& g : adequacy.remaining) AddUnique(&v.structured_in, g.label);
   if (naming.noise_withheld && v.structured_in.empty()) v.structured_in = {"command or terrain means"};
   v.unexplained_present = naming.structured || naming.noise_withheld || session_drift || step_varies ||
                           !adequacy.doubts.empty();
