@@ -91,7 +91,12 @@ std::optional<sim::SimConfig> ResolveConfig(const Sim2RealArgs& args, const Samp
                                             std::vector<std::string>* notes, std::string* why) {
   std::optional<sim::SimConfig> recorded;
   if (auto it = sim.metadata.find("sim_config"); it != sim.metadata.end()) {
-    recorded = sim::SimConfigFromJson(it->second, args.sim + ": metadata sim_config");
+    try {
+      recorded = sim::SimConfigFromJson(it->second, args.sim + ": metadata sim_config");
+    } catch (const InputError&) {
+      if (!args.locate_only && args.sim_config.empty()) throw;  // the config the analysis needs
+      notes->push_back(args.sim + ": its recorded sim_config cannot be read; not used");
+    }
   }
   if (!args.sim_config.empty()) {
     sim::SimConfig config = sim::LoadSimConfig(args.sim_config);
@@ -172,9 +177,10 @@ void Run(const Sim2RealArgs& args) {
   ctx.real_path = args.real;
   std::string why;
   std::unique_ptr<MujocoKnobSimulator> simulator;
+  const auto config = ResolveConfig(args, sim, &ctx.simulator_config_source, &ctx.notes, &why);
   if (args.locate_only) {
     why = "--locate-only: the analysis stops after locating the mismatch (no physics named)";
-  } else if (auto config = ResolveConfig(args, sim, &ctx.simulator_config_source, &ctx.notes, &why)) {
+  } else if (config) {
     simulator = std::make_unique<MujocoKnobSimulator>(*config);  // a bad robot model is the user's error
     ctx.simulator_fingerprint = simulator->Fingerprint();
   }
