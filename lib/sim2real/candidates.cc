@@ -149,13 +149,16 @@ void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vecto
   AddLateMeasurementEffects(in, set);
 }
 
-// Is a side implicated: a side knob's candidate selected, or clearing its first step's threshold?
+// Is a side implicated: a side knob's candidate selected, or among the `side_top` best candidates
+// of a forward step with a positive held-out gain at z >= side_min_z (a weak leg shows first as
+// its side, often below the step's Bonferroni threshold while other effects stand in for it).
 bool SideImplicated(const CandidateSet& set, const FitProblem& fp, const Baseline& base,
-                    const SelectionOptions& options, std::string* why) {
+                    const CandidateOptions& options, std::string* why) {
   std::vector<int> rows(fp.n);
   for (int i = 0; i < fp.n; ++i) rows[i] = i;
-  SelectionOptions quick = options;
+  SelectionOptions quick = options.first_pass;
   quick.bootstrap_selection = 0;
+  quick.backward = true;
   const SelectionResult sel = ForwardSelect(fp, rows, base.fold, quick);
   for (int e : sel.selected) {
     if (!set.candidates[e].side.empty()) {
@@ -163,10 +166,12 @@ bool SideImplicated(const CandidateSet& set, const FitProblem& fp, const Baselin
       return true;
     }
   }
-  if (!sel.steps.empty()) {
-    for (const auto& c : sel.steps[0].candidates) {
-      if (!set.candidates[c.effect].side.empty() && c.z >= sel.steps[0].threshold_z && c.gain > 0) {
-        *why = set.candidates[c.effect].knob + Fmt(" cleared the first step's threshold (z %.1f)", c.z);
+  for (size_t s = 0; s < sel.steps.size(); ++s) {
+    const auto& cands = sel.steps[s].candidates;
+    for (size_t r = 0; r < cands.size() && static_cast<int>(r) < options.side_top; ++r) {
+      if (!set.candidates[cands[r].effect].side.empty() && cands[r].gain > 0 && cands[r].z >= options.side_min_z) {
+        *why = set.candidates[cands[r].effect].knob + Fmt(" ranked %.0f of the first pass's step %.0f", r + 1.0, s + 1.0) +
+               Fmt(" (held-out z %.1f)", cands[r].z);
         return true;
       }
     }
@@ -177,8 +182,8 @@ bool SideImplicated(const CandidateSet& set, const FitProblem& fp, const Baselin
 }  // namespace
 
 bool CandidateOptions::IsValid(std::string* error) const {
-  if (placements < 0 || !(slope_ridge >= 0)) {
-    if (error) *error = "placements >= 0 and slope_ridge >= 0";
+  if (placements < 0 || !(slope_ridge >= 0) || side_top < 1) {
+    if (error) *error = "placements >= 0, slope_ridge >= 0 and side_top >= 1";
     return false;
   }
   return recording.IsValid(error) && first_pass.IsValid(error);
@@ -239,7 +244,7 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
     return set;
   }
   std::string why;
-  if (!SideImplicated(set, MakeCandidateProblem(in, base, set), base, options.first_pass, &why)) {
+  if (!SideImplicated(set, MakeCandidateProblem(in, base, set), base, options, &why)) {
     set.legs_note = "per-leg probes not recorded: no side knob is implicated by the first pass";
     return set;
   }

@@ -6,8 +6,9 @@
 // pitch/roll bias, heading drift). A probe that changes nothing is inert, not a candidate.
 //
 // Per-leg probes cost one recording per leg and value: they are recorded only when a cheaper
-// first pass (every other knob) implicates a side, i.e. a side knob is selected or clears its
-// forward step's threshold, or when the robot has no side knobs at all.
+// first pass (every other knob) implicates a side, i.e. a side knob is selected or ranks among the
+// best `side_top` candidates of a forward step with held-out z >= side_min_z, or when the robot
+// has no side knobs at all.
 #include <string>
 #include <vector>
 
@@ -28,6 +29,8 @@ struct CandidateOptions {
   RecordingOptions recording;   // cache and threads
   bool legs_only_when_implicated = true;
   SelectionOptions first_pass;  // the selection that decides whether a side is implicated
+  int side_top = 3;             // ... by a side knob among this many best candidates of a step
+  double side_min_z = 1.0;      // ... with at least this held-out z
   bool IsValid(std::string* error) const;
 };
 
