@@ -48,41 +48,37 @@ std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& 
   return probes;
 }
 
-void AddMeasurementEffects(const AnalysisInputs& in, CandidateSet* set) {
+void AddMeasurement(const KnobCandidate& c, const EffectSpec& spec, ExternalCandidate::Kind kind, CandidateSet* set) {
+  set->candidates.push_back(c);
+  set->library.push_back(spec);
+  ExternalCandidate e;
+  e.kind = kind;
+  set->externals.push_back(e);
+}
+
+// Tracker bias (every pose axis but yaw) and noise: first in the library.
+void AddTrackerEffects(const AnalysisInputs& in, CandidateSet* set) {
   const int dx = in.real.pose_dim();
-  const PoseLayout& layout = in.layout;
-  auto add = [&](KnobCandidate c, EffectSpec spec, ExternalCandidate::Kind kind) {
-    set->candidates.push_back(c);
-    set->library.push_back(spec);
-    ExternalCandidate e;
-    e.kind = kind;
-    set->externals.push_back(e);
-  };
-  add({"tracker_bias", "tracker_bias", "tracker.offset", "x units"},
-      ExternalSpec("tracker_bias", "constant offset of the tracked pose", layout.dyaw >= 0 ? dx - 1 : dx, "x units"),
-      ExternalCandidate::kTrackerBias);
+  AddMeasurement({"tracker_bias", "tracker_bias", "tracker.offset", "x units"},
+                 ExternalSpec("tracker_bias", "constant offset of the tracked pose", in.layout.dyaw >= 0 ? dx - 1 : dx,
+                              "x units"),
+                 ExternalCandidate::kTrackerBias, set);
   KnobCandidate noise{"tracker_noise", "tracker_noise", "tracker.noise_scale", ""};
   noise.nominal = 1;
   noise.physical_min = 0;
-  add(noise, NoiseEffect(), ExternalCandidate::kShift);
+  AddMeasurement(noise, NoiseEffect(), ExternalCandidate::kShift, set);
 }
 
-void AddLateMeasurementEffects(const AnalysisInputs& in, CandidateSet* set) {
-  auto add = [&](KnobCandidate c, EffectSpec spec, ExternalCandidate::Kind kind) {
-    set->candidates.push_back(c);
-    set->library.push_back(spec);
-    ExternalCandidate e;
-    e.kind = kind;
-    set->externals.push_back(e);
-  };
+// IMU pitch/roll bias (with terrain) and heading drift (with yaw): last in the library.
+void AddImuAndHeading(const AnalysisInputs& in, CandidateSet* set) {
   if (in.real.terrain_dim() >= 2) {
-    add({"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad"},
-        ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"), ExternalCandidate::kImuBias);
+    AddMeasurement({"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad"},
+                   ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"), ExternalCandidate::kImuBias, set);
   }
   if (in.layout.dyaw >= 0) {
-    add({"heading_drift", "heading_drift", "tracker.yaw_drift", "rad per execution"},
-        ExternalSpec("heading_drift", "heading drift per execution", 1, "rad per execution"),
-        ExternalCandidate::kHeading);
+    AddMeasurement({"heading_drift", "heading_drift", "tracker.yaw_drift", "rad per execution"},
+                   ExternalSpec("heading_drift", "heading drift per execution", 1, "rad per execution"),
+                   ExternalCandidate::kHeading, set);
   }
 }
 
@@ -143,10 +139,10 @@ void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vecto
   std::stable_sort(probes.begin(), probes.end(), [](const Probe& a, const Probe& b) { return a.knob < b.knob; });
   set->candidates.clear(), set->library.clear(), set->externals.clear(), set->shifts.clear();
   set->inert_knobs.clear();
-  AddMeasurementEffects(in, set);
+  AddTrackerEffects(in, set);
   AddKnobCandidates(sim, in, probes, slope_ridge, set);
   AddPayload(sim, set);
-  AddLateMeasurementEffects(in, set);
+  AddImuAndHeading(in, set);
 }
 
 // Is a side implicated: a side knob's candidate selected, or among the `side_top` best candidates

@@ -18,9 +18,7 @@ using test::FillResidualsAndFolds;
 // shifts has the simulated scale), and keeps both shifts.
 TEST(ForwardSelect, BackwardPassDropsNoiseThatOnlyStoodInForMissingShifts) {
   const int n = 400, dx = 2;
-  FitProblem fp;
-  fp.n = n;
-  fp.dx = dx;
+  FitProblem fp = test::ToyProblem(n, dx);
   Eigen::MatrixXd d1 = Eigen::MatrixXd::Zero(n * dx, 1), d2 = Eigen::MatrixXd::Zero(n * dx, 1);
   for (int i = 0; i < n; ++i) {
     d1(i * dx) = (i % 2 ? 1.0 : -1.0);

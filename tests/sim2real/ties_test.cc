@@ -10,15 +10,11 @@
 namespace dgmm::sim2real {
 namespace {
 
-using test::FillResidualsAndFolds;
-
 // Two candidates with the same design (perfectly collinear signatures) from different families
 // must be reported as a tie; a third, orthogonal one must not.
 TEST(TiedCandidates, CollinearSignaturesTie) {
   const int n = 300, dx = 2;
-  FitProblem fp;
-  fp.n = n;
-  fp.dx = dx;
+  FitProblem fp = test::ToyProblem(n, dx);
   Eigen::MatrixXd d1(n * dx, 1), d3(n * dx, 1);
   for (int i = 0; i < n; ++i) {
     d1(i * dx) = 1.0 + 0.5 * std::sin(i);
@@ -36,7 +32,7 @@ TEST(TiedCandidates, CollinearSignaturesTie) {
   fp.d = {d1, d1, d3};
   std::vector<int> fold;
   const std::vector<int> rows =
-      FillResidualsAndFolds(&fp, [&](int i, int j) { return 0.8 * d1(i * dx + j); }, 3, &fold);
+      test::FillResidualsAndFolds(&fp, [&](int i, int j) { return 0.8 * d1(i * dx + j); }, 3, &fold);
   SelectionOptions so;
   so.bootstrap_selection = 0;
   const SelectionResult sel = ForwardSelect(fp, rows, fold, so);

@@ -31,4 +31,12 @@ inline std::vector<int> FillResidualsAndFolds(FitProblem* fp, Shift shift, std::
   return rows;
 }
 
+// An empty problem of n samples of dimension dx.
+inline FitProblem ToyProblem(int n, int dx) {
+  FitProblem fp;
+  fp.n = n;
+  fp.dx = dx;
+  return fp;
+}
+
 }  // namespace dgmm::sim2real::test
