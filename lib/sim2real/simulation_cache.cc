@@ -62,6 +62,10 @@ std::string RecordingKey(const KnobSimulator& simulator, const Recording& record
     std::snprintf(buf, sizeof buf, "=%.17g", v.value);
     text += "\n" + simulator.knobs().at(v.knob).name + buf;
   }
+  return HashHex(text);
+}
+
+std::string HashHex(const std::string& text) {
   char hex[33];
   std::snprintf(hex, sizeof hex, "%016llx%016llx", static_cast<unsigned long long>(Fnv1a(text)),
                 static_cast<unsigned long long>(Fnv1a(text, 0x9e3779b97f4a7c15ull)));

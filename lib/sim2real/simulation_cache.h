@@ -20,6 +20,10 @@ struct RecordingOptions {
 // $XDG_CACHE_HOME/dgmm, else $HOME/.cache/dgmm; empty when neither is set.
 std::string DefaultCacheDir();
 
+// 32 hex digits of `text`: two 64-bit FNV-1a hashes with different offsets (a cache key, not a
+// cryptographic hash; a simulator's Fingerprint() may use it too).
+std::string HashHex(const std::string& text);
+
 // Hex key of one recording: hash of (cache version, fingerprint, protocol, seed, placements,
 // knob name = value for each value in order).
 std::string RecordingKey(const KnobSimulator& simulator, const Recording& recording,
