@@ -218,7 +218,8 @@ class ScoreTest(unittest.TestCase):
         self.assertTrue(s["confident_wrong"])
         unsure = verdict("explained", [name("mass", inclusion=None)])  # not computed
         self.assertFalse(score.score_pair(pair("single", FRICTION), unsure)["confident_wrong"])
-        doubted = dict(wrong, status="partly_explained", doubts=["mass.scale pinned at its upper limit 2"])
+        doubted = {"verdict": dict(wrong["verdict"], status="partly_explained",
+                                   doubts=["mass.scale pinned at its upper limit 2"])}
         self.assertFalse(score.score_pair(pair("single", FRICTION), doubted)["confident_wrong"])
 
     def test_value_needs_the_planted_knob(self):
