@@ -195,6 +195,7 @@ def summarize(results):
         "two_effect_both_found": _rate(r["score"]["both_found"] for r in twos),
         "confident_wrong": _rate(r["score"]["confident_wrong"] for r in scored),
         "out_of_library_unexplained": _rate(r["score"]["unexplained_reported"] for r in ool),
+        "out_of_library_doubted": _rate(r["score"].get("doubt_reported", False) for r in ool),
         "value_within_25pct": _rate(v is not None and v["error"] is not None
                                     and abs(v["error"]) <= VALUE_TOL for v in values),
         "median_gap_closed": statistics.median(gaps) if gaps else None,
