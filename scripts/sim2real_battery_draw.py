@@ -62,11 +62,15 @@ RANGES = {
     "heading_drift_rad": (0.01, 0.04),          # per execution, random sign
     "ool.periodic_pitch_rad": (0.015, 0.03),
     "ool.fatigue_rate": (0.15, 0.3),
-    # Version 3 (MJCF edits of one leg of the scorpion: tibia 0.16 m, foot radius 0.02 m, leg
-    # about 0.55 kg of 12.4 kg).
-    "ool.tibia_scale": (0.65, 0.85),
-    "ool.foot_radius_m": (0.035, 0.055),
-    "ool.mount_offset_m": (0.03, 0.06),             # along the torso's x axis, random sign
+    # Version 3 (MJCF edits of one leg of the scorpion: tibia 0.16 m, foot radius 0.02 m, legs
+    # 0.15 m apart along the torso, a leg about 0.55 kg of 12.4 kg). First drawn as tibia x0.65-0.85,
+    # foot 35-55 mm, mount 30-60 mm; a method-free check on DEV plants (seeds 950-963, real seeds
+    # 100950-100963: mean-shift / consistent z of a foot of 50-65 mm and a mount offset of 55 mm
+    # at the null's level, tibia x0.8 too) raised the ends below to changes the protocol can see at
+    # all; one leg's geometry stays hard to see (7 others carry the robot).
+    "ool.tibia_scale": (0.55, 0.75),
+    "ool.foot_radius_m": (0.07, 0.1),
+    "ool.mount_offset_m": (0.07, 0.12),             # along the torso's x axis, random sign
     "ool.leg_mass_kg": (0.4, 1.0),
 }
 
