@@ -163,6 +163,29 @@ void WriteOutputs(const Sim2RealArgs& args, const sim2real::Analysis& a, const s
   }
 }
 
+// The analysis; when the simulator cannot re-record the sim set's recording (e.g. a protocol it
+// does not know), the report says why and the analysis only locates.
+sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, const Sim2RealArgs& args,
+                                   std::unique_ptr<MujocoKnobSimulator>* simulator, std::string* why,
+                                   sim2real::ReportContext* ctx) {
+  const sim2real::AnalysisOptions options = MakeOptions(args);
+  if (!*simulator) return sim2real::Analyse(sim, real, nullptr, options, *why);
+  try {
+    sim2real::Analysis a = sim2real::Analyse(sim, real, simulator->get(), options, *why);
+    if (!a.inputs.recording_from_metadata) {
+      ctx->notes.push_back(args.sim + " records no protocol and seed (metadata): the signatures re-record protocol "
+                           "paper with --seed " + std::to_string(args.seed) + ", not the sim set's own recording");
+    }
+    return a;
+  } catch (const InputError& e) {
+    *why = std::string("the simulator could not re-record the sim set (") + e.what() + "): located only";
+    Warn(*why);
+    ctx->notes.push_back(*why);
+    simulator->reset();
+    return sim2real::Analyse(sim, real, nullptr, options, *why);  // set errors throw again here
+  }
+}
+
 void Run(const Sim2RealArgs& args) {
   const SampleSet sim = ReadSampleSet(args.sim);
   const SampleSet real = ReadSampleSet(args.real);
@@ -187,7 +210,7 @@ void Run(const Sim2RealArgs& args) {
   if (!simulator) ctx.notes.push_back(why);
   ReportStage("sim2real: analysing " + std::to_string(real.size()) + " real vs " + std::to_string(sim.size()) +
               " sim samples");
-  const sim2real::Analysis a = sim2real::Analyse(sim, real, simulator.get(), MakeOptions(args), why);
+  const sim2real::Analysis a = AnalyseOrLocate(sim, real, args, &simulator, &why, &ctx);
   // Everything is written into a sibling folder that replaces -o whole at the end.
   AtomicDir output(args.out, "report.json");
   WriteOutputs(args, a, simulator.get(), output.temp_path(), &ctx);

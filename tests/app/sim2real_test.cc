@@ -139,6 +139,21 @@ TEST(Sim2RealApp, WithoutAnyConfigItSaysItCanOnlyLocate) {
   EXPECT_FALSE(o.report["simulator"]["analysed"].get<bool>());
 }
 
+// A sim set whose recording the simulator cannot repeat (a protocol it does not know): the report
+// says why and only locates.
+TEST(Sim2RealApp, ARecordingTheSimulatorCannotRepeatIsLocatedOnly) {
+  const auto dir = MakeTempDir("sim2real-badprotocol");
+  SampleSet sim = ReadSampleSet(Sim());
+  sim.metadata["protocol"] = "no-such-protocol";
+  WriteSampleSet(sim, (dir / "sim.h5").string());
+  const Outputs o = RunSim2Real({"--sim", (dir / "sim.h5").string(), "--real", Real("slip"), "--permutations", "200",
+                                 "--cache", "-"},
+                                dir);
+  EXPECT_EQ(o.report["verdict"]["status"], "located");
+  EXPECT_NE(o.report["verdict"]["sentence"].get<std::string>().find("could not re-record"), std::string::npos);
+  ExpectOneStory(o);
+}
+
 TEST(Sim2RealApp, BadInputIsOneLineAndNoOutput) {
   const auto dir = MakeTempDir("sim2real-bad");
   const auto out = dir / "out";
