@@ -106,10 +106,17 @@ void TestFit(const AnalysisInputs& in, const Baseline& base, const Refinement& r
   std::mt19937_64 rng(options.seed + 7);
   out->after = LocateModel(in, base, out->residuals, corrected, false, options.locate, rng);
   for (const auto& g : out->after.significant) {
-    if (!(g.deficit > 0)) continue;  // the correction beats the ceiling there: not a mismatch it leaves
-    out->remaining.push_back(g);
-    out->doubts.push_back("mismatch remains after the correction in " + g.label +
-                          Fmt(" (%.2f nats per sample below the ceiling, q %.2g)", g.deficit, g.q_value));
+    if (g.deficit > 0) out->remaining.push_back(g);  // where the correction beats the ceiling it leaves nothing
+  }
+  if (!out->remaining.empty()) {
+    // One doubt naming the worst regions (remaining is sorted by deficit).
+    std::string where;
+    for (size_t k = 0; k < out->remaining.size() && k < 3; ++k) {
+      const Region& g = out->remaining[k];
+      where += (k ? "; " : "") + g.label + Fmt(" (%.2f nats per sample below the ceiling, q %.2g)", g.deficit, g.q_value);
+    }
+    if (out->remaining.size() > 3) where += Fmt(" and %.0f more region(s)", out->remaining.size() - 3.0);
+    out->doubts.push_back("mismatch remains after the correction in " + where);
   }
 }
 

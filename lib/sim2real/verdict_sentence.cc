@@ -80,20 +80,23 @@ std::string SpreadPart(const Naming& naming, const Refinement& r) {
   return s;
 }
 
+// The first few entries of a list, "a, b, c and 4 more".
+std::string FirstFew(const std::vector<std::string>& items, const std::string& separator) {
+  constexpr size_t kShown = 5;
+  std::string s;
+  for (size_t w = 0; w < items.size() && w < kShown; ++w) s += (w == 0 ? " " : separator) + items[w];
+  if (items.size() > kShown) s += Fmt(" and %.0f more", static_cast<double>(items.size() - kShown));
+  return s;
+}
+
 }  // namespace
 
 std::string VerdictSentence(const Verdict& v, const Adequacy* adequacy, const Naming* naming, const Refinement* r) {
   std::string s = Headline(v);
   if (v.unexplained_present && !v.structured_in.empty() && v.status != "located") {
-    s += " The residual is structured in";
-    for (size_t w = 0; w < v.structured_in.size(); ++w) s += (w == 0 ? " " : ", ") + v.structured_in[w];
-    s += ".";
+    s += " The residual is structured in" + FirstFew(v.structured_in, ", ") + ".";
   }
-  if (v.status == "located") {
-    s += " Where the sim model fails:";
-    for (size_t w = 0; w < v.structured_in.size(); ++w) s += (w == 0 ? " " : "; ") + v.structured_in[w];
-    s += ".";
-  }
+  if (v.status == "located") s += " Where the sim model fails:" + FirstFew(v.structured_in, "; ") + ".";
   for (const auto& w : v.weak) {
     s += " " + w.family + " (" + w.knob + Fmt(" = %.4g) also fitted but is not named: inclusion %.0f%%", w.value, 100 * w.inclusion) +
          Fmt(" is below %.0f%%.", 100 * v.min_inclusion);
