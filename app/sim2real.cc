@@ -1,28 +1,29 @@
-// `dgmm sim2real`: where the simulation fails on real recordings, what physics it left out, the
-// corrected model, and how much of the gap it closes (lib/sim2real, docs/sim2real.md).
+// `dgmm sim2real`: where the simulation fails on real recordings, which simulator knobs (or
+// measurement effects) explain it and how sure that is, the corrected model and the simulator
+// config at the named values (lib/sim2real/analysis.h, docs/sim2real.md).
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <memory>
+#include <optional>
+#include <thread>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "app/wiring/mujoco_knob_simulator.h"
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
-#include "sim2real/corrected_model.h"
 #include "sim/sim_config.h"
+#include "sim2real/analysis.h"
+#include "sim2real/corrected_model.h"
 #include "sim2real/figures.h"
-#include "sim2real/knob_analysis.h"
-#include "sim2real/pipeline.h"
-#include "sim2real/recalibrate.h"
 #include "sim2real/report.h"
-#include "sim2real/verdict.h"
 #include "util/atomic_dir.h"
 #include "util/atomic_file.h"
-#include "util/output_guard.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -30,14 +31,13 @@ namespace {
 struct Sim2RealArgs {
   std::string sim, real, out, sim_config, cache;
   int signature_placements = 78;
-  std::vector<std::string> effects;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
+  int threads = 0;
   bool json = false;
   bool no_figures = false;
-  bool legacy_resim = false;
-  bool no_knobs = false;
+  bool locate_only = false;
   bool no_experiment_check = false;
 };
 
@@ -52,13 +52,12 @@ void WriteText(const std::filesystem::path& path, const std::string& text) {
 }
 
 // Refuses, before any output exists, what has no answer: identical --sim and --real files,
-// inputs inside the output folder, a --sim-config that cannot be loaded.
+// inputs inside the output folder.
 void CheckInputs(const Sim2RealArgs& args) {
   namespace fs = std::filesystem;
   if (SameFile(args.sim, args.real) || SameContent(args.sim, args.real)) {
     throw MakeInputError(args.real, "--real",
-                         "is the same data as --sim " + args.sim +
-                             "; expected a real set to compare with the simulation");
+                         "is the same data as --sim " + args.sim + "; expected a real set to compare with the simulation");
   }
   CheckOutputDir(args.out, "report.json");
   std::error_code ec;
@@ -69,138 +68,194 @@ void CheckInputs(const Sim2RealArgs& args) {
     auto mismatch = std::mismatch(out.begin(), out.end(), in.begin(), in.end());
     if (!out.empty() && mismatch.first == out.end()) {
       throw MakeInputError(input, "-o",
-                           "is inside the output folder " + args.out +
-                               ", which is replaced as a whole; move it or choose another -o");
+                           "is inside the output folder " + args.out + ", which is replaced as a whole; move it or "
+                           "choose another -o");
     }
   }
-  if (!args.sim_config.empty()) sim::LoadSimConfig(args.sim_config);  // refuse up front
+}
+
+// The top-level keys (dotted for nested objects) where two configs differ.
+std::string DifferingKeys(const std::string& a, const std::string& b) {
+  const auto fa = nlohmann::json::parse(a).flatten(), fb = nlohmann::json::parse(b).flatten();
+  std::string keys;
+  for (const auto& [k, v] : fa.items()) {
+    if (k == "/mjcf_path") continue;  // where the robot lives may differ; its text is in the fingerprint
+    if (!fb.contains(k) || fb[k] != v) keys += (keys.empty() ? "" : ", ") + k.substr(1);
+  }
+  return keys;
+}
+
+// The simulator config: --sim-config, else the sim set's own (metadata "sim_config", written by
+// `dgmm simulate`). Empty optional with *why when there is none.
+std::optional<sim::SimConfig> ResolveConfig(const Sim2RealArgs& args, const SampleSet& sim, std::string* source,
+                                            std::vector<std::string>* notes, std::string* why) {
+  std::optional<sim::SimConfig> recorded;
+  if (auto it = sim.metadata.find("sim_config"); it != sim.metadata.end()) {
+    try {
+      recorded = sim::SimConfigFromJson(it->second, args.sim + ": metadata sim_config");
+    } catch (const InputError&) {
+      if (!args.locate_only && args.sim_config.empty()) throw;  // the config the analysis needs
+      notes->push_back(args.sim + ": its recorded sim_config cannot be read; not used");
+    }
+  }
+  if (!args.sim_config.empty()) {
+    sim::SimConfig config = sim::LoadSimConfig(args.sim_config);
+    *source = "--sim-config " + args.sim_config;
+    if (recorded) {
+      const std::string keys = DifferingKeys(sim::SimConfigToJson(config), sim::SimConfigToJson(*recorded));
+      if (!keys.empty()) {
+        notes->push_back("--sim-config " + args.sim_config + " contradicts the config the sim set was recorded with (" +
+                         keys + "); the analysis simulates with --sim-config as asked");
+        Warn(notes->back());
+      }
+    }
+    return config;
+  }
+  if (recorded) {
+    *source = "the sim set's own recorded config (metadata sim_config of " + args.sim + ")";
+    return recorded;
+  }
+  *why = "no simulator config: " + args.sim + " records none in its metadata and no --sim-config was given, so the "
+         "analysis can only locate the mismatch (no physics named)";
+  return std::nullopt;
+}
+
+sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args) {
+  sim2real::AnalysisOptions o;
+  const int threads = args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
+  o.seed = args.seed;
+  o.locate.seed = args.seed;
+  o.locate.locate.mmd.permutations = args.permutations;
+  o.candidates.placements = args.signature_placements;
+  o.candidates.recording.cache_dir = args.cache;
+  o.candidates.recording.threads = threads;
+  o.refine.seed = args.seed;
+  o.refine.selection.bootstrap_selection = args.bootstrap;
+  o.adequacy.seed = args.seed;
+  o.adequacy.locate.mmd.permutations = args.permutations;
+  o.ties.experiment.enabled = !args.no_experiment_check;
+  o.ties.experiment.seed = args.seed;
+  o.ties.experiment.threads = std::min(threads, 2);
+  o.on_stage = [](const std::string& stage) { ReportStage("sim2real: " + stage); };
+  return o;
+}
+
+// The models, the config at the named values and the figures into `dir`; fills the context.
+void WriteOutputs(const Sim2RealArgs& args, const sim2real::Analysis& a, const sim2real::KnobSimulator* simulator,
+                  const std::filesystem::path& dir, sim2real::ReportContext* ctx) {
+  ctx->sim_model_file = "sim_model.h5";
+  WriteModel(sim2real::BuildSimModel(a.baseline.sim_model, a.inputs.first_execution_share, a.inputs.sim_set),
+             (dir / ctx->sim_model_file).string());
+  if (a.knobs_analysed) {
+    ctx->corrected_model_file = "corrected_model.h5";
+    WriteModel(sim2real::BuildCorrectedModel(a.baseline.sim_model, a.correction, a.inputs.first_execution_share,
+                                             a.inputs.sim_set),
+               (dir / ctx->corrected_model_file).string());
+    ctx->recalibrated_config_file = "recalibrated_config.json";
+    WriteText(dir / ctx->recalibrated_config_file, simulator->ConfigJson(a.named_values) + "\n");
+  }
+  if (args.no_figures) {
+    ctx->notes.push_back("figures skipped: --no-figures");
+  } else {
+    std::string note;
+    ctx->figures = sim2real::RenderFigures(a, dir, &note);
+    if (!note.empty()) ctx->notes.push_back(note);
+  }
+}
+
+// The analysis; when the simulator cannot re-record the sim set's recording (e.g. a protocol it
+// does not know), the report says why and the analysis only locates.
+sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, const Sim2RealArgs& args,
+                                   std::unique_ptr<MujocoKnobSimulator>* simulator, std::string* why,
+                                   sim2real::ReportContext* ctx) {
+  const sim2real::AnalysisOptions options = MakeOptions(args);
+  if (!*simulator) return sim2real::Analyse(sim, real, nullptr, options, *why);
+  try {
+    sim2real::Analysis a = sim2real::Analyse(sim, real, simulator->get(), options, *why);
+    if (!a.inputs.recording_from_metadata) {
+      ctx->notes.push_back(args.sim + " records no protocol and seed (metadata): the signatures re-record protocol "
+                           "paper with --seed " + std::to_string(args.seed) + ", not the sim set's own recording");
+    }
+    return a;
+  } catch (const InputError& e) {
+    *why = std::string("the simulator could not re-record the sim set (") + e.what() + "): located only";
+    Warn(*why);
+    ctx->notes.push_back(*why);
+    simulator->reset();
+    return sim2real::Analyse(sim, real, nullptr, options, *why);  // set errors throw again here
+  }
 }
 
 void Run(const Sim2RealArgs& args) {
-  namespace fs = std::filesystem;
   const SampleSet sim = ReadSampleSet(args.sim);
   const SampleSet real = ReadSampleSet(args.real);
   if (sim.pose_dim() != real.pose_dim() || sim.terrain_dim() != real.terrain_dim()) {
     throw MakeInputError(args.real, sim.pose_dim() != real.pose_dim() ? "x" : "z",
-                         fmt::format("{} pose and {} terrain dimensions; expected those of --sim "
-                                     "{} ({} and {})",
-                                     real.pose_dim(), real.terrain_dim(), args.sim, sim.pose_dim(),
-                                     sim.terrain_dim()));
+                         fmt::format("{} pose and {} terrain dimensions; expected those of --sim {} ({} and {})",
+                                     real.pose_dim(), real.terrain_dim(), args.sim, sim.pose_dim(), sim.terrain_dim()));
   }
   CheckInputs(args);
-  // Everything is written into a sibling folder that replaces -o whole at the end.
-  AtomicDir output(args.out, "report.json");
-  const fs::path out_dir = output.temp_path();
-  sim2real::Sim2RealOptions options;
-  options.seed = args.seed;
-  options.selection.bootstrap_selection = args.bootstrap;
-  options.locate.mmd.permutations = args.permutations;
-  options.only_effects = args.effects;
-  ReportStage("sim2real: analysing " + std::to_string(real.size()) + " real vs " +
-              std::to_string(sim.size()) + " sim samples");
-  const sim2real::Sim2RealResult result = sim2real::RunSim2Real(sim, real, options);
-
   sim2real::ReportContext ctx;
   ctx.sim_path = args.sim;
   ctx.real_path = args.real;
-  ctx.corrected_model_file = "corrected_model.h5";
-  ctx.sim_model_file = "sim_model.h5";
-  WriteModel(sim2real::BuildCorrectedModel(result, sim), (out_dir / ctx.corrected_model_file).string());
-  WriteModel(sim2real::BuildSimModel(result, sim), (out_dir / ctx.sim_model_file).string());
-  sim2real::Verdict verdict = sim2real::VerdictFromEffects(result);
-  if (!args.sim_config.empty() && !args.no_knobs) {
-    ReportStage("sim2real: simulator knobs (signatures, selection, refinement)");
-    sim2real::KnobAnalysisOptions ko;
-    ko.seed = args.seed;
-    ko.selection = options.selection;
-    ko.signatures.cache_dir = args.cache;
-    ko.signatures.placements = args.signature_placements;
-    ko.experiment.enabled = !args.no_experiment_check;
-    ko.experiment.seed = args.seed;
-    const sim::SimConfig config = sim::LoadSimConfig(args.sim_config);  // a bad config is the user's error
-    try {
-      const sim2real::KnobAnalysis knobs = sim2real::AnalyseKnobs(sim, real, config, result, ko);
-      verdict = knobs.verdict;
-      ctx.knob_analysis_json = sim2real::KnobAnalysisJson(knobs);
-    } catch (const InputError& e) {
-      // E.g. a sim set without episodes: the data-level verdict stands, and the report says why.
-      ctx.notes.push_back(std::string("simulator-knob analysis skipped: ") + e.what());
-    }
+  std::string why;
+  std::unique_ptr<MujocoKnobSimulator> simulator;
+  const auto config = ResolveConfig(args, sim, &ctx.simulator_config_source, &ctx.notes, &why);
+  if (args.locate_only) {
+    why = "--locate-only: the analysis stops after locating the mismatch (no physics named)";
+  } else if (config) {
+    simulator = std::make_unique<MujocoKnobSimulator>(*config);  // a bad robot model is the user's error
+    ctx.simulator_fingerprint = simulator->Fingerprint();
   }
-  ctx.verdict_json = sim2real::VerdictJson(verdict);
-  ctx.verdict_sentence = verdict.sentence;
-  if (!args.sim_config.empty() && args.legacy_resim) {
-    ReportStage("sim2real: re-simulating with fitted physical parameters (legacy scans)");
-    sim2real::RecalibrationOptions recal;
-    recal.sim_config_path = args.sim_config;
-    recal.seed = args.seed;
-    ctx.recalibration_json = sim2real::Recalibrate(result, real, recal);
-    // The recalibrated config on its own, ready for `dgmm simulate --config`.
-    const auto recal_json = nlohmann::json::parse(ctx.recalibration_json, nullptr, false);
-    if (!recal_json.is_discarded() && recal_json.contains("recalibrated_config")) {
-      WriteText(out_dir / "recalibrated_config.json",
-                recal_json["recalibrated_config"].dump(2) + "\n");
-    }
-  }
-  if (args.no_figures) {
-    ctx.notes.push_back("figures skipped: --no-figures");
-  } else {
-    std::string note;
-    ctx.figures = sim2real::RenderFigures(result, sim, real, out_dir, &note);
-    if (!note.empty()) ctx.notes.push_back(note);
-  }
-  const std::string json = sim2real::ReportJson(result, ctx);
-  WriteText(out_dir / "report.html", sim2real::ReportHtml(result, ctx, out_dir));
-  WriteText(out_dir / "report.json", json);  // the marker of a complete result, last
+  if (!simulator) ctx.notes.push_back(why);
+  ReportStage("sim2real: analysing " + std::to_string(real.size()) + " real vs " + std::to_string(sim.size()) +
+              " sim samples");
+  const sim2real::Analysis a = AnalyseOrLocate(sim, real, args, &simulator, &why, &ctx);
+  // Everything is written into a sibling folder that replaces -o whole at the end.
+  AtomicDir output(args.out, "report.json");
+  WriteOutputs(args, a, simulator.get(), output.temp_path(), &ctx);
+  const std::string json = sim2real::ReportJson(a, ctx);
+  WriteText(output.temp_path() / "report.html", sim2real::ReportHtml(a, ctx, output.temp_path()));
+  WriteText(output.temp_path() / "report.json", json);  // the marker of a complete result, last
   output.Commit();
-  if (args.json) {
-    std::cout << json;
-    return;
-  }
-  std::cout << result.conclusion << "\n";
-  if (!verdict.sentence.empty()) std::cout << "verdict: " << verdict.sentence << "\n";
-  for (const auto& n : ctx.notes) std::cout << "note: " << n << "\n";
-  std::cout << "report: " << (fs::path(args.out) / "report.html").string() << "\n";
+  std::cout << (args.json ? json : sim2real::ReportSummary(a, ctx, (std::filesystem::path(args.out) / "report.html").string()));
 }
 
 void Setup(CLI::App& root) {
   auto args = std::make_shared<Sim2RealArgs>();
   CLI::App* cmd = root.add_subcommand(
       "sim2real",
-      "Compare a simulated and a real sample set: locate where the sim-trained model fails "
-      "(terrain, sequence, command), name the physics the simulation left out (slip, traction, "
-      "payload offset, actuator asymmetry, latency, compliance, bias, noise), write the corrected "
-      "model and show how much of the gap it closes. Writes report.html, report.json, "
-      "corrected_model.h5, sim_model.h5 and PNGs into -o.");
+      "Compare a simulated and a real sample set: locate where the sim-trained model fails (terrain, sequence, "
+      "command), name the simulator knobs (friction, contact, masses, payload, actuator gains, damping, latency, "
+      "backlash, ...) or measurement effects (tracker bias and noise, IMU bias, heading drift) that explain it, by "
+      "re-simulating the sim set's own recording at other knob values; say how sure that is (inclusion, ties, the "
+      "experiment that would separate them, doubts) and how much of the gap the correction closes. The simulator "
+      "config is the sim set's own (recorded by dgmm simulate) unless --sim-config is given; without one the tool "
+      "only locates. Writes report.html, report.json, sim_model.h5, corrected_model.h5, recalibrated_config.json and "
+      "PNGs into -o.");
   cmd->add_option("--sim", args->sim, "simulated sample set (.h5)")->required();
   cmd->add_option("--real", args->real, "real sample set (.h5)")->required();
   cmd->add_option("-o,--output", args->out, "output folder")->required();
   cmd->add_option("--seed", args->seed, "seed of folds, bootstrap and permutations")->capture_default_str();
-  cmd->add_option("--sim-config", args->sim_config, "simulation config of the sim set (JSON)");
-  cmd->add_option("--effects", args->effects,
-                  "restrict the data-level effect library to these keys (comma-separated), e.g. "
-                  "bias,noise")
-      ->delimiter(',');
+  cmd->add_option("--sim-config", args->sim_config,
+                  "simulation config (JSON) to re-simulate with; default: the one the sim set records (a different "
+                  "one is reported)");
+  cmd->add_flag("--locate-only", args->locate_only, "only locate the mismatch (no re-simulation, no physics named)");
+  cmd->add_option("--threads", args->threads, "threads for the recordings and the experiment check (0: all cores)")
+      ->capture_default_str()->check(CLI::Range(0, 1024));
   cmd->add_option("--cache", args->cache,
-                  "folder of cached knob simulations (default $XDG_CACHE_HOME/dgmm or ~/.cache/dgmm; - for none)");
+                  "folder of cached recordings (default $XDG_CACHE_HOME/dgmm or ~/.cache/dgmm; - for none)");
   cmd->add_option("--signature-placements", args->signature_placements,
-                  "placements per knob simulation (paper protocol: >= 78 covers every command 3 times)")
+                  "placements per recording (paper protocol: >= 78 covers every command 3 times)")
       ->capture_default_str()->check(CLI::Range(3, 10000));
-  cmd->add_option("--bootstrap", args->bootstrap, "bootstrap resamples of the effect selection")
+  cmd->add_option("--bootstrap", args->bootstrap, "bootstrap resamples of the selection (inclusion; 0: not computed)")
       ->capture_default_str()->check(CLI::Range(0, 1000));
   cmd->add_option("--permutations", args->permutations, "permutations per two-sample test")
       ->capture_default_str()->check(CLI::Range(1, 100000));
   cmd->add_flag("--no-figures", args->no_figures, "skip the PNG figures");
-  cmd->add_flag("--no-knobs", args->no_knobs,
-                "with --sim-config, skip the simulator-knob analysis (the verdict then comes from the "
-                "data-level effects)");
   cmd->add_flag("--no-experiment-check", args->no_experiment_check,
-                "with --sim-config, do not simulate the discriminating experiment proposed for a tie of two "
-                "simulator knobs (report.json verdict.ties[].experiment.checked_by_simulation stays false)");
-  cmd->add_flag("--legacy-resim", args->legacy_resim,
-                "with --sim-config, also run the scans of the data-level effects (friction, payload, "
-                "leg gain; report.json \"recalibration\", recalibrated_config.json)");
-  cmd->add_flag("--json", args->json, "print report.json to stdout instead of the conclusion");
+                "do not record the discriminating experiment proposed for a tie of two knobs");
+  cmd->add_flag("--json", args->json, "print report.json to stdout instead of the summary");
   cmd->callback([args] { Run(*args); });
 }
 

@@ -411,7 +411,7 @@ def make_older_outputs(dgmm, w, inp):
     report = os.path.join(d, "report")
     dgmm_ok(dgmm, ["sim2real", "--sim", inp["sim"], "--real",
                    os.path.join(ROOT, "datasets", "sim2real", "null", "real.h5"), "-o", report,
-                   "--no-figures", "--bootstrap", "0", "--permutations", "50", "--cache", "-"])
+                   "--no-figures", "--locate-only", "--permutations", "50"])
     old["dir"] = report
     os.makedirs(os.path.join(d, "logdir"))
     for name in ["commands.csv", "pose.csv", "imu.csv"]:
@@ -738,7 +738,7 @@ def cases(inp, seed):
             ("--real mutated", s2r(sim, I["set_flip1.h5"]), [sim, I["set_flip1.h5"]],
              "set_flip1.h5"),
             ("--real version 1", s2r(sim, I["set_v1.h5"]), [sim, I["set_v1.h5"]], "set_v1.h5"),
-            ("--effects bogus", s2r(sim, real, "--effects", "bogus"), [sim, real], "bogus"),
+            ("--threads -1", s2r(sim, real, "--threads", "-1"), [sim, real], "--threads"),
             ("--sim a model", s2r(I["m.h5"], real), [I["m.h5"], real], "m.h5")]:
         add("sim2real", f"sim2real {label}", args, ins, out=O, kind="dir", needles=[needle])
     add("sim2real", "sim2real -o an input file",

@@ -1,62 +1,55 @@
 #!/usr/bin/env bash
-# Times `dgmm sim2real` (default settings: 20 selection bootstraps, 1000 permutations per test) on
-# every shipped pair (390 real vs 830 sim samples), 3 runs each, and writes the medians into the
-# `sim2real` section of docs/performance.md. Usage: scripts/bench_sim2real.sh [build-dir]
+# Times `dgmm sim2real` on a shipped pair (datasets/sim2real/payload: 390 real vs 830 sim samples,
+# the sim set's own recorded config, default settings, no figures): uncached (a fresh recording
+# cache, so every knob signature is recorded) with --threads 1 and with --threads N, then cached
+# (the same analysis again with N threads), and writes the `sim2real` section of
+# docs/performance.md. N is the machine's core count (`nproc`). Usage:
+#   scripts/bench_sim2real.sh [build-dir]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${1:-${DGMM_BUILD_DIR:-$root/build}}
 dgmm="$build/app/dgmm"
 data="$root/datasets/sim2real"
+[ -x "$dgmm" ] || { echo "bench_sim2real: $dgmm not built" >&2; exit 1; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-runs=3
-figures_flag=(--no-figures)
-wrap=()
-if command -v xvfb-run > /dev/null; then wrap=(xvfb-run -a); figures_flag=(); fi
-median() { sort -g | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }
-rows=""
-for pair in slip payload weak_leg null; do
-  times=()
-  for i in $(seq $runs); do
-    start=$(date +%s.%N)
-    "${wrap[@]}" "$dgmm" sim2real --sim "$data/sim.h5" --real "$data/$pair/real.h5" -o "$tmp/$pair" \
-      "${figures_flag[@]}" > /dev/null
-    end=$(date +%s.%N)
-    times+=("$(echo "$end - $start" | bc -l)")
-  done
-  med=$(printf '%s\n' "${times[@]}" | median)
-  analysis=$(python3 -c "import json; print('%.1f' % json.load(open('$tmp/$pair/report.json'))['seconds'])")
-  rows+="| $pair | $(printf '%.1f' "$med") | $analysis |"$'\n'
-  echo "sim2real $pair: median wall ${med}s over $runs runs (analysis ${analysis}s)"
-done
-# One run per effect pair with --sim-config (re-simulation of the mapped effects: friction,
-# payload, leg gains; see docs/sim2real.md "Re-simulation").
-recal_rows=""
-for pair in slip payload weak_leg; do
+cores=$(nproc)
+pair=payload
+# run NAME THREADS CACHE: one analysis; prints its wall seconds; the report is in $tmp/NAME.
+run() {
+  local start end
   start=$(date +%s.%N)
-  "$dgmm" sim2real --sim "$data/sim.h5" --real "$data/$pair/real.h5" -o "$tmp/recal-$pair" \
-    --no-figures --sim-config "$data/configs/nominal.json" > /dev/null
-  recal=$(echo "$(date +%s.%N) - $start" | bc -l)
-  sims=$(python3 -c "import json; print(json.load(open('$tmp/recal-$pair/report.json'))['recalibration'].get('simulations', 0))")
-  recal_rows+="| $pair | $sims | $(printf '%.1f' "$recal") |"$'\n'
-  echo "sim2real $pair with --sim-config: ${recal}s ($sims simulations)"
+  "$dgmm" --quiet sim2real --sim "$data/sim.h5" --real "$data/$pair/real.h5" -o "$tmp/$1" --no-figures \
+    --threads "$2" --cache "$3" > /dev/null
+  end=$(date +%s.%N)
+  echo "$end - $start" | bc -l
+}
+field() { python3 -c "import json; j=json.load(open('$tmp/$1/report.json')); print($2)"; }
+rows=""
+for threads in 1 "$cores"; do
+  t=$(run "uncached-$threads" "$threads" "$tmp/cache-$threads")
+  sig=$(field "uncached-$threads" "'%.0f' % j['seconds']['candidates']")
+  n=$(field "uncached-$threads" "j['knobs']['recordings']['signatures'] + j['knobs']['recordings']['refinement']")
+  rows+="| uncached | $threads | $(printf '%.0f' "$t") | $sig | $n |"$'\n'
+  echo "sim2real $pair uncached, $threads thread(s): ${t}s ($n recordings, signatures ${sig}s)"
 done
+t=$(run cached "$cores" "$tmp/cache-$cores")
+n=$(field cached "j['knobs']['recordings']['signatures'] + j['knobs']['recordings']['refinement']")
+rows+="| cached | $cores | $(printf '%.1f' "$t") | - | $n |"$'\n'
+echo "sim2real $pair cached, $cores thread(s): ${t}s ($n recordings)"
+verdict=$(field cached "j['verdict']['status'] + ': ' + '; '.join('%s %.3g' % (n['knob'], n['value']) for n in j['verdict']['named'])")
 cat > "$tmp/section.md" <<MD
 ### sim2real (\`scripts/bench_sim2real.sh\`)
 
-One \`dgmm sim2real\` run, 390 real vs 830 sim samples (the shipped MuJoCo pairs), default
-settings (20 bootstrap resamples of the selection, 200 of the parameters, 1000 permutations per
-MMD test), figures ${figures_flag[*]:-rendered under xvfb-run}. Median of $runs runs on $(nproc) cores,
-$(date -u +%Y-%m-%d). Target: under 120 s.
+\`dgmm sim2real\` on the shipped payload pair (390 real vs 830 sim samples), the sim set's recorded
+config, default settings (78 placements per recording, 20 bootstrap resamples, 1000 permutations
+per test), no figures; $(date -u +%Y-%m-%d) on $cores cores ($(uptime | sed 's/.*load average/load average/')). Uncached: a
+fresh recording cache; cached: the same analysis again. Verdict: $verdict. Targets (issue #22):
+uncached <= 90 s on 2 cores and <= 30 s with 16 threads, cached <= 10 s.
 
-| pair | wall s (median, incl. reading, figures, report) | analysis s (last run) |
-|---|---|---|
+| run | threads | wall s | signatures s | recordings made |
+|---|---|---|---|---|
 $rows
-With \`--sim-config\` (each mapped effect re-simulated, 40 placements = 200 samples per
-simulation, 2 threads, plus the 80-placement check), one run per pair, no figures:
-
-| pair | simulations | wall s |
-|---|---|---|
-$recal_rows
 MD
+cat "$tmp/section.md"
 python3 "$root/scripts/replace_section.py" "$root/docs/performance.md" sim2real "$tmp/section.md"

@@ -488,8 +488,13 @@ def main():
             r["error"] = error
         else:
             r["score"] = score.score_pair(truth, report)
+            recordings = (report.get("knobs") or {}).get("recordings")
             stats = find_key(report, "from_cache")
-            if stats is not None:
+            if recordings is not None:  # issue #22's report
+                r["simulations"] = recordings["signatures"] + recordings["refinement"]
+                r["from_cache"] = recordings["signatures_from_cache"] + recordings["refinement_from_cache"]
+                r["signature_simulations"] = recordings["signatures"]
+            elif stats is not None:
                 r["simulations"], r["from_cache"] = stats.get("simulations"), stats["from_cache"]
                 r["signature_simulations"] = stats.get("signature_simulations")
         results[p["seed"]] = r

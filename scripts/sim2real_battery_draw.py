@@ -7,10 +7,13 @@ same pair. Each planted effect is a dict {family, knob, value, unit, nominal, wh
 data}: `config` edits the sim config JSON of the "real" robot, `mjcf` edits a copy of its MJCF,
 `data` edits the recorded set.
 
-Draw versions: 1 is the generator of seed ranges up to 10000-10039 (kept bit for bit); 2 (the
-default, from seed range 11000) adds the contact family's floor solimp option, the physics family
-"backlash", and plants tracker noise through the config (the simulator's own tracker noise scaled
-by s) instead of adding noise to the recorded set.
+Draw versions: 1 is the generator of seed ranges up to 10000-10039 (kept bit for bit); 2 (from
+seed range 11000) adds the contact family's floor solimp option, the physics family "backlash",
+and plants tracker noise through the config (the simulator's own tracker noise scaled by s)
+instead of adding noise to the recorded set. 3 (the default, issue #22, from seed range 12000)
+draws version 2's pairs with other kind shares (more out-of-library pairs) and adds
+out-of-library physics no simulator knob describes, planted by editing one leg of the real robot's
+MJCF: a shorter tibia, a larger foot, a hip mounted off its place, a mass added to the leg.
 """
 import re
 
@@ -23,14 +26,17 @@ PHYSICS = PHYSICS_V1 + ["backlash"]
 MEASUREMENT = ["imu_bias", "tracker_bias", "tracker_noise", "heading_drift"]
 FAMILIES_V1 = PHYSICS_V1 + MEASUREMENT
 FAMILIES = PHYSICS + MEASUREMENT
-DRAW_VERSIONS = (1, 2)
-DEFAULT_DRAW_VERSION = 2
+DRAW_VERSIONS = (1, 2, 3)
+DEFAULT_DRAW_VERSION = 3
 OUT_OF_LIBRARY = ["periodic_pitch", "fatigue"]
+OUT_OF_LIBRARY_GEOMETRY = ["short_tibia", "large_foot", "mount_offset", "leg_mass"]  # version 3
 
 # Shares of the pair kinds (issue #9: ~20% nulls, ~20% two effects, ~10% outside every library);
 # the rest are single in-library effects. A share of pairs runs on the second robot.
 P_NULL, P_TWO, P_OOL = 0.2, 0.2, 0.1
 P_SECOND_ROBOT = 0.15
+# Version 3 (issue #22): a quarter of the pairs out of library, two thirds of those geometry.
+P_NULL_V3, P_TWO_V3, P_OOL_V3, P_GEOMETRY_V3 = 0.2, 0.15, 0.25, 0.67
 
 
 # Physical ranges, fixed before any analysis result was seen (docs/sim2real.md lists them; the
@@ -56,6 +62,16 @@ RANGES = {
     "heading_drift_rad": (0.01, 0.04),          # per execution, random sign
     "ool.periodic_pitch_rad": (0.015, 0.03),
     "ool.fatigue_rate": (0.15, 0.3),
+    # Version 3 (MJCF edits of one leg of the scorpion: tibia 0.16 m, foot radius 0.02 m, legs
+    # 0.15 m apart along the torso, a leg about 0.55 kg of 12.4 kg). First drawn as tibia x0.65-0.85,
+    # foot 35-55 mm, mount 30-60 mm; a method-free check on DEV plants (seeds 950-963, real seeds
+    # 100950-100963: mean-shift / consistent z of a foot of 50-65 mm and a mount offset of 55 mm
+    # at the null's level, tibia x0.8 too) raised the ends below to changes the protocol can see at
+    # all; one leg's geometry stays hard to see (7 others carry the robot).
+    "ool.tibia_scale": (0.55, 0.75),
+    "ool.foot_radius_m": (0.07, 0.1),
+    "ool.mount_offset_m": (0.07, 0.12),             # along the torso's x axis, random sign
+    "ool.leg_mass_kg": (0.4, 1.0),
 }
 
 
@@ -229,6 +245,35 @@ def draw_out_of_library(rng):
             "config": {}, "mjcf": None, "data": {"fatigue": {"rate": rate}}}
 
 
+def draw_out_of_library_geometry(rng):
+    """Version 3: one leg of the real robot differs in its MJCF (no simulator knob describes it)."""
+    kind = OUT_OF_LIBRARY_GEOMETRY[int(rng.integers(0, len(OUT_OF_LIBRARY_GEOMETRY)))]
+    leg = int(rng.integers(0, 8))
+    e = {"family": "out_of_library", "kind": kind, "knob": None, "unit": "", "config": {}, "data": None}
+    if kind == "short_tibia":
+        f = _range(rng, "ool.tibia_scale")
+        e.update(value=f, what=f"leg {leg} tibia shortened to {100 * f:.0f}%", mjcf={"tibia_scale": [leg, f]})
+    elif kind == "large_foot":
+        r = _range(rng, "ool.foot_radius_m")
+        e.update(value=r, unit="m", what=f"leg {leg} foot radius {1000 * r:.0f} mm (nominal 20)",
+                 mjcf={"foot_radius": [leg, r]})
+    elif kind == "mount_offset":
+        d = _signed(rng, *RANGES["ool.mount_offset_m"])
+        e.update(value=d, unit="m", what=f"leg {leg} hip mounted {1000 * d:+.0f} mm along the torso",
+                 mjcf={"mount_offset": [leg, d]})
+    else:
+        m = _range(rng, "ool.leg_mass_kg")
+        e.update(value=m, unit="kg", what=f"{m:.2f} kg added to leg {leg}'s tibia", mjcf={"leg_mass": [leg, m]})
+    return e
+
+
+def _kind(rng, version):
+    u = rng.random()
+    p_null, p_two, p_ool = (P_NULL_V3, P_TWO_V3, P_OOL_V3) if version >= 3 else (P_NULL, P_TWO, P_OOL)
+    return "null" if u < p_null else "two" if u < p_null + p_two else \
+        "out_of_library" if u < p_null + p_two + p_ool else "single"
+
+
 def draw_pair(seed, nominals, version=DEFAULT_DRAW_VERSION):
     """The concealed pair of `seed` under draw `version`: robot, kind and planted effects (list,
     empty for a null)."""
@@ -236,19 +281,18 @@ def draw_pair(seed, nominals, version=DEFAULT_DRAW_VERSION):
         raise ValueError(f"draw version {version}: expected one of {DRAW_VERSIONS}")
     rng = np.random.default_rng(seed)
     robot = "harvestman" if rng.random() < P_SECOND_ROBOT else "scorpion"
-    u = rng.random()
-    kind = "null" if u < P_NULL else "two" if u < P_NULL + P_TWO else \
-        "out_of_library" if u < P_NULL + P_TWO + P_OOL else "single"
+    kind = _kind(rng, version)
     if robot == "harvestman" and kind in ("two", "out_of_library"):
         kind = "single"  # the second robot is tried on single effects and nulls
     if kind == "null":
         effects = []
     elif kind == "out_of_library":
-        effects = [draw_out_of_library(rng)]
+        geometry = version >= 3 and rng.random() < P_GEOMETRY_V3
+        effects = [draw_out_of_library_geometry(rng) if geometry else draw_out_of_library(rng)]
     else:
         choices = FAMILIES_V1 if version == 1 else FAMILIES
         families = list(rng.choice(choices, size=2 if kind == "two" else 1, replace=False))
-        effects = [draw_effect(str(f), rng, nominals[robot], robot, version) for f in families]
+        effects = [draw_effect(str(f), rng, nominals[robot], robot, min(version, 2)) for f in families]
     return {"seed": seed, "robot": robot, "kind": kind, "effects": effects,
             "real_seed": 100000 + seed, "draw_version": version}
 
@@ -261,9 +305,58 @@ def merge(base, edit):
     return out
 
 
+def _leg_block(xml, leg):
+    """(start, end) of leg `leg`'s coxa body element (legN_coxa ... its closing tag)."""
+    start = xml.find(f'<body name="leg{leg}_coxa"')
+    if start < 0:
+        raise ValueError(f"MJCF: expected a body named leg{leg}_coxa")
+    depth, i = 0, start
+    for m in re.finditer(r"<body\b|</body>", xml[start:]):
+        depth += 1 if m.group(0) == "<body" else -1
+        if depth == 0:
+            return start, start + m.end()
+    raise ValueError(f"MJCF: leg{leg}_coxa is not closed")
+
+
+def _edit_leg(xml, edit):
+    """Version 3's one-leg geometry and mass edits (see draw_out_of_library_geometry)."""
+    (kind, (leg, v)), = edit.items()
+    a, b = _leg_block(xml, leg)
+    block = xml[a:b]
+    if kind == "tibia_scale":
+        def scale(m):
+            return f"{m.group(1)}{float(m.group(2)) * v:.5f}\""
+        # The tibia segment's end and the foot geom/site positions (0 0 -L) become -L * v.
+        block = re.sub(r'(fromto="0 0 0 0 0 )(-[0-9.]+)"', scale, block)
+        block = re.sub(r'(<(?:geom|site) name="leg%d_foot"[^>]*pos="0 0 )(-[0-9.]+)"' % leg, scale, block)
+    elif kind == "foot_radius":
+        block, n = re.subn(r'(<geom name="leg%d_foot")' % leg, r'\1 size="%.4f"' % v, block)
+        if n != 1:
+            raise ValueError(f"MJCF: expected a geom named leg{leg}_foot")
+    elif kind == "mount_offset":
+        def move(m):
+            x, y, z = (float(t) for t in m.group(2).split())
+            return f'{m.group(1)}{x + v:.5f} {y:.5f} {z:.5f}"'
+        block = re.sub(r'(<body name="leg%d_coxa" pos=")([^"]+)"' % leg, move, block, count=1)
+    elif kind == "leg_mass":
+        # A child body of the tibia (its mass is not overridden by the config's segment masses).
+        block, n = re.subn(r'(<body name="leg%d_tibia"[^>]*>)' % leg,
+                           r'\1<body name="leg%d_extra_mass" pos="0 0 -0.05"><geom type="sphere" size="0.015" '
+                           r'mass="%.4f"/></body>' % (leg, v), block)
+        if n != 1:
+            raise ValueError(f"MJCF: expected a body named leg{leg}_tibia")
+    return xml[:a] + block + xml[b:]
+
+
 def edit_mjcf(xml, edit):
     """Applies an `mjcf` edit (floor_solref [tc, dr] and/or floor_solimp [dmin, dmax, width,
-    midpoint, power]) to MJCF text; the floor geom must be named "floor"."""
+    midpoint, power]; or version 3's one-leg edits tibia_scale, foot_radius, mount_offset,
+    leg_mass [leg, value]) to MJCF text; the floor geom must be named "floor"."""
+    leg_edits = {k: v for k, v in edit.items() if k in ("tibia_scale", "foot_radius", "mount_offset", "leg_mass")}
+    for k, v in leg_edits.items():
+        xml = _edit_leg(xml, {k: v})
+    if not any(k.startswith("floor") for k in edit):
+        return xml
     attrs = ""
     if "floor_solref" in edit:
         tc, dr = edit["floor_solref"]

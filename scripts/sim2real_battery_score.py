@@ -129,10 +129,17 @@ def score_pair(pair, report):
     else:
         s["unexplained_reported"] = verdict.get("status") in ("unexplained", "partly_explained") \
             or bool((verdict.get("unexplained") or {}).get("present"))
+        # Issue #22: unexplained or partly explained with a doubt (or located structure) that says
+        # what does not fit.
+        s["doubt_reported"] = verdict.get("status") in ("unexplained", "partly_explained") and bool(
+            verdict.get("doubts") or (verdict.get("unexplained") or {}).get("structured_in"))
+    s["doubts"] = verdict.get("doubts") or []
     inclusion = first.get("inclusion") if first else None
+    # A stated doubt (issue #22: a value pinned or impossible, mismatch left after the correction)
+    # makes an answer not confident.
     s["confident_wrong"] = bool(first is not None and not truth & tie_families(verdict, first)
                                 and inclusion is not None and inclusion >= CONFIDENT
-                                and first.get("tie_group") is None)
+                                and first.get("tie_group") is None and not verdict.get("doubts"))
     if kind in ("single", "two"):
         s["values"] = {}
         for e in pair["effects"]:
@@ -188,6 +195,7 @@ def summarize(results):
         "two_effect_both_found": _rate(r["score"]["both_found"] for r in twos),
         "confident_wrong": _rate(r["score"]["confident_wrong"] for r in scored),
         "out_of_library_unexplained": _rate(r["score"]["unexplained_reported"] for r in ool),
+        "out_of_library_doubted": _rate(r["score"].get("doubt_reported", False) for r in ool),
         "value_within_25pct": _rate(v is not None and v["error"] is not None
                                     and abs(v["error"]) <= VALUE_TOL for v in values),
         "median_gap_closed": statistics.median(gaps) if gaps else None,

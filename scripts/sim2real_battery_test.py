@@ -47,7 +47,7 @@ class DrawTest(unittest.TestCase):
     def test_same_seed_same_pair_and_shares(self):
         n = nominals()
         self.assertEqual(json.dumps(draw.draw_pair(1234, n)), json.dumps(draw.draw_pair(1234, n)))
-        pairs = [draw.draw_pair(s, n) for s in range(20000, 22000)]
+        pairs = [draw.draw_pair(s, n, version=2) for s in range(20000, 22000)]
         share = lambda k: sum(p["kind"] == k for p in pairs) / len(pairs)
         # Shares of issue #9 (the second robot turns its two-effect / out-of-library draws into
         # single effects, so those shares sit a little under nominal). Binomial slack ~ 3 sd.
@@ -132,12 +132,11 @@ class DrawVersionTest(unittest.TestCase):
                     xml = '<geom name="floor" type="plane"/>'
                     self.assertEqual(draw.edit_mjcf(xml, e["mjcf"]), old.edit_mjcf(xml, e["mjcf"]))
 
-    def test_version_2_is_the_default_and_draws_the_new_options(self):
+    def test_version_2_draws_the_new_options(self):
         n = nominals()
-        self.assertEqual(draw.draw_pair(11000, n), draw.draw_pair(11000, n, version=2))
         with self.assertRaises(ValueError):
-            draw.draw_pair(11000, n, version=3)
-        pairs = [draw.draw_pair(s, n) for s in range(11000, 11400)]
+            draw.draw_pair(11000, n, version=4)
+        pairs = [draw.draw_pair(s, n, version=2) for s in range(11000, 11400)]
         effects = [dict(e, robot=p["robot"]) for p in pairs for e in p["effects"]]
         knobs = {e["knob"] for e in effects}
         for k in ("floor.solimp.dmax", "floor.solref.timeconst", "floor.solref.dampratio",
@@ -160,6 +159,31 @@ class DrawVersionTest(unittest.TestCase):
                                   "tracker_roll_sd_rad", "tracker_pitch_sd_rad"})
                 for k, v in e["config"]["noise"].items():
                     self.assertAlmostEqual(v, n[e["robot"]]["noise"][k] * e["value"])
+
+    def test_version_3_is_the_default_and_adds_geometry_out_of_library(self):
+        n = nominals()
+        self.assertEqual(draw.draw_pair(12000, n), draw.draw_pair(12000, n, version=3))
+        pairs = [draw.draw_pair(s, n) for s in range(30000, 32000)]
+        share = lambda k: sum(p["kind"] == k for p in pairs) / len(pairs)
+        self.assertAlmostEqual(share("out_of_library"), 0.25 * 0.85, delta=0.03)
+        kinds = {p["effects"][0]["kind"] for p in pairs if p["kind"] == "out_of_library"}
+        self.assertEqual(kinds, set(draw.OUT_OF_LIBRARY) | set(draw.OUT_OF_LIBRARY_GEOMETRY))
+        with open(os.path.join(battery.ROOT, "datasets/robots/scorpion.xml")) as f:
+            xml = f.read()
+        for p in pairs:
+            e = p["effects"][0] if p["effects"] else {}
+            if e.get("kind") in draw.OUT_OF_LIBRARY_GEOMETRY:
+                self.assertEqual(p["robot"], "scorpion")
+                edited = draw.edit_mjcf(xml, e["mjcf"])
+                self.assertNotEqual(edited, xml)
+                leg = list(e["mjcf"].values())[0][0]
+                a, b = draw._leg_block(xml, leg)
+                self.assertEqual(edited[:a], xml[:a])  # only that leg changes
+        short = draw.edit_mjcf(xml, {"tibia_scale": [3, 0.5]})
+        a, b = draw._leg_block(short, 3)
+        self.assertEqual(short[a:b].count("-0.08000"), 3)  # segment end, foot geom, foot site
+        heavy = draw.edit_mjcf(xml, {"leg_mass": [6, 0.8]})
+        self.assertIn('name="leg6_extra_mass"', heavy)
 
     def test_solimp_edit_sets_the_floor_solimp(self):
         with open(os.path.join(battery.ROOT, "datasets/robots/scorpion.xml")) as f:
@@ -218,6 +242,9 @@ class ScoreTest(unittest.TestCase):
         self.assertTrue(s["confident_wrong"])
         unsure = verdict("explained", [name("mass", inclusion=None)])  # not computed
         self.assertFalse(score.score_pair(pair("single", FRICTION), unsure)["confident_wrong"])
+        doubted = {"verdict": dict(wrong["verdict"], status="partly_explained",
+                                   doubts=["mass.scale pinned at its upper limit 2"])}
+        self.assertFalse(score.score_pair(pair("single", FRICTION), doubted)["confident_wrong"])
 
     def test_value_needs_the_planted_knob(self):
         other = verdict("explained", [name("friction", "floor.friction.torsional", 0.6)])

@@ -66,7 +66,7 @@ def main():
             continue
         with open(os.path.join(out, "report.json")) as f:
             rep = json.load(f)
-        ka = rep.get("knob_analysis", {})
+        recordings = (rep.get("knobs") or {}).get("recordings") or {}
         for tie in rep["verdict"]["ties"]:
             e = tie["experiment"]
             sim_ = e.get("simulation") or {}
@@ -84,7 +84,7 @@ def main():
                          {True: "yes", False: "no", None: "not checked"}[e.get("confirmed")]
                          + ("" if e.get("checked_by_simulation") else f" ({e.get('not_checked_because')})"),
                          f"{sim_['seconds']:.1f} s" if sim_ else "-",
-                         f"{ka.get('signature_simulations', '?')}", f"{wall:.0f} s"])
+                         f"{recordings.get('signatures', '?')}", f"{wall:.0f} s"])
     head = ["pair", "tie", "command", "terrain", "proposed executions", "proposed d2", "simulated values",
             "executions simulated", "spread scale", "simulated d2", "z at proposed", "p", "needed by sim",
             "confirmed", "check wall", "signature sims", "analysis wall"]

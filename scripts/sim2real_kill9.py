@@ -6,8 +6,8 @@ a kill must be removed by the next run.
 Usage: /usr/bin/python3 scripts/sim2real_kill9.py DGMM WORKDIR [--seed N] [--kills N]
                                                    [--markdown FILE]
 
-A small run (datasets/sim2real/sim.h5 vs slip/real.h5, figures on, --bootstrap 0, 100
-permutations, no knob cache) is first made twice without interruption: its duration T sets the
+A small run (datasets/sim2real/sim.h5 vs slip/real.h5, figures on, --locate-only so that no
+re-simulation makes it minutes long, 100 permutations) is first made twice without interruption: its duration T sets the
 spread of the kill moments and its files are the "complete new" reference. The "older" result is
 the null pair's report (other files, other bytes). Each trial starts from an output folder
 holding the older result (even trials) or no folder (odd trials), kills the run with SIGKILL
@@ -43,8 +43,8 @@ DATA = os.path.join(ROOT, "datasets", "sim2real")
 
 def command(dgmm, real, out, seed):
     return [dgmm, "--quiet", "sim2real", "--sim", os.path.join(DATA, "sim.h5"), "--real",
-            os.path.join(DATA, real, "real.h5"), "-o", out, "--seed", str(seed), "--bootstrap",
-            "0", "--permutations", "100", "--cache", "-"]
+            os.path.join(DATA, real, "real.h5"), "-o", out, "--seed", str(seed), "--locate-only",
+            "--permutations", "100"]
 
 
 def digest(folder):

@@ -15,50 +15,34 @@
 namespace dgmm::sim2real {
 namespace {
 
-// The analysis' prediction of x for command c at terrain z with a known first-execution flag.
+// The analysis' prediction of x for command c at terrain z with a known first-execution flag:
+// the sim model, moved by the correction when there is one.
 class Predictor {
  public:
-  Predictor(const Sim2RealResult& r, const SampleSet& sim, bool corrected)
-      : r_(r), corrected_(corrected) {
-    DetectTerrainColumns(sim, &pitch_col_, &roll_col_);
-    tau2_ = corrected ? std::exp(2 * r.fit.log_tau) : 1.0;
+  Predictor(const LinearGaussianModel& model, const Correction* correction)
+      : model_(model), correction_(correction) {
+    tau2_ = correction ? std::exp(2 * correction->log_tau) : 1.0;
   }
 
-  // E[x | c, z, f] = u + sum_e D_e(u, g(z), f) theta_e (effects only when corrected).
+  // E[x | c, z, f] = u + shift(c, z, f).
   Eigen::VectorXd Mean(int c, const Eigen::VectorXd& z, bool first) const {
-    const Prediction p = r_.sim_model.Predict(c, z, first ? 1.0 : 0.0);
-    if (!corrected_) return p.mean;
-    const double pitch = pitch_col_ >= 0 ? z(pitch_col_) : 0.0;
-    const double roll = roll_col_ >= 0 ? z(roll_col_) : 0.0;
-    const Eigen::Vector3d g = BodyGravity(pitch, roll);
-    Eigen::VectorXd mean = p.mean;
-    for (size_t k = 0; k < r_.fit.effects.size(); ++k) {
-      const EffectSpec& e = r_.library[r_.fit.effects[k]];
-      if (!e.is_noise) mean += EffectDesign(e, r_.layout, p.mean, g, first) * r_.fit.theta[k];
-    }
-    return mean;
+    const Prediction p = model_.Predict(c, z, first ? 1.0 : 0.0);
+    if (!correction_) return p.mean;
+    return p.mean + correction_->Shift(c, z, first ? 1.0 : 0.0, static_cast<int>(p.mean.size()));
   }
 
   // tau^2 Sigma_c(z, f): the predictive covariance (with its inflation at z).
   Eigen::MatrixXd Covariance(int c, const Eigen::VectorXd& z, bool first) const {
-    const Prediction p = r_.sim_model.Predict(c, z, first ? 1.0 : 0.0);
+    const Prediction p = model_.Predict(c, z, first ? 1.0 : 0.0);
     return tau2_ * p.chol * p.chol.transpose();
   }
 
-  // Whether the prediction depends on the first-execution flag at all.
-  bool UsesSequence() const {
-    if (r_.sim_model.uses_sequence()) return true;
-    if (!corrected_) return false;
-    for (int e : r_.fit.effects) {
-      if (r_.library[e].needs_sequence) return true;
-    }
-    return false;
-  }
+  // Whether the prediction may depend on the first-execution flag (the signatures do).
+  bool UsesSequence() const { return model_.uses_sequence() || (correction_ && correction_->shift); }
 
  private:
-  const Sim2RealResult& r_;
-  bool corrected_;
-  int pitch_col_ = -1, roll_col_ = -1;
+  const LinearGaussianModel& model_;
+  const Correction* correction_;
   double tau2_ = 1.0;
 };
 
@@ -168,8 +152,9 @@ LocalFit FitPiece(const Predictor& predictor, int c, const Piece& piece, const E
   return fit;
 }
 
-MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected,
-                  const CorrectedModelOptions& options) {
+MotionModel Build(const LinearGaussianModel& model, const Correction* correction, double first_execution_share,
+                  const SampleSet& sim, const CorrectedModelOptions& options) {
+  const bool corrected = correction != nullptr;
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "corrected model options", error);
   MotionModel m;
@@ -182,9 +167,9 @@ MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected,
   m.command_dim_names = sim.command_dim_names;
   m.transform = sim.transform;
   m.seed = options.seed;
-  const Predictor predictor(r, sim, corrected);
+  const Predictor predictor(model, correction);
   const bool sequence = predictor.UsesSequence();
-  const double share = std::clamp(r.first_execution_share, 0.0, 1.0);
+  const double share = std::clamp(first_execution_share, 0.0, 1.0);
   // (flag, weight) of the execution kinds mixed in each piece.
   std::vector<std::pair<bool, double>> kinds;
   if (!sequence) {
@@ -197,11 +182,8 @@ MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected,
   const std::vector<Piece> pieces = TerrainPieces(z, options);
   nlohmann::json effects = nlohmann::json::array();
   if (corrected) {
-    for (size_t k = 0; k < r.fit.effects.size(); ++k) {
-      const EffectSpec& e = r.library[r.fit.effects[k]];
-      effects.push_back({{"effect", e.key},
-                         {"theta", std::vector<double>(r.fit.theta[k].data(),
-                                                       r.fit.theta[k].data() + r.fit.theta[k].size())}});
+    for (const auto& t : correction->terms) {
+      effects.push_back({{"effect", t.key}, {"theta", std::vector<double>(t.theta.data(), t.theta.data() + t.theta.size())}});
     }
   }
   m.metadata["sim2real_effects"] = effects.dump();
@@ -212,7 +194,7 @@ MotionModel Build(const Sim2RealResult& r, const SampleSet& sim, bool corrected,
                         "first-execution share " + std::to_string(share)
                       : std::string()) +
       "; p(x | c, z) is piecewise linear in z, weighted by the terrain density of the pieces";
-  for (int c : r.sim_model.Commands()) {
+  for (int c : model.Commands()) {
     if (c < sim.num_commands()) {
       m.command_values[c] = sim.commands.row(c).transpose();
       if (c < static_cast<int>(sim.command_labels.size())) m.command_labels[c] = sim.command_labels[c];
@@ -242,14 +224,15 @@ bool CorrectedModelOptions::IsValid(std::string* error) const {
   return true;
 }
 
-MotionModel BuildSimModel(const Sim2RealResult& result, const SampleSet& sim,
+MotionModel BuildSimModel(const LinearGaussianModel& model, double first_execution_share, const SampleSet& sim,
                           const CorrectedModelOptions& options) {
-  return Build(result, sim, false, options);
+  return Build(model, nullptr, first_execution_share, sim, options);
 }
 
-MotionModel BuildCorrectedModel(const Sim2RealResult& result, const SampleSet& sim,
+MotionModel BuildCorrectedModel(const LinearGaussianModel& model, const Correction& correction,
+                                double first_execution_share, const SampleSet& sim,
                                 const CorrectedModelOptions& options) {
-  return Build(result, sim, true, options);
+  return Build(model, &correction, first_execution_share, sim, options);
 }
 
 }  // namespace dgmm::sim2real

@@ -6,7 +6,7 @@
 // with k the terrain pieces (k-means of the sim terrain samples, m_k, S_k their mean and
 // covariance), f in {first execution, repeat} weighted by the real share of first executions
 // (a model file has no sequence input), a + B (z - m_k) the local least-squares fit of the
-// prediction E[x | c, z, f] = u_c(z, f) [+ sum_e D_e(u, g(z), f) theta_e] over the piece's
+// prediction E[x | c, z, f] = u_c(z, f) [+ sum_e D_e(c, z, f) theta_e] over the piece's
 // samples, and Sigma_ckf = tau^2 Sigma_c(z, f) averaged over the piece plus the fit's residual
 // scatter. See docs/sim2real.md, "The corrected model file".
 #include <cstdint>
@@ -14,7 +14,8 @@
 
 #include "core/motion_model.h"
 #include "core/sample_set.h"
-#include "sim2real/pipeline.h"
+#include "sim2real/correction.h"
+#include "sim2real/linear_gaussian.h"
 
 namespace dgmm::sim2real {
 
@@ -32,11 +33,13 @@ struct CorrectedModelOptions {
   bool IsValid(std::string* error) const;
 };
 
-// kind "sim2real-sim": the sim-trained linear-Gaussian model used by the analysis.
-MotionModel BuildSimModel(const Sim2RealResult& result, const SampleSet& sim,
+// kind "sim2real-sim": the sim-trained linear-Gaussian model used by the analysis; first
+// executions mixed in with the real set's share. `sim` is the sim set in raw units.
+MotionModel BuildSimModel(const LinearGaussianModel& model, double first_execution_share, const SampleSet& sim,
                           const CorrectedModelOptions& options = {});
-// kind "corrected": the sim model plus the fitted effects (and the noise scale tau).
-MotionModel BuildCorrectedModel(const Sim2RealResult& result, const SampleSet& sim,
+// kind "corrected": the sim model moved by the knob correction (correction.h).
+MotionModel BuildCorrectedModel(const LinearGaussianModel& model, const Correction& correction,
+                                double first_execution_share, const SampleSet& sim,
                                 const CorrectedModelOptions& options = {});
 
 }  // namespace dgmm::sim2real

@@ -57,7 +57,7 @@ bool EffectFitOptions::IsValid(std::string* error) const {
 }
 
 FitProblem MakeFitProblem(const Samples& real, const LinearGaussianModel& sim_model,
-                          const std::vector<EffectSpec>& library, const PoseLayout& layout) {
+                          const std::vector<EffectSpec>& library) {
   FitProblem fp;
   fp.n = real.size();
   fp.dx = real.pose_dim();
@@ -76,15 +76,13 @@ FitProblem MakeFitProblem(const Samples& real, const LinearGaussianModel& sim_mo
     fp.r0.row(i) = l.solve(real.x.row(i).transpose() - p.mean).transpose();
     fp.log_norm(i) = -0.5 * (fp.dx * std::log(2 * std::numbers::pi) + p.log_det);
     fp.chol.push_back(p.chol);
-    for (size_t k = 0; k < library.size(); ++k) {
-      if (library[k].is_noise) continue;
-      Eigen::MatrixXd d = EffectDesign(library[k], layout, p.mean, real.gravity.row(i).transpose(),
-                                       real.first_execution[i] != 0);
-      fp.d[k].middleRows(i * fp.dx, fp.dx) = d;
-      fp.g[k].middleRows(i * fp.dx, fp.dx) = l.solve(d);
-    }
   }
   return fp;
+}
+
+void SetDesign(FitProblem* fp, int k, int i, const Eigen::MatrixXd& d) {
+  fp->d[k].middleRows(i * fp->dx, fp->dx) = d;
+  fp->g[k].middleRows(i * fp->dx, fp->dx) = fp->chol[i].triangularView<Eigen::Lower>().solve(d);
 }
 
 EffectFit FitEffects(const FitProblem& fp, const std::vector<int>& effects,

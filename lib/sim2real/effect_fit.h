@@ -26,8 +26,11 @@ struct FitProblem {
   std::vector<int> command;
 };
 
+// The designs start at zero: SetDesign fills each mean effect's rows.
 FitProblem MakeFitProblem(const Samples& real, const LinearGaussianModel& sim_model,
-                          const std::vector<EffectSpec>& library, const PoseLayout& layout);
+                          const std::vector<EffectSpec>& library);
+// Row i of effect k: raw design d (dx x p_k) and its whitened form L_i^-1 d.
+void SetDesign(FitProblem* fp, int k, int i, const Eigen::MatrixXd& d);
 
 // Fitted parameters of a set of library effects (indices into FitProblem::library).
 struct EffectFit {

@@ -5,9 +5,8 @@
 #include <cmath>
 #include <map>
 #include <random>
-#include <thread>
 
-#include "sim/protocol.h"
+#include "sim2real/simulation_cache.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -68,10 +67,10 @@ PairedSeparation SeparationOfPairs(const Eigen::MatrixXd& a, const Eigen::Matrix
   return out;
 }
 
-ExperimentCheck CheckExperiment(const sim::SimConfig& config, const std::vector<sim::Knob>& knobs,
-                                const sim::KnobValue& a, const sim::KnobValue& b, const Eigen::Vector3d& command,
-                                double pitch_rad, double roll_rad, int proposed_executions,
-                                const ExperimentCheckOptions& options, double spread_scale) {
+ExperimentCheck CheckExperiment(const KnobSimulator& simulator, const KnobValue& a, const KnobValue& b,
+                                const Eigen::VectorXd& command, const Eigen::VectorXd& terrain,
+                                int proposed_executions, const ExperimentCheckOptions& options,
+                                double spread_scale) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "experiment check options", error);
   const auto start = std::chrono::steady_clock::now();
@@ -79,40 +78,26 @@ ExperimentCheck CheckExperiment(const sim::SimConfig& config, const std::vector<
   out.executions_proposed = proposed_executions;
   out.seed = options.seed;
   out.spread_scale = spread_scale;
-  out.knobs = {knobs.at(a.knob).name, knobs.at(b.knob).name};
+  out.knobs = {simulator.knobs().at(a.knob).name, simulator.knobs().at(b.knob).name};
   out.values = {a.value, b.value};
   const int want = std::clamp(proposed_executions, options.min_executions, options.max_executions);
   out.placements = (want + options.executions_per_placement - 1) / options.executions_per_placement;
-  out.heading_rad = sim::HeadingForTerrain(config, pitch_rad, roll_rad);
-  sim::CellOptions cell;
+  Cell cell;
   cell.command = command;
-  cell.heading_rad = out.heading_rad;
+  cell.terrain = terrain;
   cell.placements = out.placements;
   cell.executions_per_placement = options.executions_per_placement;
   cell.seed = options.seed;
-  // The two runs (in parallel when allowed); same seed: common random numbers.
-  SampleSet sets[2];
-  std::string failure[2];
-  auto run = [&](int r) {
-    try {
-      sim::ModelEdit edit;
-      const sim::SimConfig c = sim::ApplyKnobs(config, knobs, {r == 0 ? a : b}, &edit);
-      sets[r] = sim::SimulateCell(c, cell, nullptr, edit);
-    } catch (const std::exception& e) {
-      failure[r] = e.what();
-    }
-  };
-  if (options.threads >= 2) {
-    std::thread other(run, 1);
-    run(0);
-    other.join();
-  } else {
-    run(0);
-    run(1);
+  // The two runs (in parallel when allowed); same cell and seed: common random numbers.
+  CellRecording runs[2];
+  try {
+    ParallelFor(2, options.threads, [&](int r) { runs[r] = simulator.RecordCell(cell, {r == 0 ? a : b}); });
+  } catch (const std::exception& e) {
+    throw MakeInputError("simulator", "", std::string("experiment check simulation failed: ") + e.what());
   }
-  for (const auto& f : failure) {
-    if (!f.empty()) throw MakeInputError("--sim-config", "", "experiment check simulation failed: " + f);
-  }
+  out.heading_deg = runs[0].heading_deg;
+  out.placement = runs[0].placement;
+  const SampleSet sets[2] = {runs[0].set, runs[1].set};
   // Pair executions by (placement, execution index); a placement re-placed after a fall in one
   // run only is no longer paired and is left out.
   std::map<std::pair<int, int>, int> row_b;
@@ -150,7 +135,8 @@ void RecordCheck(const ExperimentCheck& check, double z_required, VerdictExperim
   ex->executions_simulated = check.executions_simulated;
   ex->placements = check.placements;
   ex->seed = check.seed;
-  ex->heading_deg = check.heading_rad * 180.0 / M_PI;
+  ex->heading_deg = check.heading_deg;
+  ex->placement = check.placement;
   ex->spread_scale = check.spread_scale;
   ex->simulated_separation = check.separation.d2;
   ex->z = check.separation.z;

@@ -4,12 +4,12 @@
 // in the proposed command x terrain cell, with the same seed (common random numbers: the same
 // placements and sensor noise), and the two outcome sets are compared.
 #include <Eigen/Dense>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "sim/knobs.h"
-#include "sim/sim_config.h"
+#include "sim2real/knob_simulator.h"
 #include "sim2real/verdict.h"
 
 namespace dgmm::sim2real {
@@ -56,7 +56,8 @@ struct ExperimentCheck {
   std::string why_not;          // when not checked
   int executions_proposed = 0, executions_simulated = 0, placements = 0;
   std::uint64_t seed = 0;
-  double heading_rad = 0;       // slope-frame heading that gives the cell's terrain
+  double heading_deg = NAN;     // where the simulator stood the robot for the cell's terrain
+  std::string placement;        // the same in words
   double spread_scale = 1;      // the simulated spread was scaled by this (SeparationOfPairs)
   std::vector<std::string> knobs;
   std::vector<double> values;   // the two simulated values (one knob each)
@@ -65,13 +66,13 @@ struct ExperimentCheck {
   double seconds = 0;
 };
 
-// Simulates the cell (command (long, lat, turn) at the heading whose standing pitch and roll are
-// closest to `pitch_rad`, `roll_rad`) at knob value `a` and at `b`, max(min, min(proposed, max))
-// executions each, and measures their separation. Throws InputError when a simulation fails.
-ExperimentCheck CheckExperiment(const sim::SimConfig& config, const std::vector<sim::Knob>& knobs,
-                                const sim::KnobValue& a, const sim::KnobValue& b, const Eigen::Vector3d& command,
-                                double pitch_rad, double roll_rad, int proposed_executions,
-                                const ExperimentCheckOptions& options, double spread_scale = 1.0);
+// Records the cell (command, terrain as the sim set's columns) at knob value `a` and at `b`,
+// max(min, min(proposed, max)) executions each, paired by the simulator's common random numbers,
+// and measures their separation. Throws InputError when a simulation fails.
+ExperimentCheck CheckExperiment(const KnobSimulator& simulator, const KnobValue& a, const KnobValue& b,
+                                const Eigen::VectorXd& command, const Eigen::VectorXd& terrain,
+                                int proposed_executions, const ExperimentCheckOptions& options,
+                                double spread_scale = 1.0);
 
 // Writes the check into the verdict's experiment (checked_by_simulation, confirmed, simulation).
 void RecordCheck(const ExperimentCheck& check, double z_required, VerdictExperiment* experiment);

@@ -53,7 +53,6 @@ EffectSpec ExternalSpec(const std::string& key, const std::string& title, int pa
   s.id = EffectId::kExternal;
   s.key = key;
   s.title = title;
-  s.physics = title;
   for (int p = 0; p < params; ++p) s.parameters.push_back({"t" + std::to_string(p), unit});
   return s;
 }

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "sim2real/effects.h"
+#include "sim2real/effect_fit.h"
 #include "sim2real/linear_gaussian.h"
 #include "sim2real/samples.h"
 #include "sim2real/signatures.h"

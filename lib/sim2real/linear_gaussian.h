@@ -78,6 +78,17 @@ class LinearGaussianModel {
     Eigen::MatrixXd z_cov;
   };
   Eigen::VectorXd Features(const Eigen::Ref<const Eigen::VectorXd>& z, double first) const;
+  // The steps of FitWithPrior (linear_gaussian.cc).
+  static void PooledSlopes(const Samples& s, const Eigen::MatrixXd& covariates,
+                           const std::map<int, std::vector<int>>& by_command, Eigen::MatrixXd* slopes,
+                           Eigen::VectorXd* z_scatter);
+  PerCommand FitCommand(const Samples& s, const std::vector<int>& idx, const Eigen::MatrixXd& covariates,
+                        const PerCommand* from_prior, double prior_count, const Eigen::MatrixXd& pooled_slopes,
+                        const Eigen::VectorXd& z_scatter, double n_rows, const LinearGaussianOptions& options,
+                        Eigen::MatrixXd* scatter) const;
+  void SetCovariances(const Eigen::MatrixXd& pooled_cov, const std::map<int, Eigen::MatrixXd>& scatter,
+                      const std::map<int, std::vector<int>>& by_command, const LinearGaussianModel& prior,
+                      double prior_count, const LinearGaussianOptions& options, int p);
   Eigen::VectorXd Phi(const Eigen::Ref<const Eigen::VectorXd>& z, double first) const;
   int pose_dim_ = 0, terrain_dim_ = 0;
   bool use_sequence_ = false;

@@ -1,6 +1,7 @@
 #include "sim2real/locate.h"
 
 #include <algorithm>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -97,113 +98,119 @@ std::string DescribeTerrain(const Eigen::VectorXd& centre, int pitch_col, int ro
   return buf;
 }
 
-std::vector<Region> Locate(const LocateInput& in, const LocateOptions& options, std::mt19937_64& rng) {
-  const Samples& real = *in.real;
-  const Samples& sim = *in.sim;
-  std::vector<Region> all;
-  // Adds one region of `family` with the listed real and sim rows.
-  auto add = [&](const std::string& family, const std::string& label, int c, int t, int s,
-                 const std::vector<int>& real_rows, const std::vector<int>& sim_rows,
-                 const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+namespace {
+
+// Builds the regions of Locate in order (the permutation tests draw from one generator).
+class RegionBuilder {
+ public:
+  RegionBuilder(const LocateInput& in, const LocateOptions& options, std::mt19937_64& rng)
+      : in_(in), options_(options), rng_(rng) {}
+
+  // One region of `family` with the real and sim rows of (command c, terrain t, sequence q), -1: all.
+  void Add(const std::string& family, const std::string& label, int c, int t, int q, const Eigen::MatrixXd& a,
+           const Eigen::MatrixXd& b, const std::vector<int>* real_rows = nullptr) {
+    const std::vector<int> rr = real_rows ? *real_rows : Select(*in_.real, in_.real_terrain, c, t, q);
+    const std::vector<int> sr = Select(*in_.sim, in_.sim_terrain, c, t, q);
     Region r;
-    r.family = family;
-    r.label = label;
-    r.command = c;
-    r.terrain = t;
-    r.sequence = s;
-    r.n_real = static_cast<int>(real_rows.size());
-    r.n_sim = static_cast<int>(sim_rows.size());
+    r.family = family, r.label = label, r.command = c, r.terrain = t, r.sequence = q;
+    r.n_real = static_cast<int>(rr.size());
+    r.n_sim = static_cast<int>(sr.size());
     double sum = 0;
-    for (int i : real_rows) sum += in.ceiling_heldout(i) - in.model_heldout(i);
-    r.deficit = real_rows.empty() ? 0.0 : sum / real_rows.size();
-    MmdResult m = MmdTest(Rows(a, real_rows), Rows(b, sim_rows), options.mmd, rng);
+    for (int i : rr) sum += in_.ceiling_heldout(i) - in_.model_heldout(i);
+    r.deficit = rr.empty() ? 0.0 : sum / rr.size();
+    const MmdResult m = MmdTest(Rows(a, rr), Rows(b, sr), options_.mmd, rng_);
     r.mmd2 = m.mmd2;
     r.p_value = m.p_value;
-    all.push_back(r);
-  };
-  auto select = [](const Samples& s, const std::vector<int>& terrain, int c, int t, int q) {
+    all_.push_back(r);
+  }
+  static std::vector<int> Select(const Samples& s, const std::vector<int>& terrain, int c, int t, int q) {
     std::vector<int> rows;
     for (int i = 0; i < s.size(); ++i) {
-      if ((c < 0 || s.command[i] == c) && (t < 0 || terrain[i] == t) &&
-          (q < 0 || s.first_execution[i] == q)) {
+      if ((c < 0 || s.command[i] == c) && (t < 0 || terrain[i] == t) && (q < 0 || s.first_execution[i] == q)) {
         rows.push_back(i);
       }
     }
     return rows;
-  };
-  std::vector<int> commands = real.command;
-  std::sort(commands.begin(), commands.end());
-  commands.erase(std::unique(commands.begin(), commands.end()), commands.end());
-  const int terrains = static_cast<int>(in.terrain_labels.size());
-  auto command_label = [&](int c) {
-    return c < static_cast<int>(in.command_labels.size()) ? in.command_labels[c] : std::to_string(c);
-  };
-  const auto& ra = in.real_residuals;
-  const auto& sb = in.sim_residuals;
-  if (terrains > 1) {
-    for (int t = 0; t < terrains; ++t) {
-      add("terrain", in.terrain_labels[t], -1, t, -1, select(real, in.real_terrain, -1, t, -1),
-          select(sim, in.sim_terrain, -1, t, -1), ra, sb);
-    }
   }
-  if (real.has_sequence && sim.has_sequence) {
-    const char* names[2] = {"repeated command (steps 1+)", "first execution after a command change"};
-    for (int q = 0; q < 2; ++q) {
-      add("sequence", names[q], -1, -1, q, select(real, in.real_terrain, -1, -1, q),
-          select(sim, in.sim_terrain, -1, -1, q), ra, sb);
-    }
+  std::vector<Region>& regions() { return all_; }
+
+ private:
+  const LocateInput& in_;
+  const LocateOptions& options_;
+  std::mt19937_64& rng_;
+  std::vector<Region> all_;
+};
+
+// The naive comparison: x alone, per command, pooled over terrain and sequence, each dimension
+// scaled by the sim's within-command standard deviation.
+void AddPooledX(const LocateInput& in, const std::vector<int>& commands,
+                const std::function<std::string(int)>& command_label, RegionBuilder* b) {
+  const Samples& sim = *in.sim;
+  Eigen::VectorXd scale = Eigen::VectorXd::Zero(sim.pose_dim());
+  std::map<int, std::vector<int>> by_c;
+  for (int i = 0; i < sim.size(); ++i) by_c[sim.command[i]].push_back(i);
+  double count = 0;
+  for (const auto& [c, rows] : by_c) {
+    Eigen::MatrixXd xs = Rows(sim.x, rows);
+    scale += (xs.rowwise() - xs.colwise().mean()).colwise().squaredNorm().transpose();
+    count += rows.size() - 1.0;
   }
-  for (int c : commands) {
-    add("command", "command " + command_label(c), c, -1, -1, select(real, in.real_terrain, c, -1, -1),
-        select(sim, in.sim_terrain, c, -1, -1), ra, sb);
-  }
-  if (in.with_cells && terrains > 1) {
-    for (int c : commands) {
-      for (int t = 0; t < terrains; ++t) {
-        auto rr = select(real, in.real_terrain, c, t, -1);
-        if (static_cast<int>(rr.size()) < options.min_real_per_cell) continue;
-        add("cell", "command " + command_label(c) + ", " + in.terrain_labels[t], c, t, -1, rr,
-            select(sim, in.sim_terrain, c, t, -1), ra, sb);
-      }
-    }
-  }
-  if (in.with_pooled_x) {
-    // Naive comparison: x alone, per command, pooled over terrain and sequence, each dimension
-    // scaled by the sim's within-command standard deviation.
-    Eigen::VectorXd scale = Eigen::VectorXd::Zero(sim.pose_dim());
-    std::map<int, std::vector<int>> by_c;
-    for (int i = 0; i < sim.size(); ++i) by_c[sim.command[i]].push_back(i);
-    double count = 0;
-    for (const auto& [c, rows] : by_c) {
-      Eigen::MatrixXd xs = Rows(sim.x, rows);
-      scale += (xs.rowwise() - xs.colwise().mean()).colwise().squaredNorm().transpose();
-      count += rows.size() - 1.0;
-    }
-    scale = (scale / std::max(1.0, count)).cwiseSqrt().cwiseMax(1e-12);
-    Eigen::MatrixXd xr = real.x * scale.cwiseInverse().asDiagonal();
-    Eigen::MatrixXd xsim = sim.x * scale.cwiseInverse().asDiagonal();
-    for (int c : commands) {
-      add("pooled_x", "command " + command_label(c) + " (x only, pooled)", c, -1, -1,
-          select(real, in.real_terrain, c, -1, -1), select(sim, in.sim_terrain, c, -1, -1), xr, xsim);
-    }
-  }
-  // Benjamini-Hochberg: terrain, sequence and command regions form one family (so a null pair
-  // has at most alpha chance of any flagged region); cells and the naive test their own.
+  scale = (scale / std::max(1.0, count)).cwiseSqrt().cwiseMax(1e-12);
+  const Eigen::MatrixXd xr = in.real->x * scale.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd xsim = sim.x * scale.cwiseInverse().asDiagonal();
+  for (int c : commands) b->Add("pooled_x", "command " + command_label(c) + " (x only, pooled)", c, -1, -1, xr, xsim);
+}
+
+// Benjamini-Hochberg: terrain, sequence and command regions form one family (so a null pair has
+// at most alpha chance of any flagged region); cells and the naive test their own.
+void ControlFalseDiscoveries(double alpha, std::vector<Region>* all) {
   std::map<std::string, std::vector<int>> families;
-  for (size_t i = 0; i < all.size(); ++i) {
-    const std::string& f = all[i].family;
+  for (size_t i = 0; i < all->size(); ++i) {
+    const std::string& f = (*all)[i].family;
     const bool coarse = f == "terrain" || f == "sequence" || f == "command";
     families[coarse ? "regions" : f].push_back(static_cast<int>(i));
   }
   for (const auto& [f, idx] : families) {
     std::vector<double> p;
-    for (int i : idx) p.push_back(all[i].p_value);
-    std::vector<double> q = BenjaminiHochberg(p);
+    for (int i : idx) p.push_back((*all)[i].p_value);
+    const std::vector<double> q = BenjaminiHochberg(p);
     for (size_t k = 0; k < idx.size(); ++k) {
-      all[idx[k]].q_value = q[k];
-      all[idx[k]].significant = q[k] < options.alpha;
+      (*all)[idx[k]].q_value = q[k];
+      (*all)[idx[k]].significant = q[k] < alpha;
     }
   }
+}
+
+}  // namespace
+
+std::vector<Region> Locate(const LocateInput& in, const LocateOptions& options, std::mt19937_64& rng) {
+  const Samples& real = *in.real;
+  RegionBuilder b(in, options, rng);
+  std::vector<int> commands = real.command;
+  std::sort(commands.begin(), commands.end());
+  commands.erase(std::unique(commands.begin(), commands.end()), commands.end());
+  const int terrains = static_cast<int>(in.terrain_labels.size());
+  const std::function<std::string(int)> command_label = [&](int c) {
+    return c < static_cast<int>(in.command_labels.size()) ? in.command_labels[c] : std::to_string(c);
+  };
+  const auto& ra = in.real_residuals;
+  const auto& sb = in.sim_residuals;
+  for (int t = 0; terrains > 1 && t < terrains; ++t) b.Add("terrain", in.terrain_labels[t], -1, t, -1, ra, sb);
+  if (real.has_sequence && in.sim->has_sequence) {
+    const char* names[2] = {"repeated command (steps 1+)", "first execution after a command change"};
+    for (int q = 0; q < 2; ++q) b.Add("sequence", names[q], -1, -1, q, ra, sb);
+  }
+  for (int c : commands) b.Add("command", "command " + command_label(c), c, -1, -1, ra, sb);
+  for (int c : commands) {
+    for (int t = 0; in.with_cells && terrains > 1 && t < terrains; ++t) {
+      const auto rr = RegionBuilder::Select(real, in.real_terrain, c, t, -1);
+      if (static_cast<int>(rr.size()) < options.min_real_per_cell) continue;
+      b.Add("cell", "command " + command_label(c) + ", " + in.terrain_labels[t], c, t, -1, ra, sb, &rr);
+    }
+  }
+  if (in.with_pooled_x) AddPooledX(in, commands, command_label, &b);
+  std::vector<Region>& all = b.regions();
+  ControlFalseDiscoveries(options.alpha, &all);
   std::stable_sort(all.begin(), all.end(), [](const Region& a, const Region& b) {
     if (a.significant != b.significant) return a.significant;
     return a.deficit > b.deficit;

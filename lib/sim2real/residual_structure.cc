@@ -54,6 +54,127 @@ double ExcessKurtosis(const Eigen::MatrixXd& r) {
   return total / r.cols();
 }
 
+namespace {
+
+// The residuals per episode (the exchangeable unit): sums, counts and labels (the first sample's
+// command, the majority terrain).
+struct EpisodeUnits {
+  std::vector<int> unit;        // per sample
+  Eigen::MatrixXd sum, scaled;  // units x dx; scaled = sum / sqrt(count): unit variance under H0
+  std::vector<int> count, command, terrain;
+};
+
+EpisodeUnits Units(const Eigen::MatrixXd& r, const std::vector<int>& command, const std::vector<int>& terrain,
+                   const std::vector<int>& episode) {
+  const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
+  std::map<int, int> unit_of;
+  for (int i = 0; i < n; ++i) unit_of.emplace(episode[i], static_cast<int>(unit_of.size()));
+  const int units = static_cast<int>(unit_of.size());
+  EpisodeUnits e;
+  e.sum = Eigen::MatrixXd::Zero(units, dx);
+  e.count.assign(units, 0), e.command.assign(units, -1), e.terrain.assign(units, -1);
+  std::vector<std::map<int, int>> terrain_votes(units);
+  e.unit.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const int u = e.unit[i] = unit_of[episode[i]];
+    e.sum.row(u) += r.row(i);
+    ++e.count[u];
+    if (e.command[u] < 0) e.command[u] = command[i];
+    if (terrain[i] >= 0) ++terrain_votes[u][terrain[i]];
+  }
+  for (int u = 0; u < units; ++u) {
+    int best = 0;
+    for (const auto& [t, v] : terrain_votes[u]) {
+      if (v > best) best = v, e.terrain[u] = t;
+    }
+  }
+  e.scaled.resize(units, dx);
+  for (int u = 0; u < units; ++u) e.scaled.row(u) = e.sum.row(u) / std::sqrt(std::max(1, e.count[u]));
+  return e;
+}
+
+// Between-group test of the episode means over `labels` (labels permuted over episodes).
+void GroupTest(const EpisodeUnits& e, const std::string& where, const std::vector<int>& labels, int permutations,
+               std::mt19937_64& rng, ResidualStructure* out) {
+  std::set<int> distinct(labels.begin(), labels.end());
+  distinct.erase(-1);
+  if (distinct.size() < 2) return;
+  ResidualTest t;
+  t.where = where;
+  t.statistic = BetweenSS(e.scaled, labels);
+  std::vector<int> perm = labels;
+  std::vector<double> null;
+  for (int p = 0; p < permutations; ++p) {
+    std::shuffle(perm.begin(), perm.end(), rng);
+    null.push_back(BetweenSS(e.scaled, perm));
+  }
+  t.p_value = PermutationP(t.statistic, null);
+  out->tests.push_back(t);
+}
+
+// Sum of squares of the step-index means of `centred` for step labels s; the means in *means.
+double StepSS(const Eigen::MatrixXd& centred, const std::vector<int>& s, int max_step, Eigen::MatrixXd* means) {
+  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(max_step + 1, centred.cols());
+  Eigen::VectorXd c = Eigen::VectorXd::Zero(max_step + 1);
+  for (int i = 0; i < centred.rows(); ++i) {
+    if (s[i] < 0) continue;
+    m.row(s[i]) += centred.row(i);
+    c(s[i]) += 1;
+  }
+  double ss = 0;
+  for (int k = 0; k <= max_step; ++k) {
+    if (c(k) > 0) {
+      ss += m.row(k).squaredNorm() / c(k);
+      m.row(k) /= c(k);
+    }
+  }
+  if (means) *means = m;
+  return ss;
+}
+
+// Step: the residual minus its episode mean, step labels permuted within each episode; then the
+// periodicity of the step-mean profile (its main direction's lag-1 autocorrelation).
+void StepTest(const Eigen::MatrixXd& r, const EpisodeUnits& e, const std::vector<int>& step, int permutations,
+              std::mt19937_64& rng, ResidualStructure* out) {
+  const int n = static_cast<int>(r.rows());
+  Eigen::MatrixXd centred(n, r.cols());
+  for (int i = 0; i < n; ++i) centred.row(i) = r.row(i) - e.sum.row(e.unit[i]) / e.count[e.unit[i]];
+  const int max_step = *std::max_element(step.begin(), step.end());
+  Eigen::MatrixXd means;
+  ResidualTest t;
+  t.where = "step";
+  t.statistic = StepSS(centred, step, max_step, &means);
+  std::map<int, std::vector<int>> rows_of;
+  for (int i = 0; i < n; ++i) rows_of[e.unit[i]].push_back(i);
+  std::vector<double> null;
+  std::vector<int> perm = step;
+  for (int p = 0; p < permutations; ++p) {
+    for (const auto& [u, rows] : rows_of) {
+      std::vector<int> s;
+      for (int i : rows) s.push_back(step[i]);
+      std::shuffle(s.begin(), s.end(), rng);
+      for (size_t k = 0; k < rows.size(); ++k) perm[rows[k]] = s[k];
+    }
+    null.push_back(StepSS(centred, perm, max_step, nullptr));
+  }
+  t.p_value = PermutationP(t.statistic, null);
+  out->tests.push_back(t);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(means, Eigen::ComputeThinV);
+  const Eigen::VectorXd profile = means * svd.matrixV().col(0);
+  out->step_profile = profile;
+  const Eigen::VectorXd c = profile.array() - profile.mean();
+  double num = 0;
+  for (int k = 0; k + 1 < c.size(); ++k) num += c(k) * c(k + 1);
+  const double lag1 = c.squaredNorm() > 0 ? num / c.squaredNorm() : 0;
+  ResidualTest per;
+  per.where = "periodic";
+  per.statistic = lag1;
+  per.p_value = t.p_value;  // the same evidence; named periodic when the profile alternates
+  if (lag1 < -0.3) out->tests.push_back(per);
+}
+
+}  // namespace
+
 ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vector<int>& command,
                                         const std::vector<int>& terrain, const std::vector<int>& episode,
                                         const std::vector<int>& step, double sim_kurtosis,
@@ -61,106 +182,11 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vec
   ResidualStructure out;
   const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
   std::mt19937_64 rng(seed);
-  // Episode means and per-episode labels (the first sample's command; the majority terrain).
-  std::map<int, int> unit_of;
-  for (int i = 0; i < n; ++i) unit_of.emplace(episode[i], static_cast<int>(unit_of.size()));
-  const int units = static_cast<int>(unit_of.size());
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(units, dx);
-  std::vector<int> count(units, 0), unit_cmd(units, -1);
-  std::vector<std::map<int, int>> terrain_votes(units);
-  std::vector<int> unit(n);
-  for (int i = 0; i < n; ++i) {
-    unit[i] = unit_of[episode[i]];
-    sum.row(unit[i]) += r.row(i);
-    ++count[unit[i]];
-    if (unit_cmd[unit[i]] < 0) unit_cmd[unit[i]] = command[i];
-    if (terrain[i] >= 0) ++terrain_votes[unit[i]][terrain[i]];
-  }
-  std::vector<int> unit_terrain(units, -1);
-  for (int u = 0; u < units; ++u) {
-    int best = 0;
-    for (const auto& [t, v] : terrain_votes[u]) {
-      if (v > best) best = v, unit_terrain[u] = t;
-    }
-  }
-  // Episode sums scaled so that each unit mean has unit variance per dim under H0: sum/sqrt(count).
-  Eigen::MatrixXd scaled(units, dx);
-  for (int u = 0; u < units; ++u) scaled.row(u) = sum.row(u) / std::sqrt(std::max(1, count[u]));
-  auto group_test = [&](const std::string& where, const std::vector<int>& labels) {
-    std::set<int> distinct(labels.begin(), labels.end());
-    distinct.erase(-1);
-    if (distinct.size() < 2) return;
-    ResidualTest t;
-    t.where = where;
-    t.statistic = BetweenSS(scaled, labels);
-    std::vector<int> perm = labels;
-    std::vector<double> null;
-    for (int p = 0; p < options.permutations; ++p) {
-      std::shuffle(perm.begin(), perm.end(), rng);
-      null.push_back(BetweenSS(scaled, perm));
-    }
-    t.p_value = PermutationP(t.statistic, null);
-    out.tests.push_back(t);
-  };
-  group_test("command", unit_cmd);
-  group_test("terrain", unit_terrain);
-  // Step: residual minus its episode mean; permute step labels within each episode.
+  const EpisodeUnits e = Units(r, command, terrain, episode);
+  GroupTest(e, "command", e.command, options.permutations, rng, &out);
+  GroupTest(e, "terrain", e.terrain, options.permutations, rng, &out);
   const bool has_steps = std::any_of(step.begin(), step.end(), [](int s) { return s > 0; });
-  if (has_steps && units < n) {
-    Eigen::MatrixXd centred(n, dx);
-    for (int i = 0; i < n; ++i) centred.row(i) = r.row(i) - sum.row(unit[i]) / count[unit[i]];
-    const int max_step = *std::max_element(step.begin(), step.end());
-    auto step_ss = [&](const std::vector<int>& s, Eigen::MatrixXd* means) {
-      Eigen::MatrixXd m = Eigen::MatrixXd::Zero(max_step + 1, dx);
-      Eigen::VectorXd c = Eigen::VectorXd::Zero(max_step + 1);
-      for (int i = 0; i < n; ++i) {
-        if (s[i] < 0) continue;
-        m.row(s[i]) += centred.row(i);
-        c(s[i]) += 1;
-      }
-      double ss = 0;
-      for (int k = 0; k <= max_step; ++k) {
-        if (c(k) > 0) {
-          ss += m.row(k).squaredNorm() / c(k);
-          m.row(k) /= c(k);
-        }
-      }
-      if (means) *means = m;
-      return ss;
-    };
-    Eigen::MatrixXd means;
-    ResidualTest t;
-    t.where = "step";
-    t.statistic = step_ss(step, &means);
-    std::map<int, std::vector<int>> rows_of;
-    for (int i = 0; i < n; ++i) rows_of[unit[i]].push_back(i);
-    std::vector<double> null;
-    std::vector<int> perm = step;
-    for (int p = 0; p < options.permutations; ++p) {
-      for (const auto& [u, rows] : rows_of) {
-        std::vector<int> s;
-        for (int i : rows) s.push_back(step[i]);
-        std::shuffle(s.begin(), s.end(), rng);
-        for (size_t k = 0; k < rows.size(); ++k) perm[rows[k]] = s[k];
-      }
-      null.push_back(step_ss(perm, nullptr));
-    }
-    t.p_value = PermutationP(t.statistic, null);
-    out.tests.push_back(t);
-    // Periodicity of the step-mean profile: project on its main direction, lag-1 autocorrelation.
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(means, Eigen::ComputeThinV);
-    Eigen::VectorXd profile = means * svd.matrixV().col(0);
-    out.step_profile = profile;
-    const Eigen::VectorXd c = profile.array() - profile.mean();
-    double num = 0;
-    for (int k = 0; k + 1 < c.size(); ++k) num += c(k) * c(k + 1);
-    const double lag1 = c.squaredNorm() > 0 ? num / c.squaredNorm() : 0;
-    ResidualTest per;
-    per.where = "periodic";
-    per.statistic = lag1;
-    per.p_value = t.p_value;  // the same evidence; named periodic when the profile alternates
-    if (lag1 < -0.3) out.tests.push_back(per);
-  }
+  if (has_steps && static_cast<int>(e.count.size()) < n) StepTest(r, e, step, options.permutations, rng, &out);
   if (std::isfinite(sim_kurtosis)) {
     ResidualTest t;
     t.where = "tails";

@@ -46,10 +46,6 @@ PoseLayout DetectPoseLayout(const SampleSet& set) {
   return layout;
 }
 
-Eigen::Vector3d BodyGravity(double pitch, double roll) {
-  return {std::sin(pitch), -std::sin(roll) * std::cos(pitch), -std::cos(roll) * std::cos(pitch)};
-}
-
 void DetectTerrainColumns(const SampleSet& set, int* pitch, int* roll) {
   *pitch = -1;
   *roll = -1;
@@ -70,22 +66,16 @@ Samples MakeSamples(const SampleSet& set, const std::vector<int>& command_map) {
     int c = set.command(i);
     if (c >= 0 && c < static_cast<int>(command_map.size()) && command_map[c] >= 0) rows.push_back(i);
   }
-  int pitch_col, roll_col;
-  DetectTerrainColumns(set, &pitch_col, &roll_col);
   Samples s;
   const int n = static_cast<int>(rows.size());
   s.x.resize(n, set.pose_dim());
   s.z.resize(n, set.terrain_dim());
-  s.gravity.resize(n, 3);
   s.has_sequence = set.has_sequence();
   for (int k = 0; k < n; ++k) {
     const int i = rows[k];
     s.command.push_back(command_map[set.command(i)]);
     s.x.row(k) = set.x.row(i);
     if (set.terrain_dim() > 0) s.z.row(k) = set.z.row(i);
-    const double p = pitch_col >= 0 ? set.z(i, pitch_col) : 0.0;
-    const double r = roll_col >= 0 ? set.z(i, roll_col) : 0.0;
-    s.gravity.row(k) = BodyGravity(p, r).transpose();
     if (s.has_sequence) {
       s.episode.push_back(set.episode(i));
       s.first_execution.push_back(set.step(i) == 0 ? 1 : 0);
@@ -142,14 +132,12 @@ Samples SubsetSamples(const Samples& s, const std::vector<int>& rows) {
   const int n = static_cast<int>(rows.size());
   out.x.resize(n, s.pose_dim());
   out.z.resize(n, s.terrain_dim());
-  out.gravity.resize(n, 3);
   out.has_sequence = s.has_sequence;
   for (int k = 0; k < n; ++k) {
     const int i = rows[k];
     out.command.push_back(s.command[i]);
     out.x.row(k) = s.x.row(i);
     if (s.terrain_dim() > 0) out.z.row(k) = s.z.row(i);
-    out.gravity.row(k) = s.gravity.row(i);
     out.episode.push_back(s.episode[i]);
     out.first_execution.push_back(s.first_execution[i]);
   }

@@ -1,6 +1,6 @@
 #pragma once
-// The per-sample view the sim-vs-real analysis works on: command, pose change x, terrain z, the
-// gravity direction in the body frame derived from z, and the sequence context.
+// The per-sample view the sim-vs-real analysis works on: command, pose change x, terrain z and the
+// sequence context.
 #include <Eigen/Dense>
 #include <string>
 #include <vector>
@@ -18,14 +18,11 @@ struct PoseLayout {
 };
 PoseLayout DetectPoseLayout(const SampleSet& set);
 
-// Samples of one set, flattened. Rows of x/z/gravity are samples.
+// Samples of one set, flattened. Rows of x/z are samples.
 struct Samples {
   std::vector<int> command;        // index into the shared command table (see AlignCommands)
   Eigen::MatrixXd x;               // n x dx
   Eigen::MatrixXd z;               // n x dz (dz may be 0)
-  // Unit gravity in the body frame from z = <pitch, roll> (ZYX Euler, x forward, y left, z up):
-  // g_b = (sin p, -sin r cos p, -cos r cos p). Zero horizontal part when the set has no terrain.
-  Eigen::MatrixXd gravity;         // n x 3
   std::vector<int> episode;        // placement id (one per sample; 0..n-1 without sequence data)
   // 1 for the first execution after a change of command (step 0 of a placement), else 0.
   std::vector<int> first_execution;
@@ -35,9 +32,6 @@ struct Samples {
   int terrain_dim() const { return static_cast<int>(z.cols()); }
 };
 
-// Unit gravity in the body frame at pitch p and roll r (ZYX Euler, x forward, y left, z up):
-// g_b = (sin p, -sin r cos p, -cos r cos p).
-Eigen::Vector3d BodyGravity(double pitch, double roll);
 
 // Index of the pitch and roll columns of z (by name, else columns 0 and 1), -1 when absent.
 void DetectTerrainColumns(const SampleSet& set, int* pitch, int* roll);

@@ -59,11 +59,16 @@ bool SelectionOptions::IsValid(std::string* error) const {
 
 std::vector<int> MakeFolds(const FitProblem& fp, const std::vector<int>& rows, int folds,
                            std::mt19937_64& rng) {
+  return MakeFolds(fp.episode, fp.command, rows, folds, rng);
+}
+
+std::vector<int> MakeFolds(const std::vector<int>& episode, const std::vector<int>& command,
+                           const std::vector<int>& rows, int folds, std::mt19937_64& rng) {
   // Episodes (by original id) per command, in order of first appearance, then shuffled.
   std::map<int, std::vector<int>> episodes_of_command;
   std::set<int> seen;
   for (int i : rows) {
-    if (seen.insert(fp.episode[i]).second) episodes_of_command[fp.command[i]].push_back(fp.episode[i]);
+    if (seen.insert(episode[i]).second) episodes_of_command[command[i]].push_back(episode[i]);
   }
   std::map<int, int> fold_of_episode;
   int offset = 0;
@@ -73,7 +78,7 @@ std::vector<int> MakeFolds(const FitProblem& fp, const std::vector<int>& rows, i
     offset += static_cast<int>(eps.size());
   }
   std::vector<int> fold(rows.size());
-  for (size_t k = 0; k < rows.size(); ++k) fold[k] = fold_of_episode[fp.episode[rows[k]]];
+  for (size_t k = 0; k < rows.size(); ++k) fold[k] = fold_of_episode[episode[rows[k]]];
   return fold;
 }
 
@@ -121,123 +126,156 @@ void ClusteredMean(const Eigen::VectorXd& d, const std::vector<int>& cluster, do
   *se = g > 1 ? std::sqrt(g / (g - 1) * v) / n : INFINITY;
 }
 
+namespace {
+
+// What every step of the selection shares.
+struct SelectionContext {
+  const FitProblem& fp;
+  const std::vector<int>& rows;
+  const std::vector<int>& fold;
+  const SelectionOptions& options;
+  std::vector<int> cluster;  // episode per entry of rows (duplicated episodes share a cluster)
+};
+
+// Held-out gain of each remaining candidate added to `selected`, over `current`; sorted by gain.
+SelectionStep ScoreCandidates(const SelectionContext& ctx, const std::vector<int>& selected,
+                              const std::vector<int>& remaining, const Eigen::VectorXd& current,
+                              std::map<int, Eigen::VectorXd>* heldout) {
+  SelectionStep step;
+  step.threshold_z = UpperQuantile(ctx.options.alpha / remaining.size());
+  for (int e : remaining) {
+    std::vector<int> trial = selected;
+    trial.push_back(e);
+    (*heldout)[e] = CrossValidate(ctx.fp, trial, ctx.rows, ctx.fold, ctx.options.fit);
+    CandidateScore score;
+    score.effect = e;
+    ClusteredMean((*heldout)[e] - current, ctx.cluster, &score.gain, &score.se);
+    score.z = score.se > 0 ? score.gain / score.se : 0.0;
+    step.candidates.push_back(score);
+  }
+  std::sort(step.candidates.begin(), step.candidates.end(), [](const auto& a, const auto& b) { return a.gain > b.gain; });
+  return step;
+}
+
+// The best-gaining candidate among those whose gain is significant (a larger but noisier gain does
+// not stop a clearly significant one), or a significant one nested in it whose gain is within one
+// clustered SE of the paired difference (the simpler explanation the data cannot beat); moved to
+// the front. False: none is significant.
+bool ChooseCandidate(const SelectionContext& ctx, const std::map<int, Eigen::VectorXd>& heldout, SelectionStep* step) {
+  const auto significant = [&](const CandidateScore& c) {
+    return c.z > step->threshold_z && c.gain > ctx.options.min_gain_nats;
+  };
+  auto eligible = std::find_if(step->candidates.begin(), step->candidates.end(), significant);
+  if (eligible == step->candidates.end()) return false;
+  for (auto it = step->candidates.begin(); it != step->candidates.end(); ++it) {
+    if (it == eligible || !significant(*it) || !NestedIn(ctx.fp, it->effect, eligible->effect)) continue;
+    double diff, diff_se;
+    ClusteredMean(heldout.at(eligible->effect) - heldout.at(it->effect), ctx.cluster, &diff, &diff_se);
+    if (diff <= diff_se && ctx.fp.library[it->effect].num_params() < ctx.fp.library[eligible->effect].num_params()) {
+      eligible = it;
+    }
+  }
+  std::iter_swap(step->candidates.begin(), eligible);  // keep the chosen one first
+  std::stable_sort(step->candidates.begin() + 1, step->candidates.end(),
+                   [](const auto& a, const auto& b) { return a.gain > b.gain; });
+  step->chosen = step->candidates.front().effect;
+  return true;
+}
+
+// Which runners-up the data cannot separate from the chosen one: near-equal held-out gain (within
+// one clustered SE of the paired difference) and strongly correlated fitted shifts.
+void MarkConfusable(const SelectionContext& ctx, const std::vector<int>& selected,
+                    const std::map<int, Eigen::VectorXd>& heldout, const Eigen::VectorXd& current,
+                    SelectionStep* step) {
+  const FitProblem& fp = ctx.fp;
+  const CandidateScore& best = step->candidates.front();
+  std::vector<int> with_best = selected;
+  with_best.push_back(best.effect);
+  const EffectFit fit_best = FitEffects(fp, with_best, ctx.rows, ctx.options.fit);
+  const Eigen::VectorXd shift_best = WhitenedShift(fp, fit_best, static_cast<int>(with_best.size()) - 1);
+  for (size_t k = 1; k < step->candidates.size(); ++k) {
+    const CandidateScore& other = step->candidates[k];
+    double diff, diff_se;
+    ClusteredMean(heldout.at(best.effect) - heldout.at(other.effect), ctx.cluster, &diff, &diff_se);
+    if (diff > diff_se || other.gain <= 0) continue;
+    std::vector<int> with_other = selected;
+    with_other.push_back(other.effect);
+    const EffectFit fit_other = FitEffects(fp, with_other, ctx.rows, ctx.options.fit);
+    double corr;
+    if (fp.library[best.effect].is_noise || fp.library[other.effect].is_noise) {
+      const Eigen::VectorXd a = heldout.at(best.effect) - current, b = heldout.at(other.effect) - current;
+      corr = Correlation(a.array() - a.mean(), b.array() - b.mean());
+    } else {
+      corr = Correlation(shift_best, WhitenedShift(fp, fit_other, static_cast<int>(with_other.size()) - 1));
+    }
+    if (std::abs(corr) >= ctx.options.confusion_correlation) step->confusable.push_back(other.effect);
+  }
+}
+
+// Held-out log-likelihood of the selection without its k-th effect, per k.
+std::vector<Eigen::VectorXd> HeldoutWithoutEach(const SelectionContext& ctx, const std::vector<int>& selected) {
+  std::vector<Eigen::VectorXd> out;
+  for (size_t k = 0; k < selected.size(); ++k) {
+    std::vector<int> without = selected;
+    without.erase(without.begin() + k);
+    out.push_back(CrossValidate(ctx.fp, without, ctx.rows, ctx.fold, ctx.options.fit));
+  }
+  return out;
+}
+
+// Backward pass: drop the effect whose removal costs least while that cost is insignificant.
+// Returns the held-out values without each remaining effect when computed for the final set.
+std::vector<Eigen::VectorXd> BackwardPass(const SelectionContext& ctx, SelectionResult* result,
+                                          Eigen::VectorXd* current) {
+  std::vector<Eigen::VectorXd> without_ll;
+  while (ctx.options.backward && result->selected.size() > 1) {
+    const double threshold = UpperQuantile(ctx.options.alpha / result->selected.size());
+    without_ll = HeldoutWithoutEach(ctx, result->selected);
+    size_t weakest = 0;
+    double weakest_z = INFINITY, weakest_gain = 0;
+    for (size_t k = 0; k < result->selected.size(); ++k) {
+      double gain, se;
+      ClusteredMean(*current - without_ll[k], ctx.cluster, &gain, &se);
+      const double z = se > 0 ? gain / se : (gain > 0 ? INFINITY : 0.0);
+      if (z < weakest_z) weakest = k, weakest_z = z, weakest_gain = gain;
+    }
+    if (weakest_z > threshold && weakest_gain > ctx.options.min_gain_nats) break;
+    result->removed.push_back(result->selected[weakest]);
+    result->selected.erase(result->selected.begin() + weakest);
+    *current = without_ll[weakest];
+    without_ll.clear();
+  }
+  return without_ll;
+}
+
+}  // namespace
+
 SelectionResult ForwardSelect(const FitProblem& fp, const std::vector<int>& rows,
                               const std::vector<int>& fold, const SelectionOptions& options) {
+  SelectionContext ctx{fp, rows, fold, options, {}};
+  for (int r : rows) ctx.cluster.push_back(fp.episode[r]);
   SelectionResult result;
-  std::vector<int> cluster;
-  for (size_t k = 0; k < rows.size(); ++k) {
-    cluster.push_back(fp.episode[rows[k]]);  // duplicated episodes share a cluster
-  }
   Eigen::VectorXd current = CrossValidate(fp, {}, rows, fold, options.fit);
   result.heldout_sim = current;
   std::vector<int> remaining(fp.library.size());
   std::iota(remaining.begin(), remaining.end(), 0);
   while (static_cast<int>(result.selected.size()) < options.max_effects && !remaining.empty()) {
-    SelectionStep step;
-    step.threshold_z = UpperQuantile(options.alpha / remaining.size());
     std::map<int, Eigen::VectorXd> heldout;
-    for (int e : remaining) {
-      std::vector<int> trial = result.selected;
-      trial.push_back(e);
-      heldout[e] = CrossValidate(fp, trial, rows, fold, options.fit);
-      CandidateScore score;
-      score.effect = e;
-      ClusteredMean(heldout[e] - current, cluster, &score.gain, &score.se);
-      score.z = score.se > 0 ? score.gain / score.se : 0.0;
-      step.candidates.push_back(score);
-    }
-    std::sort(step.candidates.begin(), step.candidates.end(),
-              [](const auto& a, const auto& b) { return a.gain > b.gain; });
-    // The best-gaining candidate among those whose gain is significant (a larger but noisier
-    // gain does not stop a clearly significant one from being added).
-    const auto significant = [&](const CandidateScore& c) {
-      return c.z > step.threshold_z && c.gain > options.min_gain_nats;
-    };
-    auto eligible = std::find_if(step.candidates.begin(), step.candidates.end(), significant);
-    if (eligible == step.candidates.end()) {
+    SelectionStep step = ScoreCandidates(ctx, result.selected, remaining, current, &heldout);
+    if (!ChooseCandidate(ctx, heldout, &step)) {
       result.steps.push_back(step);
       break;
     }
-    // Parsimony: a significant candidate nested in the best one (its shifts a special case of
-    // the best one's) whose gain is within one clustered SE of the paired difference is the
-    // simpler explanation the data cannot beat, and is chosen instead.
-    for (auto it = step.candidates.begin(); it != step.candidates.end(); ++it) {
-      if (it == eligible || !significant(*it)) continue;
-      if (!NestedIn(fp, it->effect, eligible->effect)) continue;
-      double diff, diff_se;
-      ClusteredMean(heldout[eligible->effect] - heldout[it->effect], cluster, &diff, &diff_se);
-      if (diff <= diff_se &&
-          fp.library[it->effect].num_params() < fp.library[eligible->effect].num_params()) {
-        eligible = it;
-      }
-    }
-    std::iter_swap(step.candidates.begin(), eligible);  // keep the chosen one first
-    std::stable_sort(step.candidates.begin() + 1, step.candidates.end(),
-                     [](const auto& a, const auto& b) { return a.gain > b.gain; });
-    const CandidateScore& best = step.candidates.front();
-    step.chosen = best.effect;
-    // Which runners-up the data cannot separate from the best: near-equal held-out gain (within
-    // one clustered SE of the paired difference) and strongly correlated fitted shifts.
-    std::vector<int> with_best = result.selected;
-    with_best.push_back(best.effect);
-    EffectFit fit_best = FitEffects(fp, with_best, rows, options.fit);
-    Eigen::VectorXd shift_best = WhitenedShift(fp, fit_best, static_cast<int>(with_best.size()) - 1);
-    for (size_t k = 1; k < step.candidates.size(); ++k) {
-      const CandidateScore& other = step.candidates[k];
-      double diff, diff_se;
-      ClusteredMean(heldout[best.effect] - heldout[other.effect], cluster, &diff, &diff_se);
-      if (diff > diff_se || other.gain <= 0) continue;
-      std::vector<int> with_other = result.selected;
-      with_other.push_back(other.effect);
-      EffectFit fit_other = FitEffects(fp, with_other, rows, options.fit);
-      double corr;
-      if (fp.library[best.effect].is_noise || fp.library[other.effect].is_noise) {
-        Eigen::VectorXd a = heldout[best.effect] - current, b = heldout[other.effect] - current;
-        corr = Correlation(a.array() - a.mean(), b.array() - b.mean());
-      } else {
-        corr = Correlation(shift_best,
-                           WhitenedShift(fp, fit_other, static_cast<int>(with_other.size()) - 1));
-      }
-      if (std::abs(corr) >= options.confusion_correlation) step.confusable.push_back(other.effect);
-    }
-    result.selected.push_back(best.effect);
-    current = heldout[best.effect];
-    remaining.erase(std::find(remaining.begin(), remaining.end(), best.effect));
+    MarkConfusable(ctx, result.selected, heldout, current, &step);
+    result.selected.push_back(step.chosen);
+    current = heldout[step.chosen];
+    remaining.erase(std::find(remaining.begin(), remaining.end(), step.chosen));
     result.steps.push_back(step);
   }
-  // Held-out log-likelihood of the selection without its k-th effect, per k: the backward pass and
-  // the importance ranking both need it for the final selection, so it is computed once there.
-  auto heldout_without_each = [&]() {
-    std::vector<Eigen::VectorXd> out;
-    for (size_t k = 0; k < result.selected.size(); ++k) {
-      std::vector<int> without = result.selected;
-      without.erase(without.begin() + k);
-      out.push_back(CrossValidate(fp, without, rows, fold, options.fit));
-    }
-    return out;
-  };
-  std::vector<Eigen::VectorXd> without_ll;  // of result.selected as it stands (empty: not computed)
-  // Backward pass: drop the effect whose removal costs least while that cost is insignificant.
-  while (options.backward && result.selected.size() > 1) {
-    const double threshold = UpperQuantile(options.alpha / result.selected.size());
-    without_ll = heldout_without_each();
-    size_t weakest = 0;
-    double weakest_z = INFINITY, weakest_gain = 0;
-    for (size_t k = 0; k < result.selected.size(); ++k) {
-      double gain, se;
-      ClusteredMean(current - without_ll[k], cluster, &gain, &se);
-      const double z = se > 0 ? gain / se : (gain > 0 ? INFINITY : 0.0);
-      if (z < weakest_z) weakest = k, weakest_z = z, weakest_gain = gain;
-    }
-    if (weakest_z > threshold && weakest_gain > options.min_gain_nats) break;
-    result.removed.push_back(result.selected[weakest]);
-    result.selected.erase(result.selected.begin() + weakest);
-    current = without_ll[weakest];
-    without_ll.clear();
-  }
+  std::vector<Eigen::VectorXd> without_ll = BackwardPass(ctx, &result, &current);
   result.heldout_corrected = current;
   result.fit = FitEffects(fp, result.selected, rows, options.fit);
-  if (result.selected.size() > 1 && without_ll.empty()) without_ll = heldout_without_each();
+  if (result.selected.size() > 1 && without_ll.empty()) without_ll = HeldoutWithoutEach(ctx, result.selected);
   for (size_t k = 0; k < result.selected.size(); ++k) {
     const Eigen::VectorXd& reference = result.selected.size() == 1 ? result.heldout_sim : without_ll[k];
     result.importance.push_back((current - reference).mean());
@@ -264,11 +302,16 @@ BootstrapResult Bootstrap(const FitProblem& fp, const SelectionResult& selection
     return rows;
   };
   SelectionOptions quick = options;
+  std::vector<int> count(fp.library.size(), 0);
   for (int b = 0; b < options.bootstrap_selection; ++b) {
     std::vector<int> rows = resample();
     std::vector<int> fold = MakeFolds(fp, rows, options.folds, rng);
     SelectionResult r = ForwardSelect(fp, rows, fold, quick);
-    for (int e : r.selected) out.inclusion[e] += 1.0 / options.bootstrap_selection;
+    for (int e : r.selected) ++count[e];
+    out.selections.push_back(r.selected);
+  }
+  for (size_t e = 0; e < count.size() && options.bootstrap_selection > 0; ++e) {
+    out.inclusion[e] = static_cast<double>(count[e]) / options.bootstrap_selection;
   }
   const size_t k = selection.selected.size();
   std::vector<std::vector<std::vector<double>>> draws(k);

@@ -33,6 +33,9 @@ struct SelectionOptions {
 // round-robin over the folds (so every command keeps training data).
 std::vector<int> MakeFolds(const FitProblem& problem, const std::vector<int>& rows, int folds,
                            std::mt19937_64& rng);
+// The same from the samples' episode and command ids.
+std::vector<int> MakeFolds(const std::vector<int>& episode, const std::vector<int>& command,
+                           const std::vector<int>& rows, int folds, std::mt19937_64& rng);
 
 // The rows of fold f held out (`test`, and their positions in `rows`) and the rest (`train`).
 struct FoldSplit {
@@ -81,6 +84,7 @@ SelectionResult ForwardSelect(const FitProblem& problem, const std::vector<int>&
 
 struct BootstrapResult {
   std::vector<double> inclusion;                  // per library effect, share of resamples
+  std::vector<std::vector<int>> selections;       // per resample, the effects it selected
   std::vector<Eigen::VectorXd> lower, upper;      // per selected effect, 95% percentile interval
 };
 

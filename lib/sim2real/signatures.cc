@@ -1,153 +1,28 @@
 #include "sim2real/signatures.h"
 
-#include <atomic>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
 #include <map>
-#include <mutex>
-#include <thread>
 
-#include "sim/sim_config.h"
 #include "util/error.h"
-#if DGMM_SIM2REAL_HAVE_IO
-#include "io/sample_set_io.h"
-#include "util/atomic_file.h"
-#endif
 
 namespace dgmm::sim2real {
 namespace {
-
-#if DGMM_SIM2REAL_HAVE_IO
-constexpr bool kHaveIo = true;
-#else
-constexpr bool kHaveIo = false;
-#endif
-
-constexpr const char* kCacheVersion = "dgmm-knob-sim-v1";
-
-std::uint64_t Fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
 
 Eigen::Vector4d Phi(double pitch, double roll, double first) { return {1.0, pitch, roll, first}; }
 
 }  // namespace
 
-bool SignatureOptions::IsValid(std::string* error) const {
-  if (placements < 1 || threads < 1 || !(slope_ridge >= 0)) {
-    if (error) *error = "placements >= 1, threads >= 1, slope_ridge >= 0";
-    return false;
-  }
-  return true;
-}
+namespace {
 
-std::string DefaultCacheDir() {
-  if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) return std::string(x) + "/dgmm";
-  if (const char* h = std::getenv("HOME"); h && *h) return std::string(h) + "/.cache/dgmm";
-  return "";
-}
+// The paired executions of two recordings: phi = (1, pitch, roll, first), both x and the sim
+// table's command row of each pair.
+struct Pairs {
+  std::vector<Eigen::Vector4d> phi;
+  std::vector<Eigen::VectorXd> xn, xp;
+  std::vector<int> command;
+};
 
-std::string SimulationKey(const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                          int placements, const std::vector<sim::Knob>& knobs,
-                          const std::vector<sim::KnobValue>& values) {
-  std::string text = kCacheVersion;
-  text += "\n" + sim::RobotMjcfText(config) + "\n" + sim::SimConfigToJson(config) + "\n" +
-          sim::ProtocolName(protocol) + "\n" + std::to_string(seed) + "\n" + std::to_string(placements);
-  for (const auto& v : values) {
-    char buf[64];
-    std::snprintf(buf, sizeof buf, "=%.17g", v.value);
-    text += "\n" + knobs.at(v.knob).name + buf;
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(Fnv1a(text)));
-  return hex;
-}
-
-SimulationBatch SimulateBatch(const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                              const std::vector<sim::Knob>& knobs,
-                              const std::vector<SimulationRequest>& requests, const SignatureOptions& options) {
-  std::string error;
-  if (!options.IsValid(&error)) throw MakeInputError("", "signature options", error);
-  namespace fs = std::filesystem;
-  const auto start = std::chrono::steady_clock::now();
-  SimulationBatch batch;
-  batch.sets.resize(requests.size());
-  const std::string dir = options.cache_dir.empty() ? DefaultCacheDir() : options.cache_dir;
-  const bool use_cache = kHaveIo && !dir.empty() && dir != "-";
-  if (use_cache) {
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-  }
-  std::vector<std::string> paths(requests.size());
-  std::vector<size_t> todo;
-  for (size_t r = 0; r < requests.size(); ++r) {
-    if (use_cache) {
-      paths[r] = (fs::path(dir) / (SimulationKey(config, protocol, seed, options.placements, knobs,
-                                                 requests[r].values) + ".h5")).string();
-#if DGMM_SIM2REAL_HAVE_IO
-      if (fs::exists(paths[r])) {
-        try {
-          batch.sets[r] = ReadSampleSet(paths[r]);
-          ++batch.from_cache;
-          continue;
-        } catch (const std::exception&) {
-          // A damaged cache entry is simulated again and overwritten.
-        }
-      }
-#endif
-    }
-    todo.push_back(r);
-  }
-  sim::ProtocolOptions po;
-  po.protocol = protocol;
-  po.seed = seed;
-  po.placements = options.placements;
-  std::atomic<size_t> next{0};
-  std::mutex mu;
-  std::string failure;
-  auto worker = [&] {
-    for (size_t t = next++; t < todo.size(); t = next++) {
-      const size_t r = todo[t];
-      try {
-        SampleSet set = sim::SimulateWithKnobs(config, po, knobs, requests[r].values);
-#if DGMM_SIM2REAL_HAVE_IO
-        if (use_cache) {
-          try {
-            AtomicFile file(paths[r]);
-            WriteSampleSet(set, file.temp_path().string());
-            file.Commit();
-          } catch (const std::exception&) {
-            // The cache is an optimisation: a read-only folder only costs time.
-          }
-        }
-#endif
-        batch.sets[r] = std::move(set);
-      } catch (const std::exception& e) {
-        std::lock_guard<std::mutex> lock(mu);
-        if (failure.empty()) failure = e.what();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  const int n_threads = std::min<int>(options.threads, static_cast<int>(todo.size()));
-  for (int t = 0; t < n_threads; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  if (!failure.empty()) throw MakeInputError("--sim-config", "", "re-simulation failed: " + failure);
-  batch.simulated = static_cast<int>(todo.size());
-  batch.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return batch;
-}
-
-PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbed,
-                             const SampleSet& table, double slope_ridge) {
-  // Command rows of the sim table by label.
-  std::map<std::string, int> row_of;
+Pairs PairUp(const SampleSet& nominal, const SampleSet& perturbed, const SampleSet& table) {
+  std::map<std::string, int> row_of;  // command rows of the sim table by label
   for (int c = 0; c < table.num_commands(); ++c) {
     row_of[c < static_cast<int>(table.command_labels.size()) ? table.command_labels[c] : std::to_string(c)] = c;
   }
@@ -158,11 +33,7 @@ PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbe
   };
   std::map<std::pair<int, int>, int> index;
   for (int i = 0; i < perturbed.size(); ++i) index[{perturbed.episode(i), perturbed.step(i)}] = i;
-  const int dx = nominal.pose_dim();
-  std::vector<Eigen::Vector4d> phis;
-  std::vector<Eigen::VectorXd> diffs;
-  std::vector<int> cmd;
-  std::vector<Eigen::VectorXd> xn, xp;
+  Pairs p;
   for (int i = 0; i < nominal.size(); ++i) {
     auto it = index.find({nominal.episode(i), nominal.step(i)});
     if (it == index.end() || perturbed.command(it->second) != nominal.command(i)) continue;
@@ -170,13 +41,20 @@ PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbe
     if (c < 0) continue;
     const double pitch = nominal.terrain_dim() > 0 ? nominal.z(i, 0) : 0.0;
     const double roll = nominal.terrain_dim() > 1 ? nominal.z(i, 1) : 0.0;
-    phis.push_back(Phi(pitch, roll, nominal.step(i) == 0 ? 1.0 : 0.0));
-    diffs.push_back(perturbed.x.row(it->second).transpose() - nominal.x.row(i).transpose());
-    xn.push_back(nominal.x.row(i).transpose());
-    xp.push_back(perturbed.x.row(it->second).transpose());
-    cmd.push_back(c);
+    p.phi.push_back(Phi(pitch, roll, nominal.step(i) == 0 ? 1.0 : 0.0));
+    p.xn.push_back(nominal.x.row(i).transpose());
+    p.xp.push_back(perturbed.x.row(it->second).transpose());
+    p.command.push_back(c);
   }
-  const int n = static_cast<int>(phis.size());
+  return p;
+}
+
+}  // namespace
+
+PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbed, const SampleSet& table,
+                             double slope_ridge) {
+  const Pairs pairs = PairUp(nominal, perturbed, table);
+  const int n = static_cast<int>(pairs.phi.size()), dx = nominal.pose_dim();
   if (n < 10) throw MakeInputError("signature", "", "fewer than 10 paired simulated samples");
   PairedShift out;
   out.pairs_ = n;
@@ -184,11 +62,23 @@ PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbe
   Eigen::Matrix4d gram = Eigen::Matrix4d::Zero();
   Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(4, dx);
   Eigen::Vector4d mean_phi = Eigen::Vector4d::Zero(), sq_phi = Eigen::Vector4d::Zero();
+  const int commands = table.num_commands();
+  std::vector<Eigen::Matrix4d> g(commands, Eigen::Matrix4d::Zero());
+  std::vector<Eigen::MatrixXd> r(commands, Eigen::MatrixXd::Zero(4, dx)), rn = r, rp = r;
+  std::vector<int> count(commands, 0);
   for (int i = 0; i < n; ++i) {
-    gram += phis[i] * phis[i].transpose();
-    rhs += phis[i] * diffs[i].transpose();
-    mean_phi += phis[i] / n;
-    sq_phi += phis[i].cwiseProduct(phis[i]) / n;
+    const Eigen::Vector4d& phi = pairs.phi[i];
+    const Eigen::VectorXd diff = pairs.xp[i] - pairs.xn[i];
+    gram += phi * phi.transpose();
+    rhs += phi * diff.transpose();
+    mean_phi += phi / n;
+    sq_phi += phi.cwiseProduct(phi) / n;
+    const int c = pairs.command[i];
+    g[c] += phi * phi.transpose();
+    r[c] += phi * diff.transpose();
+    rn[c] += phi * pairs.xn[i].transpose();
+    rp[c] += phi * pairs.xp[i].transpose();
+    ++count[c];
   }
   const Eigen::Vector4d var_phi = (sq_phi - mean_phi.cwiseProduct(mean_phi)).cwiseMax(1e-12);
   out.pooled_ = (gram + 1e-9 * Eigen::Matrix4d::Identity()).ldlt().solve(rhs);
@@ -196,40 +86,24 @@ PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbe
   Eigen::Matrix4d lambda = Eigen::Matrix4d::Zero();
   for (int j = 1; j < 4; ++j) lambda(j, j) = slope_ridge * var_phi(j);
   lambda(0, 0) = 1e-9;
-  int commands = table.num_commands();
   out.b_.assign(commands, Eigen::MatrixXd());
-  std::vector<Eigen::Matrix4d> g(commands, Eigen::Matrix4d::Zero());
-  std::vector<Eigen::MatrixXd> r(commands, Eigen::MatrixXd::Zero(4, dx));
-  std::vector<int> count(commands, 0);
-  for (int i = 0; i < n; ++i) {
-    g[cmd[i]] += phis[i] * phis[i].transpose();
-    r[cmd[i]] += phis[i] * diffs[i].transpose();
-    ++count[cmd[i]];
-  }
-  Eigen::VectorXd ss_n = Eigen::VectorXd::Zero(dx), ss_p = Eigen::VectorXd::Zero(dx);
+  // Spread change: residual variance of x about each command's own linear fit in phi (the
+  // spread the sim model's covariance describes), nominal vs perturbed, pooled over commands.
+  std::vector<Eigen::MatrixXd> bn(commands), bp(commands);
   for (int c = 0; c < commands; ++c) {
     if (count[c] == 0) continue;
     Eigen::Matrix4d lam = lambda;
     lam(0, 0) = 0;
     out.b_[c] = (g[c] + lam + 1e-9 * Eigen::Matrix4d::Identity()).ldlt().solve(r[c] + lam * out.pooled_);
-  }
-  // Spread change: residual variance of x about each command's own linear fit in phi (the
-  // spread the sim model's covariance describes), nominal vs perturbed, pooled over commands.
-  std::vector<Eigen::MatrixXd> rn(commands, Eigen::MatrixXd::Zero(4, dx)), rp(commands, Eigen::MatrixXd::Zero(4, dx));
-  for (int i = 0; i < n; ++i) {
-    rn[cmd[i]] += phis[i] * xn[i].transpose();
-    rp[cmd[i]] += phis[i] * xp[i].transpose();
-  }
-  std::vector<Eigen::MatrixXd> bn(commands), bp(commands);
-  for (int c = 0; c < commands; ++c) {
-    if (count[c] == 0) continue;
     const auto solver = (g[c] + lambda + 1e-9 * Eigen::Matrix4d::Identity()).ldlt();
     bn[c] = solver.solve(rn[c]);
     bp[c] = solver.solve(rp[c]);
   }
+  Eigen::VectorXd ss_n = Eigen::VectorXd::Zero(dx), ss_p = Eigen::VectorXd::Zero(dx);
   for (int i = 0; i < n; ++i) {
-    ss_n += (xn[i] - bn[cmd[i]].transpose() * phis[i]).cwiseAbs2();
-    ss_p += (xp[i] - bp[cmd[i]].transpose() * phis[i]).cwiseAbs2();
+    const int c = pairs.command[i];
+    ss_n += (pairs.xn[i] - bn[c].transpose() * pairs.phi[i]).cwiseAbs2();
+    ss_p += (pairs.xp[i] - bp[c].transpose() * pairs.phi[i]).cwiseAbs2();
   }
   out.log_var_ = (ss_p.array() + 1e-30).log() - (ss_n.array() + 1e-30).log();
   return out;

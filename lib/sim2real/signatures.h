@@ -1,49 +1,16 @@
 #pragma once
-// Signatures of the simulator's knobs (lib/sim/knobs.h), learnt from the simulator itself: the
-// sim set's own protocol and seed are re-simulated at the nominal config and at each knob probe
-// with common random numbers (same placements, commands and sensor noise), and per command the
-// paired difference x_probe - x_nominal is regressed on phi = (1, pitch, roll, f):
+// Signatures of the simulator's knobs (knob_simulator.h), learnt from the simulator itself: the
+// sim set's own recording is repeated at the nominal knobs and at each knob probe with common
+// random numbers (same placements, commands and sensor noise), and per command the paired
+// difference x_probe - x_nominal is regressed on phi = (1, pitch, roll, f):
 //   shift_k(c, z, f) = B_kc^T phi   (dx),  B_kc = (Phi^T Phi + Lambda)^-1 (Phi^T D + Lambda B_k,pool)
-// with the slopes shrunk towards the slopes pooled over commands. Simulated sets are cached on
-// disk, keyed by a hash of (MJCF text, config JSON, protocol, seed, placements, knob, value).
+// with the slopes shrunk towards the slopes pooled over commands.
 #include <Eigen/Dense>
-#include <string>
 #include <vector>
 
 #include "core/sample_set.h"
-#include "sim/knobs.h"
-#include "sim/protocol.h"
 
 namespace dgmm::sim2real {
-
-struct SignatureOptions {
-  int placements = 78;      // per simulation (paper protocol: 3 per command covers all 26)
-  int threads = 2;          // simulations in parallel
-  std::string cache_dir;    // empty: $XDG_CACHE_HOME/dgmm, else ~/.cache/dgmm; "-": no cache
-  double slope_ridge = 5.0; // pseudo-samples pulling each command's slopes to the pooled ones
-  bool IsValid(std::string* error) const;
-};
-
-// The default cache folder ($XDG_CACHE_HOME/dgmm or $HOME/.cache/dgmm; empty when neither is set).
-std::string DefaultCacheDir();
-
-// Simulates (or reads from the cache) the protocol at the knob values. Same seed: paired.
-struct SimulationRequest {
-  std::vector<sim::KnobValue> values;  // empty: nominal
-};
-struct SimulationBatch {
-  std::vector<SampleSet> sets;  // one per request
-  int from_cache = 0, simulated = 0;
-  double wall_seconds = 0;
-};
-SimulationBatch SimulateBatch(const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                              const std::vector<sim::Knob>& knobs,
-                              const std::vector<SimulationRequest>& requests, const SignatureOptions& options);
-
-// Hex cache key of one simulation.
-std::string SimulationKey(const sim::SimConfig& config, sim::Protocol protocol, std::uint64_t seed,
-                          int placements, const std::vector<sim::Knob>& knobs,
-                          const std::vector<sim::KnobValue>& values);
 
 // How x moves from a nominal simulated set to a paired perturbed one (per command, linear in
 // phi = (1, pitch, roll, f)); commands are the rows of `command_table_of` (the sim set's table,

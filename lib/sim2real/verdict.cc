@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <nlohmann/json.hpp>
 
 #include "sim2real/sentence_format.h"
@@ -40,9 +39,12 @@ std::string VerdictJson(const Verdict& v) {
   json named = json::array();
   for (const auto& n : v.named) {
     named.push_back({{"family", n.family}, {"knob", n.knob}, {"value", Number(n.value)}, {"unit", n.unit},
-                     {"nominal", Number(n.nominal)},
+                     {"nominal", Number(n.nominal)}, {"fitted_value", Number(n.fitted)},
+                     {"range", {Number(n.lo), Number(n.hi)}}, {"ci95", {Number(n.value_lower), Number(n.value_upper)}},
                      {"inclusion", n.inclusion < 0 ? json(nullptr) : json(n.inclusion)},
-                     {"tie_group", n.tie_group < 0 ? json(nullptr) : json(n.tie_group)}});
+                     {"candidate_inclusion", n.candidate_inclusion < 0 ? json(nullptr) : json(n.candidate_inclusion)},
+                     {"tie_group", n.tie_group < 0 ? json(nullptr) : json(n.tie_group)},
+                     {"flags", n.flags}, {"doubts", n.doubts}});
   }
   json ties = json::array();
   for (const auto& t : v.ties) {
@@ -87,60 +89,21 @@ std::string VerdictJson(const Verdict& v) {
     }
     drifting.push_back(e);
   }
+  json weak = json::array();
+  for (const auto& w : v.weak) {
+    weak.push_back({{"family", w.family}, {"knob", w.knob}, {"value", Number(w.value)}, {"inclusion", w.inclusion}});
+  }
   json out = {{"status", v.status},
+              {"sentence", v.sentence},
               {"named", named},
+              {"not_named_low_inclusion", weak},
+              {"inclusion_threshold", v.min_inclusion},
+              {"doubts", v.doubts},
               {"ties", ties},
               {"drifting", drifting},
               {"unexplained", {{"present", v.unexplained_present}, {"structured_in", v.structured_in}}},
               {"gap_closed", Number(v.gap_closed)}};
   return out.dump();
-}
-
-Verdict VerdictFromEffects(const Sim2RealResult& r) {
-  // The kinematic forms of the data-level library stand for these families.
-  static const std::map<std::string, std::string> family = {
-      {"slope_slip", "friction"},       {"stride_loss", "actuator_gain"}, {"slope_traction", "friction"},
-      {"payload_offset", "payload"},    {"actuator_asymmetry", "actuator_gain"}, {"latency", "latency"},
-      {"compliance", "contact"},        {"bias", "tracker_bias"},          {"noise", "tracker_noise"}};
-  Verdict v;
-  v.gap_closed = r.gap_closed;
-  const bool not_computed = r.bootstrap_resamples == 0;
-  for (const auto& e : r.effects) {
-    VerdictNamed n;
-    auto it = family.find(e.spec.key);
-    n.family = it == family.end() ? e.spec.key : it->second;
-    n.knob = e.spec.key;
-    n.value = e.theta.size() > 0 ? e.theta.cwiseAbs().maxCoeff() : NAN;
-    if (e.spec.is_noise && e.theta.size() > 0) n.value = std::exp(e.theta(0));
-    n.unit = e.spec.parameters.empty() ? "" : e.spec.parameters.front().unit;
-    n.nominal = e.spec.is_noise ? 1.0 : 0.0;
-    n.inclusion = not_computed ? -1 : e.inclusion;
-    if (!e.confusable_with.empty()) {
-      VerdictTie t;
-      t.families.push_back(n.family);
-      for (const auto& c : e.confusable_with) {
-        auto f = family.find(c);
-        const std::string name = f == family.end() ? c : f->second;
-        if (std::find(t.families.begin(), t.families.end(), name) == t.families.end()) t.families.push_back(name);
-      }
-      if (t.families.size() > 1) {
-        t.why = "held-out gains within one standard error and fitted shifts correlated (data-level library)";
-        n.tie_group = static_cast<int>(v.ties.size());
-        v.ties.push_back(t);
-      }
-    }
-    v.named.push_back(n);
-  }
-  v.unexplained_present = !r.unexplained.empty();
-  for (const auto& g : r.unexplained) {
-    if (std::find(v.structured_in.begin(), v.structured_in.end(), g.family) == v.structured_in.end()) {
-      v.structured_in.push_back(g.family);
-    }
-  }
-  if (!r.significant_mismatch && v.named.empty()) v.status = "clean";
-  else if (v.named.empty()) v.status = "unexplained", v.unexplained_present = true;
-  else v.status = v.unexplained_present ? "partly_explained" : "explained";
-  return v;
 }
 
 }  // namespace dgmm::sim2real

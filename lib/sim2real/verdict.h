@@ -1,10 +1,17 @@
 #pragma once
-// What a user should believe: the `verdict` object of report.json (docs/sim2real.md,
-// "report.json verdict"), in the fixed family vocabulary scored by scripts/sim2real_battery.py.
+// Stage 8 of the analysis (analysis.h): what a user should believe, the `verdict` object of
+// report.json (docs/sim2real.md, "report.json verdict"), in the fixed family vocabulary scored by
+// scripts/sim2real_battery.py. A candidate is named when it is selected, constant over the session
+// (drift.h), and its family's bootstrap inclusion is at least `min_inclusion`; its value is clamped
+// to the knob's range and every doubt of the adequacy stage is stated. Status:
+//   clean            no located mismatch and nothing named;
+//   explained        named knobs, no doubt;
+//   partly_explained named knobs with doubts (a value pinned or impossible, mismatch left, ...);
+//   unexplained      a mismatch nothing named accounts for;
+//   located          no simulator: the mismatch is located, no physics named.
+#include <cmath>
 #include <string>
 #include <vector>
-
-#include "sim2real/pipeline.h"
 
 namespace dgmm::sim2real {
 
@@ -22,6 +29,7 @@ struct VerdictExperiment {
   int executions_simulated = 0, placements = 0;
   unsigned long long seed = 0;
   double heading_deg = 0;
+  std::string placement;             // where the simulator stood the robot, in words
   double spread_scale = 1;            // simulated within-cell spread scaled by the fitted noise scale (>= 1)
   double simulated_separation = 0;    // d2 measured by simulation (same units as `separation`)
   double z = 0, z_required = 0, p_value = 1;
@@ -38,8 +46,20 @@ struct VerdictTie {
 struct VerdictNamed {
   std::string family, knob, unit;
   double value = 0, nominal = 0;
-  double inclusion = -1;  // < 0: not computed (--bootstrap 0), written as null
+  double fitted = 0;                     // the fit's own reading (value is it clamped to the range)
+  double lo = NAN, hi = NAN;             // the knob's range (NaN: a measurement effect)
+  double value_lower = NAN, value_upper = NAN;  // 95% bootstrap interval of the value
+  double inclusion = -1;  // of the family, in [0, 1]; < 0: not computed (--bootstrap 0), written as null
+  double candidate_inclusion = -1;       // of this candidate alone
   int tie_group = -1;     // index into ties, -1: null
+  std::vector<std::string> flags;        // "pinned_low", "pinned_high", "outside_range", "impossible", "unconverged"
+  std::vector<std::string> doubts;       // in words
+};
+
+// A selected candidate that is not named because its family's inclusion is below the threshold.
+struct VerdictWeak {
+  std::string family, knob;
+  double value = 0, inclusion = 0;
 };
 
 // A named effect that is not a constant (drift.h): over the session (`first`/`last`: its value in
@@ -58,6 +78,9 @@ struct Verdict {
   std::vector<VerdictNamed> named;
   std::vector<VerdictTie> ties;
   std::vector<VerdictDrifting> drifting;  // effects that fit on average but drift (not named)
+  std::vector<VerdictWeak> weak;          // selected but under the inclusion threshold (not named)
+  double min_inclusion = 0;               // the threshold (family inclusion)
+  std::vector<std::string> doubts;        // every doubt, in words (the named knobs' and the correction's)
   bool unexplained_present = false;
   std::vector<std::string> structured_in;
   double gap_closed = 0;  // NaN: no gap (null)
@@ -71,10 +94,5 @@ std::string DescribeExperiment(const VerdictExperiment& e);
 
 // JSON text of the verdict object (contract of docs/sim2real.md).
 std::string VerdictJson(const Verdict& v);
-
-// The verdict of the data-level analysis (no simulator): its effects mapped onto families
-// (bias -> tracker_bias, noise -> tracker_noise, the kinematic forms onto the physics they stand
-// for); values are the effects' own parameters, not simulator units.
-Verdict VerdictFromEffects(const Sim2RealResult& result);
 
 }  // namespace dgmm::sim2real

@@ -10,39 +10,42 @@
 #include <numbers>
 #include <random>
 
-#include "sim2real/synthetic.h"
+#include "sim2real/effect_fit.h"
+#include "tests/sim2real/fake_simulator.h"
+#include "tests/sim2real/synthetic.h"
 
 namespace dgmm::sim2real {
 namespace {
 
+// The analysis of a fake pair with a friction and a latency (first executions differ from repeats).
 struct Pair {
   SampleSet sim, real;
   Samples real_samples;
-  Sim2RealResult result;
+  Analysis a;
 };
-
-Pair RunPair(const SyntheticWorld& world, std::uint64_t seed) {
-  Pair p;
-  p.sim = GenerateSynthetic(SyntheticWorld{}, "paper-830", seed);
-  p.real = GenerateSynthetic(world, "paper", seed + 1000);
-  p.real_samples = MakeSamples(p.real, AlignCommands(p.sim, p.real));
-  Sim2RealOptions options;
-  options.seed = seed;
-  options.selection.bootstrap_selection = 0;
-  options.selection.bootstrap_parameters = 0;
-  options.locate.mmd.permutations = 50;
-  p.result = RunSim2Real(p.sim, p.real, options);
-  return p;
-}
 
 const Pair& SlipPair() {
   static const Pair pair = [] {
-    SyntheticWorld w;
-    w.slip_creep = 0.05;
-    w.latency_first_loss = 0.3;  // a sequence effect too: first executions differ from repeats
-    return RunPair(w, 21);
+    static const test::FakeSimulator fake;
+    const test::FakePair fp = test::MakeFakePair(fake, {{test::kFriction, 0.6}, {test::kLatency, 0.03}});
+    AnalysisOptions options = test::FastOptions();
+    options.refine.selection.bootstrap_selection = 0;
+    options.refine.selection.bootstrap_parameters = 0;
+    Pair p;
+    p.a = Analyse(fp.sim, fp.real, &fake, options);
+    p.sim = p.a.inputs.sim_set;
+    p.real = p.a.inputs.real_set;
+    p.real_samples = p.a.inputs.real;
+    return p;
   }();
   return pair;
+}
+
+MotionModel Corrected(const Pair& p, const CorrectedModelOptions& options = {}) {
+  return BuildCorrectedModel(p.a.baseline.sim_model, p.a.correction, p.a.inputs.first_execution_share, p.sim, options);
+}
+MotionModel Sim(const Pair& p, const CorrectedModelOptions& options = {}) {
+  return BuildSimModel(p.a.baseline.sim_model, p.a.inputs.first_execution_share, p.sim, options);
 }
 
 double LogNormalDensity(const Eigen::VectorXd& x, const Eigen::VectorXd& mean, const Eigen::MatrixXd& cov) {
@@ -60,26 +63,21 @@ struct FlagCase {
   Eigen::VectorXd mean;
   Eigen::MatrixXd cov;
 };
-std::vector<FlagCase> AnalysisPrediction(const Sim2RealResult& r, bool corrected, int c,
-                                         const Eigen::VectorXd& z) {
-  const Eigen::Vector3d g(std::sin(z(0)), -std::sin(z(1)) * std::cos(z(0)), -std::cos(z(1)) * std::cos(z(0)));
-  const double tau2 = corrected ? std::exp(2 * r.fit.log_tau) : 1.0;
+std::vector<FlagCase> AnalysisPrediction(const Analysis& r, bool corrected, int c, const Eigen::VectorXd& z) {
+  const double tau2 = corrected ? std::exp(2 * r.correction.log_tau) : 1.0;
   std::vector<FlagCase> cases;
   for (int first = 0; first < 2; ++first) {
-    const Prediction p = r.sim_model.Predict(c, z, first);
+    const Prediction p = r.baseline.sim_model.Predict(c, z, first);
     Eigen::VectorXd mean = p.mean;
-    for (size_t k = 0; corrected && k < r.fit.effects.size(); ++k) {
-      const EffectSpec& e = r.library[r.fit.effects[k]];
-      if (!e.is_noise) mean += EffectDesign(e, r.layout, p.mean, g, first == 1) * r.fit.theta[k];
-    }
-    const double share = first ? r.first_execution_share : 1 - r.first_execution_share;
+    if (corrected) mean += r.correction.Shift(c, z, first, static_cast<int>(mean.size()));
+    const double share = first ? r.inputs.first_execution_share : 1 - r.inputs.first_execution_share;
     cases.push_back({share, mean, tau2 * p.chol * p.chol.transpose()});
   }
   return cases;
 }
 
 // The analysis' density of x at (c, z), its flag unknown: log sum_f share_f N(x; mean_f, cov_f).
-double AnalysisLogDensity(const Sim2RealResult& r, bool corrected, int c, const Eigen::VectorXd& x,
+double AnalysisLogDensity(const Analysis& r, bool corrected, int c, const Eigen::VectorXd& x,
                           const Eigen::VectorXd& z) {
   std::vector<double> log_p;
   for (const FlagCase& f : AnalysisPrediction(r, corrected, c, z)) {
@@ -90,7 +88,7 @@ double AnalysisLogDensity(const Sim2RealResult& r, bool corrected, int c, const 
 }
 
 // A draw of x from the analysis' flag-mixed prediction at (c, z).
-Eigen::VectorXd AnalysisDraw(const Sim2RealResult& r, bool corrected, int c, const Eigen::VectorXd& z,
+Eigen::VectorXd AnalysisDraw(const Analysis& r, bool corrected, int c, const Eigen::VectorXd& z,
                              std::mt19937_64& rng) {
   const std::vector<FlagCase> cases = AnalysisPrediction(r, corrected, c, z);
   const FlagCase& f = std::bernoulli_distribution(cases[1].weight)(rng) ? cases[1] : cases[0];
@@ -101,24 +99,24 @@ Eigen::VectorXd AnalysisDraw(const Sim2RealResult& r, bool corrected, int c, con
 }
 
 // Mean over the real samples of the analysis' log-likelihood with the flag known.
-double AnalysisScore(const Sim2RealResult& r, const Samples& real, bool corrected) {
-  const FitProblem problem = MakeFitProblem(real, r.sim_model, r.library, r.layout);
-  if (!corrected) return r.sim_model.LogLikelihood(real).mean();
-  return CorrectedLogLikelihood(problem, r.fit).mean();
+double AnalysisScore(const Analysis& r, const Samples& real, bool corrected) {
+  if (!corrected) return r.baseline.sim_model.LogLikelihood(real).mean();
+  return CorrectedLogLikelihood(r.refinement.problem, r.refinement.selection.fit).mean();
 }
 
-TEST(CorrectedModel, SyntheticPairFindsTheSequenceEffect) {
-  const Sim2RealResult& r = SlipPair().result;
-  ASSERT_FALSE(r.effects.empty());
-  EXPECT_GT(r.first_execution_share, 0.0);
-  EXPECT_LT(r.first_execution_share, 1.0);
+TEST(CorrectedModel, FakePairFindsTheSequenceEffect) {
+  const Analysis& r = SlipPair().a;
+  ASSERT_FALSE(r.correction.terms.empty());
+  ASSERT_TRUE(static_cast<bool>(r.correction.shift));
+  EXPECT_GT(r.inputs.first_execution_share, 0.0);
+  EXPECT_LT(r.inputs.first_execution_share, 1.0);
 }
 
 TEST(CorrectedModel, MixturesAreValid) {
   const Pair& p = SlipPair();
-  for (const MotionModel& m : {BuildCorrectedModel(p.result, p.sim), BuildSimModel(p.result, p.sim)}) {
+  for (const MotionModel& m : {Corrected(p), Sim(p)}) {
     EXPECT_EQ(m.dim(), p.sim.pose_dim() + p.sim.terrain_dim());
-    EXPECT_EQ(m.mixtures.size(), p.result.sim_model.Commands().size());
+    EXPECT_EQ(m.mixtures.size(), p.a.baseline.sim_model.Commands().size());
     for (const auto& [c, mix] : m.mixtures) {
       ASSERT_GT(mix.size(), 1) << "command " << c << ": one Gaussian cannot tile the terrain";
       for (int i = 0; i < mix.size(); ++i) {
@@ -135,8 +133,7 @@ TEST(CorrectedModel, MixturesAreValid) {
 // conditional log density equals the analysis' flag-mixed density.
 double PointwiseError(const Pair& p, bool corrected, const CorrectedModelOptions& options,
                       double* max_error) {
-  const MotionModel m = corrected ? BuildCorrectedModel(p.result, p.sim, options)
-                                  : BuildSimModel(p.result, p.sim, options);
+  const MotionModel m = corrected ? Corrected(p, options) : Sim(p, options);
   std::mt19937_64 rng(0);
   std::uniform_int_distribution<int> pick(0, p.sim.size() - 1);
   double sum = 0;
@@ -146,8 +143,8 @@ double PointwiseError(const Pair& p, bool corrected, const CorrectedModelOptions
     const int i = pick(rng);
     const int c = p.sim.command(i);
     const Eigen::VectorXd z = p.sim.z.row(i).transpose();
-    const Eigen::VectorXd x = AnalysisDraw(p.result, corrected, c, z, rng);
-    const double error = std::abs(m.LogLikelihood(c, x, z) - AnalysisLogDensity(p.result, corrected, c, x, z));
+    const Eigen::VectorXd x = AnalysisDraw(p.a, corrected, c, z, rng);
+    const double error = std::abs(m.LogLikelihood(c, x, z) - AnalysisLogDensity(p.a, corrected, c, x, z));
     sum += error;
     *max_error = std::max(*max_error, error);
   }
@@ -180,7 +177,7 @@ TEST(CorrectedModel, PiecesBeatOneGaussianPerCommand) {
 }
 
 // Mean over the real samples of the analysis' log-likelihood with the flag unknown.
-double FlagMixedScore(const Sim2RealResult& r, const Samples& real, bool corrected) {
+double FlagMixedScore(const Analysis& r, const Samples& real, bool corrected) {
   double sum = 0;
   for (int i = 0; i < real.size(); ++i) {
     sum += AnalysisLogDensity(r, corrected, real.command[i], real.x.row(i).transpose(),
@@ -194,20 +191,19 @@ double FlagMixedScore(const Sim2RealResult& r, const Samples& real, bool correct
 // (log sum_f s_f N_f >= log s_fi + log N_fi for each sample's own flag f_i).
 TEST(CorrectedModel, ScoresTheRealSetLikeTheAnalysis) {
   const Pair& p = SlipPair();
-  const double s = p.result.first_execution_share;
+  const double s = p.a.inputs.first_execution_share;
   const double flag_entropy = -s * std::log(s) - (1 - s) * std::log(1 - s);
   // The pieces' averaged inflation (see above), averaged again over the set.
   constexpr double kPieceTolerance = 0.05;
   for (bool corrected : {true, false}) {
-    const MotionModel m = corrected ? BuildCorrectedModel(p.result, p.sim) : BuildSimModel(p.result, p.sim);
+    const MotionModel m = corrected ? Corrected(p) : Sim(p);
     const double file = ScoreSampleSet(m, p.real).mean_log_likelihood;
-    EXPECT_NEAR(file, FlagMixedScore(p.result, p.real_samples, corrected), kPieceTolerance)
+    EXPECT_NEAR(file, FlagMixedScore(p.a, p.real_samples, corrected), kPieceTolerance)
         << (corrected ? "corrected" : "sim");
-    EXPECT_GT(file, AnalysisScore(p.result, p.real_samples, corrected) - flag_entropy - kPieceTolerance)
+    EXPECT_GT(file, AnalysisScore(p.a, p.real_samples, corrected) - flag_entropy - kPieceTolerance)
         << (corrected ? "corrected" : "sim");
   }
-  EXPECT_GT(ScoreSampleSet(BuildCorrectedModel(p.result, p.sim), p.real).mean_log_likelihood,
-            ScoreSampleSet(BuildSimModel(p.result, p.sim), p.real).mean_log_likelihood);
+  EXPECT_GT(ScoreSampleSet(Corrected(p), p.real).mean_log_likelihood, ScoreSampleSet(Sim(p), p.real).mean_log_likelihood);
 }
 
 TEST(CorrectedModel, RejectsInvalidOptions) {
@@ -217,57 +213,53 @@ TEST(CorrectedModel, RejectsInvalidOptions) {
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_FALSE(error.empty());
-  EXPECT_ANY_THROW(BuildCorrectedModel(p.result, p.sim, options));
+  EXPECT_ANY_THROW(Corrected(p, options));
 }
 
 TEST(CorrectedModel, OnePieceIsOneGaussianPerExecutionKind) {
   const Pair& p = SlipPair();
   CorrectedModelOptions options;
   options.max_pieces = 1;
-  const MotionModel m = BuildCorrectedModel(p.result, p.sim, options);
+  const MotionModel m = Corrected(p, options);
   for (const auto& [c, mix] : m.mixtures) EXPECT_EQ(mix.size(), 2);  // first, repeat
 }
 
 // Without terrain the file is one Gaussian per execution kind and command, still equal to the
-// analysis' flag-mixed prediction.
+// prediction mixed over the flag: here a hand-made correction (a shift per flag, a noise scale).
 TEST(CorrectedModel, WithoutTerrainEachCommandIsItsFlagMixture) {
   SyntheticWorld w;
   w.latency_first_loss = 0.3;
-  Pair p;
-  p.sim = GenerateSynthetic(SyntheticWorld{}, "paper-830", 5);
-  p.real = GenerateSynthetic(w, "paper", 6);
-  for (SampleSet* set : {&p.sim, &p.real}) {
+  SampleSet sim = GenerateSynthetic(SyntheticWorld{}, "paper-830", 5);
+  SampleSet real_set = GenerateSynthetic(w, "paper", 6);
+  for (SampleSet* set : {&sim, &real_set}) {
     set->z.resize(set->size(), 0);
     set->z_names.clear();
     set->z_units.clear();
   }
-  Sim2RealOptions options;
-  options.selection.bootstrap_selection = 0;
-  options.selection.bootstrap_parameters = 0;
-  options.locate.mmd.permutations = 50;
-  p.result = RunSim2Real(p.sim, p.real, options);
-  const MotionModel m = BuildCorrectedModel(p.result, p.sim);
+  std::vector<int> identity(sim.num_commands());
+  for (int c = 0; c < sim.num_commands(); ++c) identity[c] = c;
+  const LinearGaussianModel model = LinearGaussianModel::Fit(MakeSamples(sim, identity), {});
+  Correction correction;
+  correction.log_tau = 0.1;
+  correction.shift = [](int c, const Eigen::VectorXd&, double f) {
+    Eigen::VectorXd s = Eigen::VectorXd::Constant(6, 0.004 * c);
+    s(0) -= 0.05 * f;
+    return s;
+  };
+  const double share = 0.2;
+  const MotionModel m = BuildCorrectedModel(model, correction, share, sim);
   EXPECT_EQ(m.terrain_dim, 0);
-  const Samples real = MakeSamples(p.real, AlignCommands(p.sim, p.real));
-  const double tau2 = std::exp(2 * p.result.fit.log_tau);
+  const Samples real = MakeSamples(real_set, AlignCommands(sim, real_set));
+  const double tau2 = std::exp(2 * correction.log_tau);
   for (int i = 0; i < 10; ++i) {
     const int c = real.command[i];
-    ASSERT_EQ(m.MixtureFor(c).size(), p.result.sim_model.uses_sequence() ? 2 : 1);
-    // The analysis: sim prediction (no terrain) shifted by the effects, per flag, mixed.
+    ASSERT_EQ(m.MixtureFor(c).size(), 2);
     double log_p[2];
     for (int first = 0; first < 2; ++first) {
-      const Prediction pr = p.result.sim_model.Predict(c, Eigen::VectorXd(0), first);
-      Eigen::VectorXd mean = pr.mean;
-      for (size_t k = 0; k < p.result.fit.effects.size(); ++k) {
-        const EffectSpec& e = p.result.library[p.result.fit.effects[k]];
-        if (!e.is_noise) {
-          mean += EffectDesign(e, p.result.layout, pr.mean, Eigen::Vector3d(0, 0, -1), first == 1) *
-                  p.result.fit.theta[k];
-        }
-      }
-      const double share = first ? p.result.first_execution_share : 1 - p.result.first_execution_share;
-      log_p[first] = std::log(share) + LogNormalDensity(real.x.row(i).transpose(), mean,
-                                                        tau2 * pr.chol * pr.chol.transpose());
+      const Prediction pr = model.Predict(c, Eigen::VectorXd(0), first);
+      const Eigen::VectorXd mean = pr.mean + correction.Shift(c, Eigen::VectorXd(0), first, 6);
+      log_p[first] = std::log(first ? share : 1 - share) +
+                     LogNormalDensity(real.x.row(i).transpose(), mean, tau2 * pr.chol * pr.chol.transpose());
     }
     const double top = std::max(log_p[0], log_p[1]);
     const double expected = top + std::log(std::exp(log_p[0] - top) + std::exp(log_p[1] - top));

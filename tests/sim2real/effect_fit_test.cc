@@ -4,7 +4,8 @@
 
 #include <gtest/gtest.h>
 
-#include "sim2real/synthetic.h"
+#include "sim2real/knob_design.h"
+#include "tests/sim2real/synthetic.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -27,8 +28,22 @@ Fixture Make() {
   f.sim = MakeSamples(sim, id);
   f.real = MakeSamples(real, AlignCommands(sim, real));
   f.model = LinearGaussianModel::Fit(f.sim, LinearGaussianOptions{});
-  PoseLayout layout = DetectPoseLayout(sim);
-  f.problem = MakeFitProblem(f.real, f.model, EffectLibrary(layout, 6, true, true), layout);
+  // Designs: a constant offset (tracker bias), a yaw per execution (heading drift), the sim
+  // model's terrain slopes (IMU bias) and the noise scale.
+  const PoseLayout layout = DetectPoseLayout(sim);
+  const std::vector<ExternalCandidate> designs = {{ExternalCandidate::kTrackerBias, {}},
+                                                  {ExternalCandidate::kHeading, {}},
+                                                  {ExternalCandidate::kImuBias, {}}};
+  std::vector<EffectSpec> library = {ExternalSpec("bias", "bias", 5, "x units"), ExternalSpec("heading", "yaw", 1, "rad"),
+                                     ExternalSpec("imu", "imu", 2, "rad"), NoiseEffect()};
+  f.problem = MakeFitProblem(f.real, f.model, library);
+  for (int k = 0; k < 3; ++k) {
+    for (int i = 0; i < f.real.size(); ++i) {
+      SetDesign(&f.problem, k, i,
+                ExternalDesign(designs[k], {}, f.model, layout, 6, f.real.command[i], f.real.z.row(i).transpose(),
+                               f.real.first_execution[i]));
+    }
+  }
   return f;
 }
 
@@ -43,7 +58,7 @@ constexpr double kRelativeTolerance = 1e-4;
 
 TEST(EffectFit, MeanEffectsEqualLeastSquares) {
   Fixture f = Make();
-  for (const std::string key : {"actuator_asymmetry", "slope_slip", "payload_offset", "bias"}) {
+  for (const std::string key : {"bias", "heading", "imu"}) {
     const int e = IndexOf(f.problem, key);
     ASSERT_GE(e, 0) << key;
     EffectFit fit = FitEffects(f.problem, {e}, {});
@@ -60,7 +75,7 @@ TEST(EffectFit, MeanEffectsEqualLeastSquares) {
 
 TEST(EffectFit, NoiseScaleIsRootMeanSquare) {
   Fixture f = Make();
-  const int e = IndexOf(f.problem, "noise");
+  const int e = IndexOf(f.problem, "tracker_noise");
   EffectFit fit = FitEffects(f.problem, {e}, {});
   const double rms = std::sqrt(f.problem.r0.squaredNorm() / (f.problem.n * f.problem.dx));
   EXPECT_NEAR(std::exp(fit.log_tau), rms, kRelativeTolerance * rms * 10);

@@ -9,7 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "sim/protocol.h"
+#include "tests/sim2real/fake_simulator.h"
 #include "sim2real/verdict.h"
 #include "util/error.h"
 
@@ -66,62 +66,31 @@ TEST(SeparationOfPairs, MeasuresAShiftAndNotItsAbsence) {
   EXPECT_THROW(SeparationOfPairs(a, b.leftCols(2), 12, 99, 1), InputError);
 }
 
-int KnobIndex(const std::vector<sim::Knob>& knobs, const std::string& name) {
-  for (size_t k = 0; k < knobs.size(); ++k) {
-    if (knobs[k].name == name) return static_cast<int>(k);
-  }
-  ADD_FAILURE() << "no knob " << name;
-  return 0;
-}
-
 TEST(CheckExperiment, ConfirmsClearlyDifferentKnobsAndNotIdenticalOnes) {
-  const sim::SimConfig config;  // the built-in robot
-  const std::vector<sim::Knob> knobs = sim::EnumerateKnobs(config);
+  const test::FakeSimulator fake;
   ExperimentCheckOptions options;
   options.seed = 11;
-  options.min_executions = 15;  // 3 placements of 5 per run: a few seconds
+  options.min_executions = 15;
   options.permutations = 500;
-  const Eigen::Vector3d sideways(0, 0.5, 0);
-  // Across the slope (the protocol's heading 0): pitch about 0, roll about -slope.
-  const double roll = -config.slope_deg * M_PI / 180;
-  const sim::KnobValue slippery{KnobIndex(knobs, "floor.friction.sliding"), 0.3};
-  const sim::KnobValue stiff_joints{KnobIndex(knobs, "joints.damping_scale"), 4.0};
-  const ExperimentCheck differ = CheckExperiment(config, knobs, slippery, stiff_joints, sideways, 0.0, roll, 10, options);
+  const Eigen::Vector3d forward(0.5, 0, 0);
+  const Eigen::Vector2d downhill(0.3, 0.0);
+  const KnobValue slippery{test::kFriction, 0.3};
+  const KnobValue weak_left{test::kLeftGain, 0.3};
+  const ExperimentCheck differ = CheckExperiment(fake, slippery, weak_left, forward, downhill, 10, options);
   ASSERT_TRUE(differ.checked) << differ.why_not;
   EXPECT_EQ(differ.executions_simulated, 15);
   EXPECT_EQ(differ.placements, 3);
+  EXPECT_EQ(fake.cells(), 2);  // one recording per knob value
   EXPECT_GT(differ.separation.d2, 11.7 / 10);  // separable within the proposed 10 executions
   EXPECT_TRUE(differ.confirmed) << "z " << differ.separation.z << " p " << differ.separation.p_value;
 
   // Two different knobs that change nothing (each at its nominal value): identical physics.
-  const sim::KnobValue kp_nominal{KnobIndex(knobs, "actuators.kp_scale"), 1.0};
-  const sim::KnobValue damping_nominal{KnobIndex(knobs, "joints.damping_scale"), 1.0};
-  const ExperimentCheck same = CheckExperiment(config, knobs, kp_nominal, damping_nominal, sideways, 0.0, roll, 10, options);
+  const ExperimentCheck same = CheckExperiment(fake, {test::kFriction, 1.0}, {test::kLeftGain, 1.0}, forward, downhill,
+                                               10, options);
   ASSERT_TRUE(same.checked) << same.why_not;
   EXPECT_EQ(same.separation.d2, 0.0);
   EXPECT_FALSE(same.confirmed);
   EXPECT_EQ(same.separation.executions_needed, -1);
-}
-
-TEST(SimulateCell, SameSeedPairsTheRunsAndTheHeadingGivesTheTerrain) {
-  const sim::SimConfig config;
-  sim::CellOptions cell;
-  cell.command = Eigen::Vector3d(0.5, 0, 0);
-  cell.placements = 1;
-  cell.executions_per_placement = 2;
-  cell.seed = 3;
-  // Facing downhill the torso pitches nose down (pitch > 0, docs: z_frame).
-  const double slope = config.slope_deg * M_PI / 180;
-  cell.heading_rad = sim::HeadingForTerrain(config, slope, 0.0);
-  const SampleSet a = sim::SimulateCell(config, cell);
-  const SampleSet b = sim::SimulateCell(config, cell);
-  ASSERT_EQ(a.size(), 2);
-  EXPECT_EQ(a.x, b.x);
-  EXPECT_NEAR(a.z(0, 0), slope, 0.1);
-  EXPECT_NEAR(a.z(0, 1), 0.0, 0.1);
-  EXPECT_EQ(a.command_labels[a.command(0)], "+0.5,0,0");
-  cell.placements = 0;
-  EXPECT_THROW(sim::SimulateCell(config, cell), InputError);
 }
 
 TEST(Verdict, ExperimentCheckFieldsInTheJson) {

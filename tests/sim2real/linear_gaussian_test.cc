@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "sim2real/synthetic.h"
+#include "tests/sim2real/synthetic.h"
 
 namespace dgmm::sim2real {
 namespace {

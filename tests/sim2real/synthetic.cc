@@ -1,4 +1,4 @@
-#include "sim2real/synthetic.h"
+#include "tests/sim2real/synthetic.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,6 +10,11 @@
 
 namespace dgmm::sim2real {
 namespace {
+
+// Unit gravity in the body frame at pitch p and roll r (ZYX Euler, x forward, y left, z up).
+Eigen::Vector3d BodyGravity(double pitch, double roll) {
+  return {std::sin(pitch), -std::sin(roll) * std::cos(pitch), -std::cos(roll) * std::cos(pitch)};
+}
 
 // Nominal motion of the analytic robot (m, rad per execution) for command (l, a, t) and unit
 // gravity g in the body frame: walking downhill goes a little further.

@@ -1,0 +1,163 @@
+#include "sim2real/adequacy.h"
+
+#include <algorithm>
+#include <map>
+
+#include "sim2real/sentence_format.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+std::string Value(double v, const std::string& unit) { return Fmt("%.4g", v) + (unit.empty() ? "" : " " + unit); }
+
+KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const AdequacyOptions& options) {
+  KnobCheck check;
+  const int k = r.selection.selected[pos];
+  const KnobCandidate& c = set.candidates[k];
+  check.candidate = k;
+  check.fitted = CandidateValue(set, r, k, r.selection.fit.theta[pos]);
+  check.value = check.fitted;
+  if (!c.simulated && c.family != "tracker_noise") return check;  // a measurement offset has no range
+  const double lo = c.family == "tracker_noise" && c.lo == c.hi ? -INFINITY : c.lo;
+  const double hi = c.family == "tracker_noise" && c.lo == c.hi ? INFINITY : c.hi;
+  check.value = std::clamp(check.fitted, lo, hi);
+  const double tol = options.pinned_within * (std::isfinite(hi - lo) ? hi - lo : 1.0);
+  check.outside_range = check.fitted < lo - tol || check.fitted > hi + tol;
+  check.pinned_low = std::isfinite(lo) && check.value <= lo + tol && c.nominal > lo + tol;
+  check.pinned_high = std::isfinite(hi) && check.value >= hi - tol && c.nominal < hi - tol;
+  check.impossible = check.fitted < c.physical_min || (check.fitted <= c.physical_min && c.family != "payload");
+  for (const auto& f : r.refined) check.unconverged |= f.candidate == k && !f.converged;
+  if (check.impossible) {
+    check.doubts.push_back(c.knob + " fitted at " + Value(check.fitted, c.unit) + ", which no robot can have (at least " +
+                           Value(c.physical_min, c.unit) + ")");
+  } else if (check.outside_range) {
+    check.doubts.push_back(c.knob + " fitted at " + Value(check.fitted, c.unit) + ", outside its range [" +
+                           Value(c.lo, "") + ", " + Value(c.hi, c.unit) + "]");
+  }
+  if (check.pinned_low || check.pinned_high) {
+    check.doubts.push_back(c.knob + " pinned at its " + (check.pinned_low ? "lower" : "upper") + " limit " +
+                           Value(check.pinned_low ? lo : hi, c.unit));
+  }
+  if (check.unconverged) {
+    for (const auto& f : r.refined) {
+      if (f.candidate == k && !f.converged) {
+        check.doubts.push_back(c.knob + Fmt(": its refinement did not converge (best signature coefficient %.2f, "
+                                            "1 expected)", f.coefficient));
+      }
+    }
+  }
+  return check;
+}
+
+// Residual structure and drift of each selected mean effect (drift.h, residual_structure.h).
+void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refinement& r, const AdequacyOptions& options,
+                  Adequacy* out) {
+  const FitProblem& fp = r.problem;
+  const EffectFit& fit = r.selection.fit;
+  const int n = fp.n, dx = fp.dx;
+  Eigen::MatrixXd resid = fp.r0;
+  Eigen::MatrixXd total = Eigen::MatrixXd::Zero(n, dx);
+  std::vector<Eigen::MatrixXd> shifts;
+  for (size_t k = 0; k < fit.effects.size(); ++k) {
+    Eigen::VectorXd s = WhitenedShift(fp, fit, static_cast<int>(k));
+    const Eigen::MatrixXd shift = Eigen::Map<Eigen::MatrixXd>(s.data(), dx, n).transpose();
+    resid -= shift;
+    if (!fp.library[fit.effects[k]].is_noise) shifts.push_back(shift), total += shift;
+  }
+  std::vector<int> step(n, -1);
+  if (in.real.has_sequence && in.real_set.has_sequence()) {
+    for (int i = 0; i < n; ++i) step[i] = in.real_set.step(in.real_source_row[i]);
+  }
+  std::vector<EffectDrift> drifts, step_drifts;
+  for (size_t q = 0, k = 0; k < fit.effects.size(); ++k) {
+    if (fp.library[fit.effects[k]].is_noise) continue;
+    drifts.push_back(TestEffectDrift(resid, shifts[q], in.real.command, in.real.episode, options.drift, options.seed + 1 + k));
+    step_drifts.push_back(TestEffectStepVariation(resid, shifts[q], in.real.episode, step, options.drift, options.seed + 101 + k));
+    out->drift_tests.push_back({fit.effects[k], {}, {}});
+    ++q;
+  }
+  out->total_drift = TestEffectDrift(resid, total, in.real.command, in.real.episode, options.drift, options.seed);
+  out->total_step_variation = TestEffectStepVariation(resid, total, in.real.episode, step, options.drift, options.seed + 100);
+  MarkDrifting(&out->total_drift, &drifts, options.drift);
+  MarkDrifting(&out->total_step_variation, &step_drifts, options.drift);
+  for (size_t q = 0; q < drifts.size(); ++q) out->drift_tests[q].drift = drifts[q], out->drift_tests[q].step_variation = step_drifts[q];
+  out->residuals = resid * std::exp(-fit.log_tau);
+  std::vector<int> terrain_id(n, -1);
+  if (in.real.terrain_dim() > 0 && base.terrain_centres.rows() > 0) terrain_id = base.real_terrain;
+  const double sim_kurtosis = ExcessKurtosis(base.sim_model.WhitenedResiduals(in.sim));
+  out->residual = TestResidualStructure(out->residuals, in.real.command, terrain_id, in.real.episode, step, sim_kurtosis,
+                                        options.residual, options.seed);
+}
+
+// The held-out fit against the ceiling; the located regions that remain.
+void TestFit(const AnalysisInputs& in, const Baseline& base, const Refinement& r, const AdequacyOptions& options,
+             Adequacy* out) {
+  const Eigen::VectorXd& corrected = r.selection.heldout_corrected;
+  out->ll_corrected = corrected.mean();
+  ClusteredMean(base.heldout_ceiling - corrected, in.real.episode, &out->shortfall, &out->shortfall_se);
+  GapClosed(base.heldout_sim, corrected, base.heldout_ceiling, in.real.episode, &out->gap_closed, &out->gap_closed_se);
+  out->below_ceiling = out->shortfall > options.min_shortfall_nats && out->shortfall > options.shortfall_z * out->shortfall_se;
+  if (out->below_ceiling) {
+    out->doubts.push_back(Fmt("the corrected model stays %.3f nats per real sample (SE %.3f) below the real-trained "
+                              "ceiling", out->shortfall, out->shortfall_se) +
+                          (std::isfinite(out->gap_closed) ? Fmt(" (%.0f%% of the gap closed)", 100 * out->gap_closed) : ""));
+  }
+  std::mt19937_64 rng(options.seed + 7);
+  out->after = LocateModel(in, base, out->residuals, corrected, false, options.locate, rng);
+  for (const auto& g : out->after.significant) {
+    if (g.deficit > 0) out->remaining.push_back(g);  // where the correction beats the ceiling it leaves nothing
+  }
+  if (!out->remaining.empty()) {
+    // One doubt naming the worst regions (remaining is sorted by deficit).
+    std::string where;
+    for (size_t k = 0; k < out->remaining.size() && k < 3; ++k) {
+      const Region& g = out->remaining[k];
+      where += (k ? "; " : "") + g.label + Fmt(" (%.2f nats per sample below the ceiling, q %.2g)", g.deficit, g.q_value);
+    }
+    if (out->remaining.size() > 3) where += Fmt(" and %.0f more region(s)", out->remaining.size() - 3.0);
+    out->doubts.push_back("mismatch remains after the correction in " + where);
+  }
+}
+
+}  // namespace
+
+bool AdequacyOptions::IsValid(std::string* error) const {
+  if (!(shortfall_z > 0) || !(min_shortfall_nats >= 0) || !(pinned_within >= 0 && pinned_within < 0.5)) {
+    if (error) *error = "shortfall_z > 0, min_shortfall_nats >= 0, 0 <= pinned_within < 0.5";
+    return false;
+  }
+  return locate.IsValid(error) && residual.IsValid(error) && drift.IsValid(error);
+}
+
+void GapClosed(const Eigen::VectorXd& sim, const Eigen::VectorXd& corrected, const Eigen::VectorXd& ceiling,
+               const std::vector<int>& cluster, double* gap, double* se) {
+  const Eigen::VectorXd d = corrected - sim, g = ceiling - sim;
+  const double n = static_cast<double>(d.size());
+  const double gm = g.mean();
+  *gap = gm > 1e-9 ? d.mean() / gm : NAN;
+  *se = NAN;
+  if (!std::isfinite(*gap)) return;
+  std::map<int, double> sums;
+  for (Eigen::Index i = 0; i < d.size(); ++i) sums[cluster[i]] += d(i) - *gap * g(i);
+  const double c = static_cast<double>(sums.size());
+  if (c < 2) return;
+  double v = 0;
+  for (const auto& [k, s] : sums) v += s * s;
+  *se = std::sqrt(c / (c - 1) * v) / (n * gm);
+}
+
+Adequacy AssessAdequacy(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, const Refinement& r,
+                        const AdequacyOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "adequacy options", error);
+  Adequacy out;
+  TestResidual(in, base, r, options, &out);
+  TestFit(in, base, r, options, &out);
+  for (size_t pos = 0; pos < r.selection.selected.size(); ++pos) {
+    out.checks.push_back(CheckKnob(set, r, static_cast<int>(pos), options));
+  }
+  return out;
+}
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,85 @@
+#include "sim2real/analysis.h"
+
+#include <chrono>
+#include <random>
+
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double Since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// The named simulator knobs at their values: one-parameter knobs, and the payload's mass with the
+// position its refinement recorded (the nominal position when it was not refined).
+std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement& r, const Verdict& v,
+                                       const std::vector<int>& named) {
+  std::vector<KnobValue> out;
+  for (size_t j = 0; j < named.size() && j < v.named.size(); ++j) {
+    const KnobCandidate& c = set.candidates[named[j]];
+    if (c.knob_index >= 0) out.push_back({c.knob_index, v.named[j].value});
+    if (c.key == "payload" && set.payload_knob[0] >= 0) {
+      out.push_back({set.payload_knob[0], v.named[j].value});
+      if (std::isfinite(r.payload_x)) out.push_back({set.payload_knob[1], r.payload_x});
+      if (std::isfinite(r.payload_y)) out.push_back({set.payload_knob[2], r.payload_y});
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+bool AnalysisOptions::IsValid(std::string* error) const {
+  return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
+         ties.IsValid(error) && verdict.IsValid(error);
+}
+
+Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
+                 const AnalysisOptions& options, const std::string& no_simulator_reason) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "analysis options", error);
+  auto stage = [&](const std::string& name) {
+    if (options.on_stage) options.on_stage(name);
+  };
+  const auto start = Clock::now();
+  Analysis a;
+  stage("inputs and locate");
+  a.inputs = PrepareInputs(sim, real, options.seed);
+  a.baseline = LocateMismatch(a.inputs, options.locate);
+  a.seconds.locate = Since(start);
+  if (!simulator) {
+    a.locate_only_because = no_simulator_reason;
+    a.verdict = LocateOnlyVerdict(a.baseline, no_simulator_reason);
+    a.seconds.total = Since(start);
+    return a;
+  }
+  a.knobs_analysed = true;
+  auto t = Clock::now();
+  stage("candidates (knob signatures)");
+  a.candidates = BuildCandidates(*simulator, a.inputs, a.baseline, options.candidates);
+  a.seconds.candidates = Since(t), t = Clock::now();
+  stage("selection and refinement");
+  a.refinement = SelectAndRefine(*simulator, a.inputs, a.baseline, options.candidates, options.refine, &a.candidates);
+  a.seconds.refine = Since(t), t = Clock::now();
+  stage("confidence (bootstrap)");
+  std::mt19937_64 rng(options.seed + 1);
+  a.confidence = AssessConfidence(a.candidates, a.refinement, rng);
+  a.seconds.confidence = Since(t), t = Clock::now();
+  stage("adequacy");
+  a.adequacy = AssessAdequacy(a.inputs, a.baseline, a.candidates, a.refinement, options.adequacy);
+  a.naming = DecideNamed(a.candidates, a.refinement, a.confidence, a.adequacy, options.verdict);
+  a.seconds.adequacy = Since(t), t = Clock::now();
+  stage("ties and experiment checks");
+  a.ties = FindTies(simulator, a.inputs, a.baseline, a.candidates, a.refinement, a.naming.named, options.ties);
+  a.seconds.ties = Since(t);
+  a.verdict = ComposeVerdict(a.baseline, a.candidates, a.refinement, a.confidence, a.adequacy, a.naming, a.ties,
+                             options.verdict);
+  a.correction = MakeCorrection(a.inputs, a.baseline, a.candidates, a.refinement.selection.fit);
+  a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);
+  a.seconds.total = Since(start);
+  return a;
+}
+
+}  // namespace dgmm::sim2real

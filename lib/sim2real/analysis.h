@@ -1,0 +1,63 @@
+#pragma once
+// dgmm sim2real: why a simulation disagrees with the real robot (docs/sim2real.md), as a short
+// sequence of named stages, each in its own file:
+//   1. inputs      (inputs.h)        the two sets in raw units, commands aligned, the sim recording;
+//   2. baseline    (baseline.h)      locate: where the sim model fails, against a real-trained ceiling;
+//   3. candidates  (candidates.h)    the simulator's knobs' signatures and the measurement effects;
+//   4. refine      (refine.h)        selection by held-out likelihood, refined by re-recording;
+//   5. confidence  (confidence.h)    bootstrap inclusion per family, the values' intervals;
+//   6. adequacy    (adequacy.h)      locate again on the correction, the fit against the ceiling,
+//                                    values pinned or impossible, residual structure and drift;
+//   7. ties        (ties.h)          what the data cannot tell apart, and the experiment that would;
+//   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence;
+//   9. report      (report.h)        report.json, report.html, the stdout summary (in the app).
+// Without a simulator the analysis stops after stage 2 and says so.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "sim2real/correction.h"
+#include "sim2real/verdict_stage.h"
+
+namespace dgmm::sim2real {
+
+struct AnalysisOptions {
+  std::uint64_t seed = 1;  // of folds, bootstrap, permutations and k-means (stages copy it)
+  BaselineOptions locate;
+  CandidateOptions candidates;
+  RefineOptions refine;
+  AdequacyOptions adequacy;
+  TieOptions ties;
+  VerdictOptions verdict;
+  std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
+  bool IsValid(std::string* error) const;
+};
+
+struct StageTimes {
+  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, total = 0;
+};
+
+struct Analysis {
+  AnalysisInputs inputs;
+  Baseline baseline;
+  bool knobs_analysed = false;     // false: locate only (no simulator)
+  std::string locate_only_because;
+  CandidateSet candidates;
+  Refinement refinement;
+  Confidence confidence;
+  Adequacy adequacy;
+  Naming naming;
+  TieResult ties;
+  Verdict verdict;
+  Correction correction;           // the knob correction (empty without a simulator)
+  std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)
+  StageTimes seconds;
+};
+
+// `simulator` null: locate only, `no_simulator_reason` saying why. Throws InputError for sets
+// that cannot be compared and for a simulator that cannot record the sim set's protocol.
+Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
+                 const AnalysisOptions& options, const std::string& no_simulator_reason = "");
+
+}  // namespace dgmm::sim2real

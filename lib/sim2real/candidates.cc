@@ -1,0 +1,255 @@
+#include "sim2real/candidates.h"
+
+#include <algorithm>
+
+#include "sim2real/sentence_format.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+struct Probe {
+  int knob = -1;
+  double value = 0;
+  SampleSet set;
+};
+
+bool SameRecording(const SampleSet& a, const SampleSet& b) {
+  return a.x.rows() == b.x.rows() && a.x.cols() == b.x.cols() && a.z.rows() == b.z.rows() &&
+         a.z.cols() == b.z.cols() && a.x == b.x && a.z == b.z;
+}
+
+Recording OwnRecording(const AnalysisInputs& in, const CandidateOptions& options) {
+  Recording r = in.recording;
+  r.placements = options.placements;
+  return r;
+}
+
+// Records the probes of the listed knobs (and the nominal when `set` has none yet).
+std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& in, const std::vector<int>& knobs,
+                                const CandidateOptions& options, CandidateSet* set) {
+  std::vector<std::vector<KnobValue>> requests;
+  std::vector<Probe> probes;
+  const bool need_nominal = set->nominal.size() == 0;
+  if (need_nominal) requests.emplace_back();
+  for (int k : knobs) {
+    for (double v : sim.knobs()[k].probes) {
+      requests.push_back({KnobValue{k, v}});
+      probes.push_back({k, v, {}});
+    }
+  }
+  RecordingBatch batch = RecordBatch(sim, OwnRecording(in, options), requests, options.recording);
+  set->recorded += batch.recorded;
+  set->from_cache += batch.from_cache;
+  set->requests += static_cast<int>(requests.size());
+  set->seconds += batch.wall_seconds;
+  if (need_nominal) set->nominal = std::move(batch.sets[0]);
+  for (size_t p = 0; p < probes.size(); ++p) probes[p].set = std::move(batch.sets[p + (need_nominal ? 1 : 0)]);
+  return probes;
+}
+
+void AddMeasurement(const KnobCandidate& c, const EffectSpec& spec, ExternalCandidate::Kind kind, CandidateSet* set) {
+  set->candidates.push_back(c);
+  set->library.push_back(spec);
+  ExternalCandidate e;
+  e.kind = kind;
+  set->externals.push_back(e);
+}
+
+// Tracker bias (every pose axis but yaw) and noise: first in the library.
+void AddTrackerEffects(const AnalysisInputs& in, CandidateSet* set) {
+  const int dx = in.real.pose_dim();
+  AddMeasurement({"tracker_bias", "tracker_bias", "tracker.offset", "x units"},
+                 ExternalSpec("tracker_bias", "constant offset of the tracked pose", in.layout.dyaw >= 0 ? dx - 1 : dx,
+                              "x units"),
+                 ExternalCandidate::kTrackerBias, set);
+  KnobCandidate noise{"tracker_noise", "tracker_noise", "tracker.noise_scale", ""};
+  noise.nominal = 1;
+  noise.physical_min = 0;
+  AddMeasurement(noise, NoiseEffect(), ExternalCandidate::kShift, set);
+}
+
+// IMU pitch/roll bias (with terrain) and heading drift (with yaw): last in the library.
+void AddImuAndHeading(const AnalysisInputs& in, CandidateSet* set) {
+  if (in.real.terrain_dim() >= 2) {
+    AddMeasurement({"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad"},
+                   ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"), ExternalCandidate::kImuBias, set);
+  }
+  if (in.layout.dyaw >= 0) {
+    AddMeasurement({"heading_drift", "heading_drift", "tracker.yaw_drift", "rad per execution"},
+                   ExternalSpec("heading_drift", "heading drift per execution", 1, "rad per execution"),
+                   ExternalCandidate::kHeading, set);
+  }
+}
+
+// One-parameter shift candidates, the payload and the tracker's spread probe from the probes (in
+// knob order); inert probes are listed, not candidates.
+void AddKnobCandidates(const KnobSimulator& sim, const AnalysisInputs& in, const std::vector<Probe>& probes,
+                       double slope_ridge, CandidateSet* set) {
+  const auto& knobs = sim.knobs();
+  for (const Probe& p : probes) {
+    const Knob& k = knobs[p.knob];
+    const bool payload = k.role == Knob::Role::kPayloadMass || k.role == Knob::Role::kPayloadX ||
+                         k.role == Knob::Role::kPayloadY;
+    if (!payload && SameRecording(p.set, set->nominal)) {
+      if (std::find(set->inert_knobs.begin(), set->inert_knobs.end(), k.name) == set->inert_knobs.end()) {
+        set->inert_knobs.push_back(k.name);
+      }
+      continue;
+    }
+    set->shifts.push_back(PairedShift::Fit(set->nominal, p.set, in.sim_set, slope_ridge));
+    const int s = static_cast<int>(set->shifts.size()) - 1;
+    if (payload) {
+      const int slot = k.role == Knob::Role::kPayloadMass ? 0 : k.role == Knob::Role::kPayloadX ? 1 : 2;
+      set->payload_knob[slot] = p.knob;
+      set->payload_shift[slot] = s;
+      continue;
+    }
+    if (k.role == Knob::Role::kSpread) {
+      set->tracker_knob = p.knob, set->tracker_shift = s, set->tracker_probe = p.value;
+      continue;
+    }
+    KnobCandidate c{k.name + Fmt("@%.4g", p.value), k.family, k.name, k.unit, p.knob, k.nominal, p.value, k.lo, k.hi,
+                    k.physical_min, true, k.leg, k.side};
+    set->candidates.push_back(c);
+    set->library.push_back(ExternalSpec(c.key, k.name + " (simulated)", 1, "fraction of the probe's change"));
+    ExternalCandidate e;
+    e.shifts = {s};
+    set->externals.push_back(e);
+  }
+}
+
+void AddPayload(const KnobSimulator& sim, CandidateSet* set) {
+  if (set->payload_shift[0] < 0 || set->payload_shift[1] < 0 || set->payload_shift[2] < 0) return;
+  const Knob& k = sim.knobs()[set->payload_knob[0]];
+  KnobCandidate c{"payload", "payload", k.name, k.unit, -1, k.nominal, k.probes.empty() ? k.nominal : k.probes[0],
+                  k.lo, k.hi, k.physical_min, true, "", ""};
+  set->candidates.push_back(c);
+  set->library.push_back(ExternalSpec("payload", "payload on the torso (simulated)", 3, "fraction of the probe"));
+  ExternalCandidate e;
+  e.kind = ExternalCandidate::kPayload;
+  e.shifts = {set->payload_shift[0], set->payload_shift[1], set->payload_shift[2]};
+  set->externals.push_back(e);
+}
+
+// Builds the library from the probes (library order: tracker bias, tracker noise, knob probes in
+// knob order, payload, IMU bias, heading drift).
+void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vector<Probe> probes,
+                  double slope_ridge, CandidateSet* set) {
+  std::stable_sort(probes.begin(), probes.end(), [](const Probe& a, const Probe& b) { return a.knob < b.knob; });
+  set->candidates.clear(), set->library.clear(), set->externals.clear(), set->shifts.clear();
+  set->inert_knobs.clear();
+  AddTrackerEffects(in, set);
+  AddKnobCandidates(sim, in, probes, slope_ridge, set);
+  AddPayload(sim, set);
+  AddImuAndHeading(in, set);
+}
+
+// Is a side implicated: a side knob's candidate selected, or among the `side_top` best candidates
+// of a forward step with a positive held-out gain at z >= side_min_z (a weak leg shows first as
+// its side, often below the step's Bonferroni threshold while other effects stand in for it).
+bool SideImplicated(const CandidateSet& set, const FitProblem& fp, const Baseline& base,
+                    const CandidateOptions& options, std::string* why) {
+  std::vector<int> rows(fp.n);
+  for (int i = 0; i < fp.n; ++i) rows[i] = i;
+  SelectionOptions quick = options.first_pass;
+  quick.bootstrap_selection = 0;
+  quick.backward = true;
+  const SelectionResult sel = ForwardSelect(fp, rows, base.fold, quick);
+  for (int e : sel.selected) {
+    if (!set.candidates[e].side.empty()) {
+      *why = set.candidates[e].knob + " was selected in the first pass";
+      return true;
+    }
+  }
+  for (size_t s = 0; s < sel.steps.size(); ++s) {
+    const auto& cands = sel.steps[s].candidates;
+    for (size_t r = 0; r < cands.size() && static_cast<int>(r) < options.side_top; ++r) {
+      if (!set.candidates[cands[r].effect].side.empty() && cands[r].gain > 0 && cands[r].z >= options.side_min_z) {
+        *why = set.candidates[cands[r].effect].knob + Fmt(" ranked %.0f of the first pass's step %.0f", r + 1.0, s + 1.0) +
+               Fmt(" (held-out z %.1f)", cands[r].z);
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+bool CandidateOptions::IsValid(std::string* error) const {
+  if (placements < 0 || !(slope_ridge >= 0) || side_top < 1) {
+    if (error) *error = "placements >= 0, slope_ridge >= 0 and side_top >= 1";
+    return false;
+  }
+  return recording.IsValid(error) && first_pass.IsValid(error);
+}
+
+void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, int k,
+                         FitProblem* fp) {
+  if (set.library[k].is_noise) return;
+  const Samples& real = in.real;
+  for (int i = 0; i < real.size(); ++i) {
+    SetDesign(fp, k, i,
+              ExternalDesign(set.externals[k], set.shifts, base.sim_model, in.layout, real.pose_dim(), real.command[i],
+                             real.z.row(i).transpose(), real.first_execution[i]));
+  }
+}
+
+FitProblem MakeCandidateProblem(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set) {
+  FitProblem fp = MakeFitProblem(in.real, base.sim_model, set.library);
+  for (size_t k = 0; k < set.library.size(); ++k) FillCandidateDesign(in, base, set, static_cast<int>(k), &fp);
+  return fp;
+}
+
+PairedShift RecordShift(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                        const std::vector<KnobValue>& values, const CandidateOptions& options, int* recorded,
+                        int* from_cache) {
+  const RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), {values}, options.recording);
+  *recorded += batch.recorded;
+  *from_cache += batch.from_cache;
+  return PairedShift::Fit(set.nominal, batch.sets[0], in.sim_set, options.slope_ridge);
+}
+
+CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                             const CandidateOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "candidate options", error);
+  if (!in.sim_set.has_sequence()) {
+    throw MakeInputError("--sim", "episode", "signatures need the sim set's episodes and steps");
+  }
+  const auto& knobs = simulator.knobs();
+  std::vector<int> first, legs;
+  bool any_side = false;
+  for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
+    (knobs[k].leg.empty() ? first : legs).push_back(k);
+    any_side |= !knobs[k].side.empty();
+  }
+  const bool gate = options.legs_only_when_implicated && any_side && !legs.empty();
+  CandidateSet set;
+  std::vector<Probe> probes = RecordProbes(simulator, in, gate ? first : [&] {
+    std::vector<int> all = first;
+    all.insert(all.end(), legs.begin(), legs.end());
+    return all;
+  }(), options, &set);
+  BuildLibrary(simulator, in, probes, options.slope_ridge, &set);
+  set.legs_probed = !gate && !legs.empty();
+  if (!gate) {
+    set.legs_note = legs.empty() ? "" : "per-leg probes recorded (the robot has no side knobs to test first)";
+    if (!options.legs_only_when_implicated && !legs.empty()) set.legs_note = "per-leg probes recorded (always)";
+    return set;
+  }
+  std::string why;
+  if (!SideImplicated(set, MakeCandidateProblem(in, base, set), base, options, &why)) {
+    set.legs_note = "per-leg probes not recorded: no side knob is implicated by the first pass";
+    return set;
+  }
+  std::vector<Probe> leg_probes = RecordProbes(simulator, in, legs, options, &set);
+  probes.insert(probes.end(), std::make_move_iterator(leg_probes.begin()), std::make_move_iterator(leg_probes.end()));
+  BuildLibrary(simulator, in, probes, options.slope_ridge, &set);
+  set.legs_probed = true;
+  set.legs_note = "per-leg probes recorded: " + why;
+  return set;
+}
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,80 @@
+#pragma once
+// Stage 3 of the analysis (analysis.h): the candidate physics. Each simulator knob's probes are
+// recorded with the sim set's own recording (common random numbers) and become candidates with
+// their paired shift as signature (signatures.h); the payload's three probes one three-parameter
+// candidate; plus the measurement effects no simulator models (tracker bias, tracker noise, IMU
+// pitch/roll bias, heading drift). A probe that changes nothing is inert, not a candidate.
+//
+// Per-leg probes cost one recording per leg and value: they are recorded only when a cheaper
+// first pass (every other knob) implicates a side, i.e. a side knob is selected or ranks among the
+// best `side_top` candidates of a forward step with held-out z >= side_min_z, or when the robot
+// has no side knobs at all.
+#include <string>
+#include <vector>
+
+#include "sim2real/baseline.h"
+#include "sim2real/effect_fit.h"
+#include "sim2real/inputs.h"
+#include "sim2real/knob_design.h"
+#include "sim2real/knob_simulator.h"
+#include "sim2real/selection.h"
+#include "sim2real/signatures.h"
+#include "sim2real/simulation_cache.h"
+
+namespace dgmm::sim2real {
+
+struct CandidateOptions {
+  int placements = 78;          // per recording (0: the protocol's own)
+  double slope_ridge = 5.0;     // PairedShift's pull of each command's slopes to the pooled ones
+  RecordingOptions recording;   // cache and threads
+  bool legs_only_when_implicated = true;
+  SelectionOptions first_pass;  // the selection that decides whether a side is implicated
+  int side_top = 3;             // ... by a side knob among this many best candidates of a step
+  double side_min_z = 1.0;      // ... with at least this held-out z
+  bool IsValid(std::string* error) const;
+};
+
+struct KnobCandidate {
+  std::string key;      // e.g. "floor.friction.sliding@0.6", "payload", "tracker_bias"
+  std::string family;
+  std::string knob;     // knob name ("payload.mass_kg" for the payload)
+  std::string unit;
+  int knob_index = -1;  // the simulator's knob of a one-parameter simulated candidate (else -1)
+  double nominal = 0, probe = 0, lo = 0, hi = 0;  // probe: the simulated value
+  double physical_min = -1e300;
+  bool simulated = false;  // a simulator knob (else a measurement effect)
+  std::string leg, side;
+};
+
+struct CandidateSet {
+  std::vector<KnobCandidate> candidates;    // parallel to library and externals
+  std::vector<EffectSpec> library;
+  std::vector<ExternalCandidate> externals;
+  std::vector<PairedShift> shifts;          // the probes' paired shifts (refinement appends)
+  SampleSet nominal;                        // the nominal re-recording
+  int payload_knob[3] = {-1, -1, -1};       // mass, x, y knob indices
+  int payload_shift[3] = {-1, -1, -1};      // their probes' shifts
+  int tracker_knob = -1, tracker_shift = -1;  // the tracker-noise knob's spread probe
+  double tracker_probe = 1;
+  std::vector<std::string> inert_knobs;
+  bool legs_probed = false;
+  std::string legs_note;                    // why per-leg probes were or were not recorded
+  int recorded = 0, from_cache = 0, requests = 0;
+  double seconds = 0;
+};
+
+CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                             const CandidateOptions& options);
+
+// The fit problem of the real samples with every candidate's design.
+FitProblem MakeCandidateProblem(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set);
+// Refills the designs of candidate k (after its shifts changed).
+void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, int k,
+                         FitProblem* fp);
+
+// The recording of the sim set at knob values, as its paired shift from the nominal.
+PairedShift RecordShift(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                        const std::vector<KnobValue>& values, const CandidateOptions& options, int* recorded,
+                        int* from_cache);
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,88 @@
+#include "sim2real/inputs.h"
+
+#include <set>
+
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+// The real samples whose command the sim set has; their source rows; what was dropped.
+void KeepSharedCommands(AnalysisInputs* in, const std::vector<int>& real_map) {
+  const std::set<int> sim_commands(in->sim.command.begin(), in->sim.command.end());
+  std::vector<int> keep, rows;
+  int k = 0;
+  std::set<int> dropped;
+  for (int i = 0; i < in->real_set.size(); ++i) {
+    const int c = in->real_set.command(i);
+    const bool mapped = real_map[c] >= 0;
+    if (mapped && sim_commands.count(real_map[c])) {
+      keep.push_back(k);
+      rows.push_back(i);
+    } else {
+      dropped.insert(c);
+      ++in->dropped_samples;
+    }
+    if (mapped) ++k;  // MakeSamples keeps the set's order for mapped commands
+  }
+  in->real = SubsetSamples(in->real, keep);
+  in->real_source_row = rows;
+  for (int c : dropped) {
+    in->dropped_commands.push_back(c < static_cast<int>(in->real_set.command_labels.size())
+                                       ? in->real_set.command_labels[c] : std::to_string(c));
+  }
+}
+
+Recording SimRecording(const SampleSet& sim, std::uint64_t fallback_seed, bool* from_metadata) {
+  Recording r;
+  r.protocol = "paper";
+  r.seed = fallback_seed;
+  auto protocol = sim.metadata.find("protocol");
+  auto seed = sim.metadata.find("seed");
+  *from_metadata = protocol != sim.metadata.end() && seed != sim.metadata.end();
+  if (protocol != sim.metadata.end()) r.protocol = protocol->second;
+  if (seed != sim.metadata.end()) {
+    try {
+      r.seed = std::stoull(seed->second);
+    } catch (const std::exception&) {
+      throw MakeInputError("--sim", "metadata seed", "'" + seed->second + "' is not a non-negative integer");
+    }
+  }
+  return r;
+}
+
+}  // namespace
+
+AnalysisInputs PrepareInputs(const SampleSet& sim_in, const SampleSet& real_in, std::uint64_t fallback_seed) {
+  for (const auto* set : {&sim_in, &real_in}) {
+    const std::string problem = set->Validate();
+    if (!problem.empty()) throw MakeInputError(set == &sim_in ? "--sim" : "--real", "", problem);
+  }
+  AnalysisInputs in;
+  in.sim_set = ToRawUnits(sim_in, "--sim");
+  in.real_set = ToRawUnits(real_in, "--real");
+  const std::vector<int> real_map = AlignCommands(in.sim_set, in.real_set);
+  std::vector<int> identity(in.sim_set.num_commands());
+  for (int c = 0; c < in.sim_set.num_commands(); ++c) identity[c] = c;
+  in.sim = MakeSamples(in.sim_set, identity);
+  in.real = MakeSamples(in.real_set, real_map);
+  KeepSharedCommands(&in, real_map);
+  if (in.real.size() < 10) {
+    throw MakeInputError("--real", "", "fewer than 10 real samples share a command with the sim set");
+  }
+  in.layout = DetectPoseLayout(in.sim_set);
+  for (int c = 0; c < in.sim_set.num_commands(); ++c) {
+    in.command_labels.push_back(c < static_cast<int>(in.sim_set.command_labels.size())
+                                    ? in.sim_set.command_labels[c] : std::to_string(c));
+  }
+  const std::set<int> rc(in.real.command.begin(), in.real.command.end());
+  in.real_commands.assign(rc.begin(), rc.end());
+  double first = 0;
+  for (int f : in.real.first_execution) first += f;
+  in.first_execution_share = first / in.real.size();
+  in.recording = SimRecording(in.sim_set, fallback_seed, &in.recording_from_metadata);
+  DetectTerrainColumns(in.real_set, &in.pitch_col, &in.roll_col);
+  return in;
+}
+
+}  // namespace dgmm::sim2real

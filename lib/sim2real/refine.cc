@@ -1,0 +1,204 @@
+#include "sim2real/refine.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "sim2real/sentence_format.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+// What every refinement needs besides its own knob.
+struct RefineContext {
+  const KnobSimulator& simulator;
+  const AnalysisInputs& in;
+  const Baseline& base;
+  const CandidateOptions& recording;
+  const RefineOptions& options;
+  CandidateSet* set;
+  Refinement* out;
+  // Records the sim set at the values and appends its paired shift; returns its index.
+  int Record(const std::vector<KnobValue>& values) const {
+    set->shifts.push_back(RecordShift(simulator, in, *set, values, recording, &out->recorded, &out->from_cache));
+    return static_cast<int>(set->shifts.size()) - 1;
+  }
+  SelectionOptions Selection() const {
+    SelectionOptions s = options.selection;
+    s.backward = true;
+    return s;
+  }
+  void Reselect() const { out->selection = ForwardSelect(out->problem, out->rows, base.fold, Selection()); }
+};
+
+// The next value to record when refining a knob towards coefficient 1, from the (value,
+// coefficient) pairs recorded so far and the last one (`value`, coefficient `a`): inside a
+// bracket (one coefficient above 1, one below) the linear interpolation of the coefficient to 1
+// (regula falsi); otherwise the secant step nominal + a (value - nominal). Clamped to [lo, hi].
+double NextRefineValue(const std::vector<std::pair<double, double>>& trace, double nominal, double value, double a,
+                       double lo, double hi) {
+  double lo_v = NAN, lo_a = 0, hi_v = NAN, hi_a = 0;
+  for (const auto& [tv, ta] : trace) {
+    if (ta > 1 && (!std::isfinite(lo_v) || ta < lo_a)) lo_v = tv, lo_a = ta;
+    if (ta < 1 && (!std::isfinite(hi_v) || ta > hi_a)) hi_v = tv, hi_a = ta;
+  }
+  const double next = std::isfinite(lo_v) && std::isfinite(hi_v) ? lo_v + (1 - lo_a) * (hi_v - lo_v) / (hi_a - lo_a)
+                                                                 : nominal + a * (value - nominal);
+  return std::clamp(next, lo, hi);
+}
+
+int PositionIn(const std::vector<int>& v, int e) {
+  return static_cast<int>(std::find(v.begin(), v.end(), e) - v.begin());
+}
+
+// The secant / regula-falsi loop of one refinement: `record(value)` sets candidate k's shifts to a
+// new recording at `value` and returns them; the best (|coefficient - 1| smallest) is kept.
+KnobRefinement RefineLoop(const RefineContext& ctx, int k, double start, double nominal, double lo, double hi,
+                          double first_coefficient, const std::string& label,
+                          const std::function<std::vector<int>(double)>& record, bool trace_start) {
+  const int pos = PositionIn(ctx.out->selection.selected, k);
+  std::vector<std::pair<double, double>> trace;
+  if (trace_start) trace.emplace_back(ctx.set->candidates[k].probe, first_coefficient);
+  KnobRefinement r{k, label, trace_start ? ctx.set->candidates[k].probe : start, first_coefficient, false};
+  double best_err = trace_start ? std::abs(first_coefficient - 1) : INFINITY;
+  std::vector<int> best_shifts = ctx.set->externals[k].shifts;
+  double value = start;
+  FitProblem trial = ctx.out->problem;
+  for (int it = 0; it < ctx.options.refine_iterations && best_err >= ctx.options.converged_within; ++it) {
+    if (std::abs(value - nominal) < 1e-9 * (1 + std::abs(nominal))) break;
+    ctx.set->externals[k].shifts = record(value);
+    FillCandidateDesign(ctx.in, ctx.base, *ctx.set, k, &trial);
+    const double a = FitEffects(trial, ctx.out->selection.selected, {}, ctx.options.selection.fit).theta[pos](0);
+    trace.emplace_back(value, a);
+    ctx.out->trace.push_back({label, value, a});
+    if (std::abs(a - 1) < best_err) {
+      best_err = std::abs(a - 1);
+      best_shifts = ctx.set->externals[k].shifts;
+      r.value = value, r.coefficient = a, r.recorded = true;
+    }
+    value = NextRefineValue(trace, nominal, value, a, lo, hi);
+  }
+  ctx.set->externals[k].shifts = best_shifts;
+  r.converged = best_err < ctx.options.converged_within;
+  return r;
+}
+
+// The most important selected one-parameter knob not yet refined (-1: none).
+int NextToRefine(const SelectionResult& sel, const CandidateSet& set, const std::vector<int>& done) {
+  int top = -1;
+  double top_importance = -INFINITY;
+  for (size_t k = 0; k < sel.selected.size(); ++k) {
+    const int e = sel.selected[k];
+    if (set.candidates[e].knob_index >= 0 && PositionIn(done, e) == static_cast<int>(done.size()) &&
+        sel.importance[k] > top_importance) {
+      top = e, top_importance = sel.importance[k];
+    }
+  }
+  return top;
+}
+
+void RefineKnobs(const RefineContext& ctx) {
+  std::vector<int> done;
+  for (int round = 0; round < ctx.options.refine_knobs && ctx.options.refine_iterations > 0; ++round) {
+    const int top = NextToRefine(ctx.out->selection, *ctx.set, done);
+    if (top < 0) break;
+    done.push_back(top);
+    const KnobCandidate& c = ctx.set->candidates[top];
+    const int pos = PositionIn(ctx.out->selection.selected, top);
+    const double a0 = ctx.out->selection.fit.theta[pos](0);
+    ctx.out->trace.push_back({c.knob, c.probe, a0});
+    const double start = std::clamp(c.nominal + a0 * (c.probe - c.nominal), c.lo, c.hi);
+    const KnobRefinement r = RefineLoop(
+        ctx, top, start, c.nominal, c.lo, c.hi, a0, c.knob,
+        [&](double v) { return std::vector<int>{ctx.Record({KnobValue{c.knob_index, v}})}; }, true);
+    ctx.out->refined.push_back(r);
+    if (!r.recorded) continue;  // the probe's signature was already the best
+    ctx.out->signature_at[top] = r.value;
+    FillCandidateDesign(ctx.in, ctx.base, *ctx.set, top, &ctx.out->problem);
+    ctx.Reselect();
+  }
+}
+
+// The payload: recorded at the mass and position its fit implies, the mass refined along that
+// position; column 0 of its design becomes that recording (knob_design.h).
+void RefinePayload(const RefineContext& ctx) {
+  CandidateSet& set = *ctx.set;
+  const int pay = static_cast<int>(std::find_if(set.candidates.begin(), set.candidates.end(),
+                                                [](const KnobCandidate& c) { return c.key == "payload"; }) -
+                                   set.candidates.begin());
+  const int pos = PositionIn(ctx.out->selection.selected, pay);
+  if (pay >= static_cast<int>(set.candidates.size()) || pos >= static_cast<int>(ctx.out->selection.selected.size()) ||
+      ctx.options.refine_iterations == 0 || ctx.options.refine_knobs == 0) {
+    return;
+  }
+  const Eigen::VectorXd t = ctx.out->selection.fit.theta[pos];
+  if (t(0) <= 0.05) return;  // a payload heavier than nominal (a lighter one has no position to fit)
+  const auto& knobs = ctx.simulator.knobs();
+  const Knob& kx = knobs[set.payload_knob[1]];
+  const Knob& ky = knobs[set.payload_knob[2]];
+  const double px = std::clamp(kx.nominal + t(1) / t(0) * (kx.probes[0] - kx.nominal), kx.lo, kx.hi);
+  const double py = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
+  const KnobCandidate& c = set.candidates[pay];
+  const double start = std::clamp(c.nominal + t(0) * (c.probe - c.nominal), c.lo, c.hi);
+  const std::vector<int> probes = {set.payload_shift[0], set.payload_shift[1], set.payload_shift[2]};
+  const std::string label = c.knob + Fmt(" at (x %.3g, ", px) + Fmt("y %.3g) m", py);
+  const KnobRefinement r = RefineLoop(
+      ctx, pay, start, c.nominal, c.lo, c.hi, t(0), label,
+      [&](double m) {
+        const int s = ctx.Record({KnobValue{set.payload_knob[0], m}, KnobValue{set.payload_knob[1], px},
+                                  KnobValue{set.payload_knob[2], py}});
+        return std::vector<int>{s, probes[0], probes[1], probes[2]};
+      },
+      false);
+  ctx.out->refined.push_back(r);
+  if (!r.recorded) return;
+  ctx.out->payload_mass = r.value, ctx.out->payload_x = px, ctx.out->payload_y = py;
+  FillCandidateDesign(ctx.in, ctx.base, set, pay, &ctx.out->problem);
+  ctx.Reselect();
+}
+
+}  // namespace
+
+bool RefineOptions::IsValid(std::string* error) const {
+  if (refine_iterations < 0 || refine_knobs < 0 || !(converged_within > 0)) {
+    if (error) *error = "refine_iterations >= 0, refine_knobs >= 0, converged_within > 0";
+    return false;
+  }
+  return selection.IsValid(error) && spread.IsValid(error);
+}
+
+double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const Eigen::VectorXd& theta) {
+  const KnobCandidate& c = set.candidates[k];
+  if (c.key == "payload") {
+    const double at = std::isfinite(r.payload_mass) ? r.payload_mass : c.probe;
+    return c.nominal + theta(0) * (at - c.nominal);
+  }
+  if (c.knob_index >= 0) return c.nominal + theta(0) * (r.signature_at[k] - c.nominal);
+  if (c.family == "tracker_noise") return std::isfinite(r.tracker_scale) ? r.tracker_scale : std::exp(theta(0));
+  return theta.cwiseAbs().maxCoeff() * (c.family == "heading_drift" && theta(0) < 0 ? -1 : 1);
+}
+
+Refinement SelectAndRefine(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                           const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "refinement options", error);
+  const auto start = std::chrono::steady_clock::now();
+  Refinement out;
+  out.problem = MakeCandidateProblem(in, base, *set);
+  out.rows.resize(in.real.size());
+  for (int i = 0; i < in.real.size(); ++i) out.rows[i] = i;
+  out.signature_at.assign(set->candidates.size(), NAN);
+  for (size_t k = 0; k < set->candidates.size(); ++k) {
+    if (set->candidates[k].knob_index >= 0) out.signature_at[k] = set->candidates[k].probe;
+  }
+  const RefineContext ctx{simulator, in, base, recording, options, set, &out};
+  out.selection_options = ctx.Selection();
+  ctx.Reselect();
+  RefineKnobs(ctx);
+  RefinePayload(ctx);
+  RefineTrackerSpread(ctx.simulator, in, base, recording, options, set, &out);
+  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return out;
+}
+
+}  // namespace dgmm::sim2real

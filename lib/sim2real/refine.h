@@ -1,0 +1,74 @@
+#pragma once
+// Stage 4 of the analysis (analysis.h): selection by held-out real likelihood (selection.h, with
+// the backward pass), then refinement by re-recording. The most important selected one-parameter
+// knob is recorded again until its fitted coefficient is about 1 (its signature is then the
+// knob's own effect at that value, not a linear extrapolation from the probe), and the selection
+// reruns; at most `refine_knobs` knobs. The payload (mass at the centre, x and y directions) is
+// recorded at the mass and position its fit implies and the mass refined along that position.
+// A selected noise scale is the tracker's only when the selected knobs' own simulated spread
+// change does not account for it (spread.h); its scale is then refined by re-recording too.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "sim2real/candidates.h"
+#include "sim2real/spread.h"
+
+namespace dgmm::sim2real {
+
+struct RefineOptions {
+  std::uint64_t seed = 1;
+  SelectionOptions selection;     // the backward pass is always on
+  int refine_iterations = 3;      // re-recordings per refined knob (0: no refinement)
+  int refine_knobs = 2;           // knobs refined at most (most important first)
+  double converged_within = 0.1;  // |coefficient - 1| of a converged refinement
+  SpreadOptions spread;
+  bool IsValid(std::string* error) const;
+};
+
+struct RefineStep {
+  std::string knob;
+  double value = 0, coefficient = 0;  // value recorded, fitted coefficient of its signature
+};
+
+// One refined knob (or the payload's mass): did its coefficient reach about 1?
+struct KnobRefinement {
+  int candidate = -1;
+  std::string knob;
+  double value = 0;         // the value of the best signature
+  double coefficient = 0;   // its fitted coefficient (1: the signature is the knob's own effect)
+  bool converged = false;   // |coefficient - 1| < converged_within
+  bool recorded = false;    // the best signature is a new recording (not the probe's)
+};
+
+struct Refinement {
+  SelectionResult selection;            // the final one
+  SelectionOptions selection_options;   // as used (backward pass on)
+  FitProblem problem;                   // the candidates' designs, refined where recorded again
+  std::vector<int> rows;                // 0 .. n - 1
+  std::vector<double> signature_at;     // per candidate: the value its signature was recorded at (NaN: none)
+  double payload_mass = NAN;            // the payload's refined signature mass (NaN: the probe's)
+  double payload_x = NAN, payload_y = NAN;  // and position
+  SpreadTest spread;
+  double tracker_scale = NAN;           // NaN: the tracker noise is not needed
+  std::vector<RefineStep> trace;
+  std::vector<KnobRefinement> refined;
+  int recorded = 0, from_cache = 0;
+  double seconds = 0;
+};
+
+Refinement SelectAndRefine(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                           const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set);
+
+// The spread part of the stage (refine_spread.cc): tests the tracker noise beyond the selected
+// knobs' own simulated spread change when the noise scale was selected and a tracker knob exists,
+// and refines its scale by re-recording; fills r->spread, r->tracker_scale and the trace.
+void RefineTrackerSpread(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                         const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
+                         Refinement* r);
+
+// The value in the knob's unit of candidate k at coefficient(s) theta (unclamped: the fit's own
+// reading, which may lie outside the knob's range). Measurement effects: their own parameter.
+double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const Eigen::VectorXd& theta);
+
+}  // namespace dgmm::sim2real

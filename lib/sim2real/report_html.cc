@@ -1,0 +1,284 @@
+// report.html and the stdout summary (report.h).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "sim2real/report.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+std::string Escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    switch (c) {
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '&': o += "&amp;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string F(const char* fmt, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, fmt, v);
+  return buf;
+}
+
+std::string Base64(const std::string& in) {
+  static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < in.size(); i += 3) {
+    unsigned v = (unsigned char)in[i] << 16 | (unsigned char)in[i + 1] << 8 | (unsigned char)in[i + 2];
+    out += k[v >> 18 & 63];
+    out += k[v >> 12 & 63];
+    out += k[v >> 6 & 63];
+    out += k[v & 63];
+  }
+  if (i < in.size()) {
+    unsigned v = (unsigned char)in[i] << 16 | (i + 1 < in.size() ? (unsigned char)in[i + 1] << 8 : 0);
+    out += k[v >> 18 & 63];
+    out += k[v >> 12 & 63];
+    out += i + 1 < in.size() ? k[v >> 6 & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// Background colour for a deficit: white at <= 0, red growing to `scale`.
+std::string HeatColour(double v, double scale) {
+  if (!std::isfinite(v)) return "#eeeeee";
+  const double t = std::clamp(v / scale, -1.0, 1.0);
+  int r = 255, g = 255, b = 255;
+  if (t > 0) {
+    g = b = static_cast<int>(255 * (1 - t));
+  } else {
+    r = g = static_cast<int>(255 * (1 + 0.5 * t));
+  }
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", r, g, b);
+  return buf;
+}
+
+std::string HeatTable(const Analysis& a, const Eigen::MatrixXd& h) {
+  double scale = 0.5;
+  for (Eigen::Index k = 0; k < h.size(); ++k) {
+    if (std::isfinite(h.data()[k])) scale = std::max(scale, std::abs(h.data()[k]));
+  }
+  std::ostringstream o;
+  o << "<table class=heat><tr><th>command</th>";
+  for (const auto& t : a.baseline.terrain_labels) o << "<th>" << Escape(t) << "</th>";
+  o << "</tr>\n";
+  for (int i = 0; i < h.rows(); ++i) {
+    o << "<tr><td>" << Escape(a.inputs.command_labels[a.inputs.real_commands[i]]) << "</td>";
+    for (int j = 0; j < h.cols(); ++j) {
+      o << "<td style='background:" << HeatColour(h(i, j), scale) << "'>"
+        << (std::isfinite(h(i, j)) ? F("%.2f", h(i, j)) : "-") << "</td>";
+    }
+    o << "</tr>\n";
+  }
+  o << "</table>\n";
+  return o.str();
+}
+
+std::string RegionTable(const std::vector<Region>& regions, const std::vector<std::string>& families, int limit) {
+  std::ostringstream o;
+  o << "<table><tr><th>region</th><th>family</th><th>real</th><th>sim</th>"
+       "<th>deficit (nats/sample)</th><th>MMD p</th><th>BH q</th></tr>\n";
+  int shown = 0;
+  for (const auto& g : regions) {
+    if (std::find(families.begin(), families.end(), g.family) == families.end()) continue;
+    if (shown++ >= limit) break;
+    o << "<tr" << (g.significant ? " class=sig" : "") << "><td>" << Escape(g.label) << "</td><td>" << g.family
+      << "</td><td>" << g.n_real << "</td><td>" << g.n_sim << "</td><td>" << F("%.3f", g.deficit) << "</td><td>"
+      << F("%.4f", g.p_value) << "</td><td>" << F("%.4f", g.q_value) << (g.significant ? " *" : "") << "</td></tr>\n";
+  }
+  o << "</table>\n";
+  return o.str();
+}
+
+std::string LocateSection(const Analysis& a) {
+  const LocateSummary& s = a.baseline.before;
+  std::ostringstream o;
+  o << "<h2>1. Where the simulation fails (locate)</h2><p>" << a.inputs.real.size() << " real and " << a.inputs.sim.size()
+    << " simulated samples. Deficit = held-out real log-likelihood per sample of the best real-trained model minus "
+       "that of the sim-trained model (positive: the sim model explains the real data worse). Tests: MMD between "
+       "whitened residuals of real and (cross-fitted) simulated samples, Benjamini-Hochberg within each family; bold "
+       "= q &lt; 0.05.</p>\n<h3>Terrain, sequence and command regions</h3>"
+    << RegionTable(s.regions, {"terrain", "sequence", "command"}, 12)
+    << "<h3>Command &times; terrain deficit (nats per real sample)</h3>" << HeatTable(a, s.heat)
+    << "<h3>The naive test: x alone per command, pooled over terrain and sequence</h3><p>" << s.pooled_x_flagged << " of "
+    << a.inputs.real_commands.size() << " commands flagged (the conditional tests flag " << s.conditional_flagged
+    << " regions).</p>" << RegionTable(s.regions, {"pooled_x"}, 5);
+  return o.str();
+}
+
+std::string NamedTable(const Verdict& v) {
+  std::ostringstream o;
+  o << "<table><tr><th>#</th><th>family</th><th>knob</th><th>value (95% interval)</th><th>range</th><th>nominal</th>"
+       "<th>inclusion (family)</th><th>flags and doubts</th></tr>\n";
+  for (size_t k = 0; k < v.named.size(); ++k) {
+    const auto& n = v.named[k];
+    o << "<tr><td>" << k + 1 << "</td><td>" << Escape(n.family) << "</td><td>" << Escape(n.knob) << "</td><td>"
+      << F("%.4g", n.value) << " " << Escape(n.unit)
+      << (std::isfinite(n.value_lower) ? " [" + F("%.4g", n.value_lower) + ", " + F("%.4g", n.value_upper) + "]" : "")
+      << "</td><td>" << (std::isfinite(n.lo) ? F("%.4g", n.lo) + " to " + F("%.4g", n.hi) : "-") << "</td><td>"
+      << F("%.4g", n.nominal) << "</td><td>" << (n.inclusion < 0 ? "not computed" : F("%.0f%%", 100 * n.inclusion))
+      << "</td><td>";
+    for (const auto& d : n.doubts) o << Escape(d) << "<br>";
+    o << "</td></tr>\n";
+  }
+  o << "</table>\n";
+  return o.str();
+}
+
+std::string PhysicsSection(const Analysis& a) {
+  std::ostringstream o;
+  o << "<h2>2. What physics explains it (simulator knobs and measurement effects)</h2>\n";
+  if (!a.knobs_analysed) {
+    o << "<p>Not analysed: " << Escape(a.locate_only_because) << "</p>\n";
+    return o.str();
+  }
+  o << "<p>" << a.candidates.candidates.size() << " candidates (every knob probe recorded with the sim set's own "
+    << "recording, the payload, tracker bias and noise, IMU bias, heading drift). "
+    << Escape(a.candidates.legs_note) << ". A candidate is named when selected by held-out real likelihood, constant "
+    << "over the session, and its family's bootstrap inclusion is at least "
+    << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
+  if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
+  else o << NamedTable(a.verdict);
+  o << "<h3>Forward selection (held-out gain per real sample over the model of the previous step)</h3>";
+  for (size_t s = 0; s < a.refinement.selection.steps.size(); ++s) {
+    const auto& step = a.refinement.selection.steps[s];
+    o << "<p>Step " << s + 1 << " (threshold z &gt; " << F("%.2f", step.threshold_z) << "): ";
+    for (size_t c = 0; c < step.candidates.size() && c < 8; ++c) {
+      o << Escape(a.candidates.candidates[step.candidates[c].effect].key) << " " << F("%+.3f", step.candidates[c].gain)
+        << " (z " << F("%.1f", step.candidates[c].z) << "); ";
+    }
+    o << (step.chosen >= 0 ? "chose " + Escape(a.candidates.candidates[step.chosen].key) : "stopped") << ".</p>\n";
+  }
+  return o.str();
+}
+
+std::string SureSection(const Analysis& a) {
+  std::ostringstream o;
+  o << "<h2>3. How sure (ties, discriminating experiments, doubts)</h2>\n";
+  if (a.verdict.ties.empty()) o << "<p>No ties: no other family fits the named knobs' signatures as well.</p>\n";
+  for (const auto& t : a.verdict.ties) {
+    o << "<p><b>";
+    for (size_t f = 0; f < t.families.size(); ++f) o << (f ? " / " : "") << Escape(t.families[f]);
+    o << "</b>: " << Escape(t.why) << ". " << Escape(DescribeExperiment(t.experiment)) << "</p>\n";
+  }
+  if (a.verdict.doubts.empty()) o << "<p>No doubts.</p>\n";
+  else o << "<ul>";
+  for (const auto& d : a.verdict.doubts) o << "<li>" << Escape(d) << "</li>";
+  if (!a.verdict.doubts.empty()) o << "</ul>\n";
+  return o.str();
+}
+
+std::string FitSection(const Analysis& a, const ReportContext& ctx) {
+  const Baseline& b = a.baseline;
+  std::ostringstream o;
+  o << "<h2>4. The fit (adequacy of the correction)</h2><table><tr><th>model</th><th>held-out real log-likelihood per "
+       "sample</th></tr><tr><td>(a) sim-trained</td><td>" << F("%.3f", b.ll_sim) << "</td></tr>";
+  if (a.knobs_analysed) {
+    o << "<tr><td>(b) corrected (the knob correction)</td><td>" << F("%.3f", a.adequacy.ll_corrected) << "</td></tr>";
+  }
+  o << "<tr><td>(c) real-trained ceiling (sim prior strength " << F("%.0f", b.ceiling_prior_count) << ")</td><td>"
+    << F("%.3f", b.ll_ceiling) << "</td></tr><tr><td>real-trained from real data alone</td><td>" << F("%.3f", b.ll_real_only)
+    << "</td></tr></table>\n";
+  if (!a.knobs_analysed) return o.str();
+  const Adequacy& q = a.adequacy;
+  o << "<p>Share of the gap closed: "
+    << (std::isfinite(q.gap_closed) ? F("%.0f%%", 100 * q.gap_closed) + " (SE " + F("%.0f%%", 100 * q.gap_closed_se) + ")"
+                                    : std::string("no gap (the sim model is at or above the ceiling)"))
+    << "; the corrected model is " << F("%.3f", q.shortfall) << " nats per sample (SE " << F("%.3f", q.shortfall_se)
+    << ") below the ceiling. The corrected model is written as <code>" << Escape(ctx.corrected_model_file)
+    << "</code> (readable by <code>dgmm score</code> and <code>dgmm render</code>).</p>\n"
+    << "<h3>Locate again, on the corrected model</h3>"
+    << RegionTable(q.after.regions, {"terrain", "sequence", "command"}, 12)
+    << "<h3>Command &times; terrain deficit after the correction</h3>" << HeatTable(a, q.after.heat)
+    << "<h3>Residual tests</h3><table><tr><th>where</th><th>p</th><th>significant</th></tr>";
+  for (const auto& t : q.residual.tests) {
+    o << "<tr><td>" << Escape(t.where) << "</td><td>" << F("%.4f", t.p_value) << "</td><td>" << (t.significant ? "yes" : "no")
+      << "</td></tr>";
+  }
+  o << "</table>\n";
+  return o.str();
+}
+
+std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const std::filesystem::path& dir) {
+  std::ostringstream o;
+  o << "<h2>5. Details</h2>\n";
+  if (a.knobs_analysed) {
+    o << "<h3>Refinement by re-recording</h3><table><tr><th>knob</th><th>value recorded</th><th>coefficient</th></tr>";
+    for (const auto& s : a.refinement.trace) {
+      o << "<tr><td>" << Escape(s.knob) << "</td><td>" << F("%.4g", s.value) << "</td><td>" << F("%.3f", s.coefficient)
+        << "</td></tr>";
+    }
+    o << "</table>\n<p>Recordings: " << a.candidates.recorded << " for the signatures (" << a.candidates.from_cache
+      << " from the cache), " << a.refinement.recorded << " for the refinement; " << a.ties.experiment_checks
+      << " experiment checks.</p>\n";
+  }
+  if (!ctx.recalibrated_config_file.empty()) {
+    o << "<p>The simulator config at the named values: <code>" << Escape(ctx.recalibrated_config_file)
+      << "</code> (<code>dgmm simulate --config</code>).</p>\n";
+  }
+  o << "<p>Simulator config: " << Escape(ctx.simulator_config_source) << ".</p>\n";
+  for (const auto& f : ctx.figures) {
+    std::ifstream in(dir / f.file, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    o << "<figure><img alt='" << Escape(f.file) << "' src='data:image/png;base64," << Base64(ss.str())
+      << "'><figcaption>" << Escape(f.caption) << "</figcaption></figure>\n";
+  }
+  return o.str();
+}
+
+}  // namespace
+
+std::string ReportHtml(const Analysis& a, const ReportContext& ctx, const std::filesystem::path& dir) {
+  std::ostringstream o;
+  o << "<!DOCTYPE html><html><head><meta charset='utf-8'><title>dgmm sim2real report</title>"
+       "<style>body{font-family:sans-serif;max-width:1100px;margin:2em auto;line-height:1.4}"
+       "table{border-collapse:collapse;margin:1em 0}td,th{border:1px solid #ccc;padding:3px 7px;"
+       "font-size:13px}tr.sig{font-weight:bold}table.heat td{text-align:center}"
+       "img{max-width:100%}.note{color:#777}</style></head><body>\n";
+  o << "<h1>Sim vs real: " << Escape(ctx.sim_path) << " vs " << Escape(ctx.real_path) << "</h1>\n";
+  o << "<h2>Verdict: " << Escape(a.verdict.status) << "</h2><p>" << Escape(a.verdict.sentence) << "</p>\n";
+  for (const auto& n : ctx.notes) o << "<p class=note>" << Escape(n) << "</p>\n";
+  o << LocateSection(a) << PhysicsSection(a) << SureSection(a) << FitSection(a, ctx) << DetailsSection(a, ctx, dir);
+  o << "<p class=note>Method, assumptions and limits: docs/sim2real.md. Analysis took " << F("%.1f", a.seconds.total)
+    << " s.</p></body></html>\n";
+  return o.str();
+}
+
+std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std::string& report_path) {
+  std::ostringstream o;
+  o << "verdict: " << a.verdict.status << "\n" << a.verdict.sentence << "\n";
+  const LocateSummary& s = a.baseline.before;
+  o << "located: " << s.conditional_flagged << " terrain, sequence or command region(s) significant";
+  if (!s.significant.empty()) o << " (worst: " << s.significant.front().label << ")";
+  o << "\n";
+  o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
+  if (a.knobs_analysed) {
+    o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);
+  }
+  o << ", ceiling " << F("%.3f", a.baseline.ll_ceiling);
+  if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
+    o << " (" << F("%.0f%%", 100 * a.adequacy.gap_closed) << " of the gap closed, SE " << F("%.0f%%", 100 * a.adequacy.gap_closed_se)
+      << ")";
+  }
+  o << "\n";
+  for (const auto& n : ctx.notes) o << "note: " << n << "\n";
+  if (!ctx.recalibrated_config_file.empty()) o << "config at the named values: " << ctx.recalibrated_config_file << "\n";
+  o << "report: " << report_path << "\n";
+  return o.str();
+}
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,175 @@
+// report.json (report.h).
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+
+#include "sim2real/report.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+using nlohmann::json;
+
+// NaN/Inf are not JSON: null.
+json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
+
+json Vec(const Eigen::VectorXd& v) {
+  json out = json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(Num(v(i)));
+  return out;
+}
+
+json Regions(const std::vector<Region>& regions) {
+  json out = json::array();
+  for (const auto& r : regions) {
+    out.push_back({{"family", r.family}, {"label", r.label}, {"command", r.command}, {"terrain", r.terrain},
+                   {"sequence", r.sequence}, {"n_real", r.n_real}, {"n_sim", r.n_sim},
+                   {"deficit_nats_per_sample", Num(r.deficit)}, {"mmd2", Num(r.mmd2)}, {"p_value", r.p_value},
+                   {"q_value", r.q_value}, {"significant", r.significant}});
+  }
+  return out;
+}
+
+json HeatMap(const Analysis& a, const Eigen::MatrixXd& h) {
+  json rows = json::array();
+  for (int i = 0; i < h.rows(); ++i) {
+    json row = json::array();
+    for (int j = 0; j < h.cols(); ++j) row.push_back(Num(h(i, j)));
+    rows.push_back({{"command", a.inputs.command_labels[a.inputs.real_commands[i]]}, {"deficit", row}});
+  }
+  return {{"terrain", a.baseline.terrain_labels}, {"rows", rows}};
+}
+
+json LocateJson(const Analysis& a) {
+  const LocateSummary& s = a.baseline.before;
+  return {{"terrain_regions", a.baseline.terrain_labels},
+          {"significant_mismatch", a.baseline.significant_mismatch},
+          {"pooled_x_flagged_commands", s.pooled_x_flagged},
+          {"conditional_flagged_regions", s.conditional_flagged},
+          {"regions", Regions(s.regions)},
+          {"heat_map", HeatMap(a, s.heat)}};
+}
+
+json StepsJson(const Analysis& a) {
+  json steps = json::array();
+  for (const auto& s : a.refinement.selection.steps) {
+    json cs = json::array();
+    for (const auto& c : s.candidates) {
+      cs.push_back({{"key", a.candidates.candidates[c.effect].key}, {"gain", c.gain}, {"se", Num(c.se)}, {"z", c.z}});
+    }
+    steps.push_back({{"chosen", s.chosen >= 0 ? json(a.candidates.candidates[s.chosen].key) : json(nullptr)},
+                     {"threshold_z", s.threshold_z}, {"candidates", cs}});
+  }
+  return steps;
+}
+
+json KnobsJson(const Analysis& a) {
+  const CandidateSet& set = a.candidates;
+  const Refinement& r = a.refinement;
+  json cands = json::array();
+  for (size_t k = 0; k < set.candidates.size(); ++k) {
+    const auto& c = set.candidates[k];
+    cands.push_back({{"key", c.key}, {"family", c.family}, {"knob", c.knob}, {"nominal", c.nominal}, {"probe", c.probe},
+                     {"range", {c.lo, c.hi}}, {"simulated", c.simulated},
+                     {"inclusion", a.confidence.computed ? Num(a.confidence.inclusion[k]) : json(nullptr)}});
+  }
+  json trace = json::array();
+  for (const auto& s : r.trace) trace.push_back({{"knob", s.knob}, {"value", s.value}, {"coefficient", s.coefficient}});
+  json refined = json::array();
+  for (const auto& f : r.refined) {
+    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", f.coefficient}, {"converged", f.converged}});
+  }
+  json removed = json::array();
+  for (int k : r.selection.removed) removed.push_back(set.candidates[k].key);
+  json family = json::object();
+  for (const auto& [f, v] : a.confidence.family_inclusion) family[f] = v;
+  json spread = nullptr;
+  if (r.spread.tested) {
+    spread = {{"knob_log_variance_ratio", Vec(r.spread.knob_log_ratio)}, {"tracker_coefficient", r.spread.a},
+              {"gain", r.spread.gain}, {"se", r.spread.se}, {"z", r.spread.z}, {"tracker_needed", r.spread.tracker_needed},
+              {"tracker_scale", Num(r.tracker_scale)}};
+  }
+  return {{"candidates", cands}, {"selection_steps", StepsJson(a)}, {"removed_by_backward_pass", removed},
+          {"refinement", trace}, {"refined", refined}, {"family_inclusion", family},
+          {"bootstrap_resamples", a.confidence.resamples}, {"inert_knobs", set.inert_knobs},
+          {"per_leg_probes", {{"recorded", set.legs_probed}, {"why", set.legs_note}}}, {"spread", spread},
+          {"recordings", {{"signatures", set.recorded}, {"signatures_from_cache", set.from_cache},
+                          {"signature_requests", set.requests}, {"refinement", r.recorded},
+                          {"refinement_from_cache", r.from_cache}}},
+          {"placements_per_recording", a.inputs.recording.placements}};
+}
+
+json DriftJson(const EffectDrift& d, const char* change, const char* flag) {
+  return {{change, Num(d.gamma)}, {"p_value", Num(d.p_value)}, {"z", Num(d.z)}, {flag, d.drifting}};
+}
+
+json AdequacyJson(const Analysis& a) {
+  const Adequacy& q = a.adequacy;
+  json tests = json::array();
+  for (const auto& t : q.residual.tests) {
+    tests.push_back({{"where", t.where}, {"statistic", t.statistic}, {"p_value", t.p_value}, {"significant", t.significant}});
+  }
+  json drift = json::array();
+  for (const auto& d : q.drift_tests) {
+    json e = DriftJson(d.drift, "relative_change", "drifting");
+    e["key"] = a.candidates.candidates[d.candidate].key;
+    e["step_variation"] = DriftJson(d.step_variation, "relative_rms", "varies");
+    drift.push_back(e);
+  }
+  json checks = json::array();
+  for (const auto& c : q.checks) {
+    checks.push_back({{"key", a.candidates.candidates[c.candidate].key}, {"fitted_value", Num(c.fitted)},
+                      {"value", Num(c.value)}, {"outside_range", c.outside_range}, {"pinned_low", c.pinned_low},
+                      {"pinned_high", c.pinned_high}, {"impossible", c.impossible}, {"unconverged", c.unconverged},
+                      {"doubts", c.doubts}});
+  }
+  return {{"regions_after", Regions(q.after.regions)}, {"conditional_flagged_regions_after", q.after.conditional_flagged},
+          {"heat_map_after", HeatMap(a, q.after.heat)},
+          {"shortfall_nats_per_sample", Num(q.shortfall)}, {"shortfall_se", Num(q.shortfall_se)},
+          {"below_ceiling", q.below_ceiling}, {"knob_checks", checks}, {"residual_tests", tests},
+          {"drift_tests", drift}, {"total_drift", DriftJson(q.total_drift, "relative_change", "drifting")},
+          {"total_step_variation", DriftJson(q.total_step_variation, "relative_rms", "varies")},
+          {"doubts", q.doubts}};
+}
+
+json FitJson(const Analysis& a) {
+  const Baseline& b = a.baseline;
+  return {{"heldout_log_likelihood_per_sample",
+           {{"sim", b.ll_sim}, {"corrected", a.knobs_analysed ? Num(a.adequacy.ll_corrected) : json(nullptr)},
+            {"real_trained_ceiling", b.ll_ceiling}, {"real_only", b.ll_real_only},
+            {"ceiling_sim_prior_count", b.ceiling_prior_count}}},
+          {"gap_closed", a.knobs_analysed ? Num(a.adequacy.gap_closed) : json(nullptr)},
+          {"gap_closed_se", a.knobs_analysed ? Num(a.adequacy.gap_closed_se) : json(nullptr)}};
+}
+
+}  // namespace
+
+std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
+  const AnalysisInputs& in = a.inputs;
+  json out = {{"sim", ctx.sim_path}, {"real", ctx.real_path},
+              {"samples", {{"real", in.real.size()}, {"sim", in.sim.size()}}},
+              {"pose_dim", in.real.pose_dim()}, {"terrain_dim", in.real.terrain_dim()},
+              {"has_sequence", in.real.has_sequence},
+              {"verdict", json::parse(VerdictJson(a.verdict))},
+              {"locate", LocateJson(a)},
+              {"knobs", a.knobs_analysed ? KnobsJson(a) : json(nullptr)},
+              {"adequacy", a.knobs_analysed ? AdequacyJson(a) : json(nullptr)},
+              {"fit", FitJson(a)},
+              {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},
+                             {"fingerprint", ctx.simulator_fingerprint},
+                             {"locate_only_because", a.locate_only_because},
+                             {"recording", {{"protocol", in.recording.protocol}, {"seed", in.recording.seed},
+                                            {"from_sim_metadata", in.recording_from_metadata}}}}},
+              {"models", {{"corrected", ctx.corrected_model_file.empty() ? json(nullptr) : json(ctx.corrected_model_file)},
+                          {"sim", ctx.sim_model_file}}},
+              {"recalibrated_config", ctx.recalibrated_config_file.empty() ? json(nullptr) : json(ctx.recalibrated_config_file)},
+              {"figures", json::array()}, {"notes", ctx.notes},
+              {"dropped_real_commands", in.dropped_commands}, {"dropped_real_samples", in.dropped_samples},
+              {"seconds", {{"locate", a.seconds.locate}, {"candidates", a.seconds.candidates},
+                           {"refine", a.seconds.refine}, {"confidence", a.seconds.confidence},
+                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"total", a.seconds.total}}}};
+  for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});
+  return out.dump(2) + "\n";
+}
+
+}  // namespace dgmm::sim2real

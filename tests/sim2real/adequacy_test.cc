@@ -1,0 +1,65 @@
+// Stage 6: the correction is checked before any verdict. A friction beyond the knob's range is
+// pinned at the limit and doubted; physics no knob has leaves located mismatch; an in-library
+// knob leaves no doubt; the gap closed and its SE follow the delta method.
+#include "sim2real/adequacy.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+const KnobCheck* CheckOf(const test::Stages& s, const std::string& family) {
+  for (const auto& c : s.adequacy.checks) {
+    if (s.set.candidates[c.candidate].family == family) return &c;
+  }
+  return nullptr;
+}
+
+TEST(Adequacy, APlantedKnobInsideItsRangeLeavesNoDoubt) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 6);
+  const KnobCheck* c = CheckOf(s, "friction");
+  ASSERT_NE(c, nullptr);
+  EXPECT_TRUE(c->doubts.empty());
+  EXPECT_TRUE(s.adequacy.doubts.empty()) << s.adequacy.doubts.front();
+  EXPECT_TRUE(s.adequacy.remaining.empty());
+  EXPECT_FALSE(s.adequacy.below_ceiling);
+}
+
+TEST(Adequacy, AValueBelowTheRangeIsPinnedAndDoubted) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.02}}, 6);
+  const KnobCheck* c = CheckOf(s, "friction");
+  ASSERT_NE(c, nullptr);
+  EXPECT_TRUE(c->pinned_low || c->outside_range);
+  EXPECT_EQ(c->value, 0.3);  // clamped to the range's lower end
+  ASSERT_FALSE(c->doubts.empty());
+  EXPECT_NE(c->doubts[0].find("floor.friction"), std::string::npos) << c->doubts[0];
+}
+
+TEST(Adequacy, PhysicsNoKnobDescribesLeavesLocatedMismatch) {
+  test::FakeExtras extras;
+  extras.geometry = 0.03;
+  const test::Stages s = test::RunStages({}, 6, extras);
+  EXPECT_FALSE(s.adequacy.doubts.empty());
+}
+
+TEST(Adequacy, GapClosedAndItsStandardError) {
+  // corrected - sim = 1 and ceiling - sim = 2 in every episode: half the gap, no spread.
+  const Eigen::VectorXd sim = Eigen::VectorXd::Zero(6), corrected = Eigen::VectorXd::Ones(6);
+  const Eigen::VectorXd ceiling = Eigen::VectorXd::Constant(6, 2.0);
+  double gap, se;
+  GapClosed(sim, corrected, ceiling, {0, 0, 1, 1, 2, 2}, &gap, &se);
+  EXPECT_DOUBLE_EQ(gap, 0.5);
+  EXPECT_NEAR(se, 0.0, 1e-12);
+  GapClosed(sim, corrected, sim, {0, 0, 1, 1, 2, 2}, &gap, &se);
+  EXPECT_TRUE(std::isnan(gap));  // no gap to close
+  Eigen::VectorXd noisy = corrected;
+  noisy(0) = 3, noisy(2) = -1;
+  GapClosed(sim, noisy, ceiling, {0, 0, 1, 1, 2, 2}, &gap, &se);
+  EXPECT_DOUBLE_EQ(gap, 0.5);
+  EXPECT_GT(se, 0.1);
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real

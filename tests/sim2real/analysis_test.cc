@@ -1,0 +1,98 @@
+// The whole analysis (sim2real/analysis.h) on the fake simulator (fake_simulator.h): planted
+// knobs are named with their values, nulls are clean, physics no knob describes is doubted, values
+// beyond a knob's range are flagged, and the result does not depend on the thread count.
+#include "sim2real/analysis.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/sim2real/fake_simulator.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+using test::FakeExtras;
+using test::FakeSimulator;
+
+const FakeSimulator& Fake() {
+  static const FakeSimulator fake;
+  return fake;
+}
+
+Analysis RunFake(const std::vector<KnobValue>& planted, const FakeExtras& extras = {}, int threads = 1,
+             std::uint64_t seed = 7) {
+  const auto pair = test::MakeFakePair(Fake(), planted, extras, seed);
+  return Analyse(pair.sim, pair.real, &Fake(), test::FastOptions(threads));
+}
+
+// The bound on a named value.
+constexpr double kValueTolerance = 0.25;
+
+TEST(Analysis, NullPairIsClean) {
+  const Analysis a = RunFake({});
+  EXPECT_EQ(a.verdict.status, "clean") << a.verdict.sentence;
+  EXPECT_TRUE(a.verdict.named.empty()) << a.verdict.sentence;
+}
+
+TEST(Analysis, PlantedFrictionIsNamedWithItsValue) {
+  const Analysis a = RunFake({{test::kFriction, 0.7}});
+  ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
+  EXPECT_EQ(a.verdict.named[0].family, "friction") << a.verdict.sentence;
+  EXPECT_NEAR(a.verdict.named[0].value, 0.7, kValueTolerance * 0.7) << a.verdict.sentence;
+  EXPECT_EQ(a.verdict.status, "explained") << a.verdict.sentence;
+  EXPECT_FALSE(a.candidates.legs_probed) << "no side is implicated by friction: " << a.candidates.legs_note;
+}
+
+TEST(Analysis, PlantedPayloadIsNamedWithItsMass) {
+  const Analysis a = RunFake({{test::kPayloadMass, 2.0}, {test::kPayloadY, 0.1}});
+  ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
+  EXPECT_EQ(a.verdict.named[0].family, "payload") << a.verdict.sentence;
+  EXPECT_NEAR(a.verdict.named[0].value, 2.0, kValueTolerance * 2.0) << a.verdict.sentence;
+}
+
+TEST(Analysis, AWeakLegImplicatesASideAndIsNamed) {
+  const Analysis a = RunFake({{test::kLeg1Gain, 0.4}});
+  EXPECT_TRUE(a.candidates.legs_probed) << a.candidates.legs_note;
+  ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
+  EXPECT_EQ(a.verdict.named[0].family, "actuator_gain") << a.verdict.sentence;
+}
+
+TEST(Analysis, PhysicsNoKnobDescribesIsDoubted) {
+  FakeExtras extras;
+  extras.geometry = 0.03;
+  const Analysis a = RunFake({}, extras);
+  EXPECT_TRUE(a.verdict.status == "unexplained" || a.verdict.status == "partly_explained") << a.verdict.sentence;
+  EXPECT_FALSE(a.verdict.doubts.empty() && a.verdict.status != "unexplained") << a.verdict.sentence;
+}
+
+// A friction below the knob's range (0.3 .. 1.5): the value is the limit, flagged and doubted.
+TEST(Analysis, AValueBeyondTheKnobsRangeIsFlagged) {
+  const Analysis a = RunFake({{test::kFriction, 0.05}});
+  ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
+  const VerdictNamed& n = a.verdict.named[0];
+  ASSERT_EQ(n.family, "friction") << a.verdict.sentence;
+  EXPECT_GE(n.value, n.lo);
+  EXPECT_LE(n.value, n.hi);
+  EXPECT_FALSE(n.flags.empty()) << a.verdict.sentence;
+  EXPECT_FALSE(n.doubts.empty()) << a.verdict.sentence;
+  EXPECT_NE(a.verdict.status, "explained") << a.verdict.sentence;
+}
+
+TEST(Analysis, ResultsDoNotDependOnTheThreadCount) {
+  const Analysis one = RunFake({{test::kFriction, 0.7}}, {}, 1);
+  const Analysis two = RunFake({{test::kFriction, 0.7}}, {}, 3);
+  EXPECT_EQ(VerdictJson(one.verdict), VerdictJson(two.verdict));
+}
+
+TEST(Analysis, WithoutASimulatorItOnlyLocates) {
+  const auto pair = test::MakeFakePair(Fake(), {{test::kFriction, 0.6}});
+  const Analysis a = Analyse(pair.sim, pair.real, nullptr, test::FastOptions(), "no simulator config");
+  EXPECT_FALSE(a.knobs_analysed);
+  EXPECT_EQ(a.verdict.status, "located") << a.verdict.sentence;
+  EXPECT_TRUE(a.verdict.named.empty());
+  EXPECT_NE(a.verdict.sentence.find("no simulator config"), std::string::npos) << a.verdict.sentence;
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real

@@ -1,0 +1,34 @@
+// Stage 2 (locate): a planted friction is located on the slope, a null pair is not; the ceiling
+// is above the sim model where the robot differs.
+#include "sim2real/baseline.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+TEST(Baseline, LocatesAPlantedMismatchAndNotANullOne) {
+  const test::Stages slip = test::RunStages({{test::kFriction, 0.5}}, 2);
+  EXPECT_TRUE(slip.base.significant_mismatch);
+  EXPECT_GT(slip.base.ll_ceiling, slip.base.ll_sim);
+  EXPECT_EQ(slip.base.fold.size(), static_cast<size_t>(slip.in.real.size()));
+  EXPECT_EQ(slip.base.before.heat.rows(), static_cast<int>(slip.in.real_commands.size()));
+  EXPECT_EQ(slip.base.terrain_labels.size(), 3u);
+  const test::Stages null = test::RunStages({}, 2);
+  EXPECT_FALSE(null.base.significant_mismatch);
+  EXPECT_TRUE(null.base.before.significant.empty());
+}
+
+TEST(Baseline, LocateModelOfTheSimModelIsTheBaselinesOwn) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.5}}, 2);
+  std::mt19937_64 rng(5);
+  const LocateSummary again = LocateModel(s.in, s.base, s.base.real_residuals, s.base.heldout_sim, true,
+                                          s.options.locate.locate, rng);
+  ASSERT_EQ(again.regions.size(), s.base.before.regions.size());
+  EXPECT_EQ(again.heat, s.base.before.heat);  // deficits do not depend on the permutations
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real

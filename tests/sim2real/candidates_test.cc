@@ -1,0 +1,52 @@
+// Stage 3: every knob probe a candidate, the payload one three-parameter candidate, the tracker's
+// spread probe kept apart, an inert knob left out, per-leg probes only when a side is implicated.
+#include "sim2real/candidates.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+TEST(Candidates, TheLibraryOfAFakeWithoutAnImplicatedSide) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.7}}, 3);
+  const CandidateSet& set = s.set;
+  EXPECT_FALSE(set.legs_probed) << set.legs_note;
+  EXPECT_EQ(set.inert_knobs, std::vector<std::string>{"floor.friction.torsional"});
+  for (const std::string key : {"tracker_bias", "tracker_noise", "floor.friction@0.6", "payload", "imu_bias",
+                                "heading_drift", "actuators.side.left.gain@0.5"}) {
+    EXPECT_GE(test::CandidateOf(set, key), 0) << key;
+  }
+  EXPECT_LT(test::CandidateOf(set, "actuators.leg0.gain@0.5"), 0);
+  EXPECT_GE(set.tracker_shift, 0);
+  EXPECT_EQ(set.library[test::CandidateOf(set, "payload")].num_params(), 3);
+  // nominal + the probes of every knob but the legs
+  EXPECT_EQ(set.requests, 1 + test::kNumFakeKnobs - 4);
+  EXPECT_EQ(set.candidates.size(), set.library.size());
+  EXPECT_EQ(set.candidates.size(), set.externals.size());
+}
+
+TEST(Candidates, AWeakLegImplicatesItsSideAndThenTheLegsAreProbed) {
+  const test::Stages s = test::RunStages({{test::kLeg2Gain, 0.3}}, 3);
+  EXPECT_TRUE(s.set.legs_probed) << s.set.legs_note;
+  EXPECT_NE(s.set.legs_note.find("side"), std::string::npos);
+  for (int leg = 0; leg < 4; ++leg) {
+    EXPECT_GE(test::CandidateOf(s.set, "actuators.leg" + std::to_string(leg) + ".gain@0.5"), 0) << leg;
+  }
+}
+
+TEST(Candidates, ACandidatesDesignIsItsRecordedShift) {
+  const test::Stages s = test::RunStages({}, 3);
+  const FitProblem fp = MakeCandidateProblem(s.in, s.base, s.set);
+  const int k = test::CandidateOf(s.set, "floor.friction@0.6");
+  ASSERT_GE(k, 0);
+  const int i = 3;
+  const Eigen::VectorXd d = fp.d[k].middleRows(i * fp.dx, fp.dx);
+  const Eigen::VectorXd expected = s.set.shifts[s.set.externals[k].shifts[0]].Shift(
+      s.in.real.command[i], s.in.real.z.row(i).transpose(), s.in.real.first_execution[i]);
+  EXPECT_TRUE(d.isApprox(expected));
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real

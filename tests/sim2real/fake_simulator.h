@@ -1,0 +1,83 @@
+#pragma once
+// A fake simulator for the sim2real analysis's logic (lib/sim2real/knob_simulator.h): a
+// linear-Gaussian toy robot on a tilted plane whose knobs shift the pose change (dx, dy, dyaw)
+// by known signatures, with common random numbers (a recording's placements, commands and noise
+// depend on its seed only, never on the knob values). Its recordings take milliseconds, so tests
+// run the whole analysis on planted "real" sets: a knob at a planted value, measurement effects,
+// or physics no knob describes.
+//
+//   x = base(c, g) + sum_k s_k(v_k) S_k(c, g, first) + noise_scale * e,   e ~ N(0, diag(sd^2))
+// with c = (long, lat, turn), g the unit gravity in the body frame from (pitch, roll), and
+// s_k(v) the knob's size at value v (0 at the nominal; friction is mildly non-linear so that its
+// refinement has work to do).
+#include <Eigen/Dense>
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/sample_set.h"
+#include "sim2real/knob_simulator.h"
+
+namespace dgmm::sim2real::test {
+
+// Knob indices of the fake, in its knobs() order.
+enum FakeKnob {
+  kFriction = 0,  // family friction, nominal 1, range [0.3, 1.5]
+  kLeftGain,      // actuator_gain, side left
+  kRightGain,     // actuator_gain, side right
+  kLeg0Gain, kLeg1Gain, kLeg2Gain, kLeg3Gain,  // actuator_gain per leg (0, 1 left; 2, 3 right)
+  kLatency,       // latency (first executions only)
+  kPayloadMass, kPayloadX, kPayloadY,
+  kTrackerNoise,  // spread
+  kTorsional,     // changes nothing (inert)
+  kNumFakeKnobs
+};
+
+// What a recording adds beyond the knobs (the "real" robot's extras).
+struct FakeExtras {
+  Eigen::Vector3d tracker_bias = Eigen::Vector3d::Zero();  // added to (dx, dy, dyaw); yaw entry unused
+  // Physics no knob describes: dy += geometry * long * (1 + 2 roll), dx -= geometry * |turn|.
+  double geometry = 0;
+};
+
+class FakeSimulator : public KnobSimulator {
+ public:
+  FakeSimulator();
+  const std::vector<Knob>& knobs() const override { return knobs_; }
+  std::string Fingerprint() const override { return "fake-simulator-v1"; }
+  SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
+  CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
+  std::string ConfigJson(const std::vector<KnobValue>& values) const override;
+  double total_mass_kg() const override { return 10.0; }
+  double leg_reach_m() const override { return 0.3; }
+
+  // A recording with extras (the planted real set), `seed` its common random numbers.
+  SampleSet RecordWith(const Recording& recording, const std::vector<KnobValue>& values, const FakeExtras& extras) const;
+  int records() const { return records_; }
+  int cells() const { return cells_; }
+
+ private:
+  std::vector<Knob> knobs_;
+  mutable std::atomic<int> records_{0}, cells_{0};
+};
+
+}  // namespace dgmm::sim2real::test
+
+#include "sim2real/analysis.h"
+
+namespace dgmm::sim2real::test {
+
+// A sim set (the fake at nominal, recording seed `seed`) and a "real" set (another seed, the
+// planted knob values and extras), both of the fake's own protocol.
+struct FakePair {
+  SampleSet sim, real;
+};
+FakePair MakeFakePair(const FakeSimulator& simulator, const std::vector<KnobValue>& planted,
+                      const FakeExtras& extras = {}, std::uint64_t seed = 7);
+
+// Analysis options for tests: no cache, fewer permutations and resamples, `threads` threads.
+AnalysisOptions FastOptions(int threads = 1);
+
+}  // namespace dgmm::sim2real::test

@@ -1,0 +1,55 @@
+// Stage 4: selection and refinement by re-recording. The fake's friction is non-linear, so the
+// probe's linear extrapolation is off and the refinement must move the signature to the value.
+#include "sim2real/refine.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+TEST(Refine, FrictionIsRefinedUntilItsCoefficientIsAboutOne) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.45}}, 4);
+  const Refinement& r = s.refinement;
+  ASSERT_FALSE(r.refined.empty());
+  EXPECT_EQ(r.refined[0].knob, "floor.friction");
+  EXPECT_TRUE(r.refined[0].converged) << r.refined[0].coefficient;
+  EXPECT_TRUE(r.refined[0].recorded);
+  EXPECT_GE(r.recorded, 1);
+  const int k = test::CandidateOf(s.set, "floor.friction@0.6");
+  EXPECT_EQ(r.signature_at[k], r.refined[0].value);
+  const int pos = static_cast<int>(std::find(r.selection.selected.begin(), r.selection.selected.end(), k) -
+                                   r.selection.selected.begin());
+  ASSERT_LT(pos, static_cast<int>(r.selection.selected.size()));
+  // The value the coefficient stands for is the planted one (the fake is exact up to noise).
+  EXPECT_NEAR(CandidateValue(s.set, r, k, r.selection.fit.theta[pos]), 0.45, 0.05);
+}
+
+TEST(Refine, ThePayloadIsRecordedAtItsFittedPosition) {
+  const test::Stages s = test::RunStages({{test::kPayloadMass, 2.5}, {test::kPayloadY, 0.1}}, 4);
+  const Refinement& r = s.refinement;
+  ASSERT_TRUE(std::isfinite(r.payload_mass));
+  EXPECT_NEAR(r.payload_y, 0.1, 0.03);
+  EXPECT_NEAR(r.payload_x, 0.0, 0.03);
+  bool traced = false;
+  for (const auto& t : r.trace) traced |= t.knob.find("payload.mass_kg at (x") == 0;
+  EXPECT_TRUE(traced);
+}
+
+TEST(Refine, NothingSelectedOnANullPairAndNothingRecorded) {
+  const test::Stages s = test::RunStages({}, 4);
+  EXPECT_TRUE(s.refinement.selection.selected.empty());
+  EXPECT_EQ(s.refinement.recorded, 0);
+  EXPECT_FALSE(s.refinement.spread.tested);
+}
+
+TEST(Refine, AWiderTrackerNoiseIsTestedAgainstTheKnobsOwnSpread) {
+  const test::Stages s = test::RunStages({{test::kTrackerNoise, 2.0}}, 4);
+  ASSERT_TRUE(s.refinement.spread.tested);
+  EXPECT_TRUE(s.refinement.spread.tracker_needed);
+  EXPECT_NEAR(s.refinement.tracker_scale, 2.0, 0.5);
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real

@@ -1,0 +1,53 @@
+#pragma once
+// The stages of the analysis run one by one on a fake pair, for the tests of each stage.
+#include <random>
+
+#include "sim2real/analysis.h"
+#include "tests/sim2real/fake_simulator.h"
+
+namespace dgmm::sim2real::test {
+
+inline const FakeSimulator& SharedFake() {
+  static const FakeSimulator fake;
+  return fake;
+}
+
+struct Stages {
+  AnalysisOptions options = FastOptions();
+  AnalysisInputs in;
+  Baseline base;
+  CandidateSet set;
+  Refinement refinement;
+  Confidence confidence;
+  Adequacy adequacy;
+  Naming naming;
+};
+
+// Runs the stages up to and including `last` (2 baseline, 3 candidates, 4 refine, 5 confidence,
+// 6 adequacy and naming).
+inline Stages RunStages(const std::vector<KnobValue>& planted, int last, const FakeExtras& extras = {}) {
+  Stages s;
+  const FakePair pair = MakeFakePair(SharedFake(), planted, extras);
+  s.in = PrepareInputs(pair.sim, pair.real, s.options.seed);
+  s.base = LocateMismatch(s.in, s.options.locate);
+  if (last < 3) return s;
+  s.set = BuildCandidates(SharedFake(), s.in, s.base, s.options.candidates);
+  if (last < 4) return s;
+  s.refinement = SelectAndRefine(SharedFake(), s.in, s.base, s.options.candidates, s.options.refine, &s.set);
+  if (last < 5) return s;
+  std::mt19937_64 rng(2);
+  s.confidence = AssessConfidence(s.set, s.refinement, rng);
+  if (last < 6) return s;
+  s.adequacy = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  s.naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
+  return s;
+}
+
+inline int CandidateOf(const CandidateSet& set, const std::string& key) {
+  for (size_t k = 0; k < set.candidates.size(); ++k) {
+    if (set.candidates[k].key == key) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+}  // namespace dgmm::sim2real::test

@@ -1,0 +1,77 @@
+// Stage 8: what is named, the status and the sentence.
+#include "sim2real/verdict_stage.h"
+
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+Verdict Compose(const test::Stages& s, const Naming& naming) {
+  const TieResult ties = FindTies(nullptr, s.in, s.base, s.set, s.refinement, naming.named, s.options.ties);
+  return ComposeVerdict(s.base, s.set, s.refinement, s.confidence, s.adequacy, naming, ties, s.options.verdict);
+}
+
+TEST(VerdictStage, APlantedKnobIsNamedAndExplained) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 6);
+  ASSERT_EQ(s.naming.named.size(), 1u);
+  const Verdict v = Compose(s, s.naming);
+  EXPECT_EQ(v.status, "explained") << v.sentence;
+  EXPECT_EQ(v.named[0].knob, "floor.friction");
+  EXPECT_NE(v.sentence.find("floor.friction = "), std::string::npos) << v.sentence;
+  EXPECT_NE(v.sentence.find("range 0.3 to 1.5"), std::string::npos) << v.sentence;
+  EXPECT_GE(v.named[0].inclusion, 0.0);
+  EXPECT_LE(v.named[0].inclusion, 1.0);
+}
+
+TEST(VerdictStage, UnderTheInclusionThresholdNothingIsNamed) {
+  test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 6);
+  s.confidence.family_inclusion["friction"] = 0.2;
+  const Naming naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
+  EXPECT_TRUE(naming.named.empty());
+  ASSERT_EQ(naming.weak.size(), 1u);
+  const Verdict v = Compose(s, naming);
+  EXPECT_TRUE(v.named.empty());
+  EXPECT_EQ(v.status, "unexplained") << v.sentence;
+  EXPECT_NE(v.sentence.find("is below 50%"), std::string::npos) << v.sentence;
+  const auto j = nlohmann::json::parse(VerdictJson(v));
+  EXPECT_EQ(j["not_named_low_inclusion"][0]["family"], "friction");
+}
+
+TEST(VerdictStage, DoubtsMakeItPartlyExplainedAndAreInTheSentence) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.02}}, 6);
+  const Verdict v = Compose(s, s.naming);
+  ASSERT_FALSE(v.named.empty());
+  EXPECT_EQ(v.status, "partly_explained") << v.sentence;
+  ASSERT_FALSE(v.doubts.empty());
+  EXPECT_NE(v.sentence.find("Doubts:"), std::string::npos);
+  EXPECT_NE(v.sentence.find(v.doubts[0]), std::string::npos);
+}
+
+TEST(VerdictStage, BootstrapOffWritesNullInclusionAndNotComputed) {
+  test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 4);
+  s.refinement.selection_options.bootstrap_selection = 0;
+  std::mt19937_64 rng(1);
+  s.confidence = AssessConfidence(s.set, s.refinement, rng);
+  s.adequacy = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  s.naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
+  const Verdict v = Compose(s, s.naming);
+  ASSERT_FALSE(v.named.empty());
+  EXPECT_NE(v.sentence.find("inclusion not computed"), std::string::npos) << v.sentence;
+  EXPECT_TRUE(nlohmann::json::parse(VerdictJson(v))["named"][0]["inclusion"].is_null());
+}
+
+TEST(VerdictStage, LocateOnlySaysWhyAndWhere) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.5}}, 2);
+  const Verdict v = LocateOnlyVerdict(s.base, "no simulator config");
+  EXPECT_EQ(v.status, "located");
+  EXPECT_FALSE(v.structured_in.empty());
+  EXPECT_NE(v.sentence.find("no simulator config"), std::string::npos);
+  EXPECT_EQ(LocateOnlyVerdict(test::RunStages({}, 2).base, "x").status, "clean");
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real
