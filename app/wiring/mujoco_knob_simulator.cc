@@ -3,23 +3,18 @@
 #include <cmath>
 #include <cstdio>
 
+#include "sim/compiled_model.h"
 #include "sim/protocol.h"
 #include "sim/simulator.h"
+#include "sim2real/simulation_cache.h"
 #include "util/error.h"
 
 namespace dgmm::app {
 namespace {
 
-// Bump when a change of lib/sim changes what a recording at the same inputs contains.
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v1";
-
-std::uint64_t Fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
-  return h;
-}
+// Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
+// covers the compiled model, not the top-level MJCF text).
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v2";
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {
   switch (kind) {
@@ -54,14 +49,13 @@ sim2real::Knob FromSim(const sim::Knob& k) {
 MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_(config) {
   sim_knobs_ = sim::EnumerateKnobs(config_);
   for (const auto& k : sim_knobs_) knobs_.push_back(FromSim(k));
+  // Everything that determines a recording besides protocol, seed and knobs (those are in the
+  // recording key): the simulator's code version, the compiled model (included files, meshes and
+  // height fields with it) and the config without its path, so moving the robot's folder hits.
   sim::SimConfig keyed = config_;
-  keyed.mjcf_path.clear();  // moving the robot's folder must not change the key
-  const std::string text = std::string(kSimulatorCodeVersion) + "\n" + sim::RobotMjcfText(config_) + "\n" +
-                           sim::SimConfigToJson(keyed);
-  char hex[33];
-  std::snprintf(hex, sizeof hex, "%016llx%016llx", static_cast<unsigned long long>(Fnv1a(text)),
-                static_cast<unsigned long long>(Fnv1a(text, 0x9e3779b97f4a7c15ull)));
-  fingerprint_ = hex;
+  keyed.mjcf_path.clear();
+  fingerprint_ = sim2real::HashHex(std::string(kSimulatorCodeVersion) + "\n" + sim::CompiledModelBytes(config_) +
+                                   "\n" + sim::SimConfigToJson(keyed));
   const sim::Simulator robot(config_);
   total_mass_kg_ = robot.total_mass_kg();
   for (const auto& leg : robot.legs()) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 
+#include "sim/compiled_model.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -69,6 +70,13 @@ MjModelPtr LoadRobotModel(const SimConfig& config) {
     throw MakeInputError(config.mjcf_path, "MJCF", error[0] ? error : "MuJoCo cannot load it");
   }
   return model;
+}
+
+std::string CompiledModelBytes(const SimConfig& config) {
+  const MjModelPtr model = LoadRobotModel(config);
+  std::string bytes(static_cast<std::size_t>(mj_sizeModel(model.get())), '\0');
+  mj_saveModel(model.get(), nullptr, bytes.data(), static_cast<int>(bytes.size()));
+  return bytes;
 }
 
 RobotParts FindRobotParts(const mjModel* m, const SimConfig& c, const std::string& source) {

@@ -4,9 +4,46 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "sim2real/simulation_cache.h"
 
 namespace dgmm::app {
 namespace {
+
+namespace fs = std::filesystem;
+
+std::string ReadText(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+void WriteText(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+// The second robot in `dir`: robot.xml includes body.xml (harvestman.xml, with the torso's
+// half-height replaced by `torso_half_height`); the config is harvestman.json pointing at robot.xml.
+sim::SimConfig IncludingRobot(const fs::path& dir, const std::string& torso_half_height) {
+  const fs::path robots = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots";
+  fs::create_directories(dir);
+  std::string body = ReadText(robots / "harvestman.xml");
+  const std::string torso = "size=\"0.22 0.12 0.035\"";
+  const auto at = body.find(torso);
+  if (at == std::string::npos) throw std::runtime_error("harvestman.xml: torso size not found");
+  body.replace(at, torso.size(), "size=\"0.22 0.12 " + torso_half_height + "\"");
+  WriteText(dir / "body.xml", body);
+  WriteText(dir / "robot.xml", "<mujoco model=\"wrapper\"><include file=\"body.xml\"/></mujoco>\n");
+  sim::SimConfig config = sim::LoadSimConfig((robots / "harvestman.json").string());
+  config.mjcf_path = (dir / "robot.xml").string();
+  return config;
+}
 
 TEST(MujocoKnobSimulator, KnobsOfTheBuiltInRobotCarryLegSideAndPhysicalLimits) {
   const MujocoKnobSimulator sim{sim::SimConfig{}};
@@ -40,6 +77,44 @@ TEST(MujocoKnobSimulator, FingerprintFollowsTheConfigNotItsPath) {
   b.friction.sliding = 0.7;
   EXPECT_EQ(MujocoKnobSimulator(a).Fingerprint(), MujocoKnobSimulator(a).Fingerprint());
   EXPECT_NE(MujocoKnobSimulator(a).Fingerprint(), MujocoKnobSimulator(b).Fingerprint());
+}
+
+TEST(MujocoKnobSimulator, FingerprintFollowsIncludedFilesAndNotTheRobotsFolder) {
+  const fs::path root = fs::temp_directory_path() / ("dgmm_knob_sim_include_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  const MujocoKnobSimulator a(IncludingRobot(root / "a", "0.035"));
+  const MujocoKnobSimulator moved(IncludingRobot(root / "moved" / "b", "0.035"));
+  const MujocoKnobSimulator edited(IncludingRobot(root / "c", "0.045"));
+  fs::remove_all(root);
+  EXPECT_EQ(a.Fingerprint(), moved.Fingerprint());
+  EXPECT_NE(a.Fingerprint(), edited.Fingerprint());
+  // The recording cache keys follow: the edited robot cannot be served the old robot's recordings.
+  const sim2real::Recording rec{"paper", 3, 2};
+  EXPECT_EQ(sim2real::RecordingKey(a, rec, {}), sim2real::RecordingKey(moved, rec, {}));
+  EXPECT_NE(sim2real::RecordingKey(a, rec, {}), sim2real::RecordingKey(edited, rec, {}));
+}
+
+TEST(MujocoKnobSimulator, RecordCellRepeatsACommandAtOnePlacementAndKnobsChangeIt) {
+  const MujocoKnobSimulator sim{sim::SimConfig{}};
+  sim2real::Cell cell;
+  cell.command = Eigen::Vector3d(0.5, 0, 0);
+  cell.terrain = Eigen::Vector2d(0.2, 0.0);
+  cell.placements = 1;
+  cell.executions_per_placement = 3;
+  cell.seed = 5;
+  const sim2real::CellRecording a = sim.RecordCell(cell, {});
+  const sim2real::CellRecording b = sim.RecordCell(cell, {});
+  ASSERT_EQ(a.set.size(), 3);
+  EXPECT_EQ(a.set.x, b.set.x);
+  EXPECT_NE(a.placement.find("heading"), std::string::npos) << a.placement;
+  int friction = -1;
+  for (int k = 0; k < static_cast<int>(sim.knobs().size()); ++k) {
+    if (sim.knobs()[k].name == "floor.friction.sliding") friction = k;
+  }
+  ASSERT_GE(friction, 0);
+  EXPECT_NE(sim.RecordCell(cell, {{friction, 0.2}}).set.x, a.set.x);
+  cell.terrain = Eigen::Vector3d(0.2, 0.0, 0.0);
+  EXPECT_THROW(sim.RecordCell(cell, {}), std::exception);
 }
 
 TEST(MujocoKnobSimulator, RecordingsAtTheSameKnobsArePairedAndKnobsChangeThem) {
