@@ -47,6 +47,13 @@ sim2real::Knob FromSim(const sim::Knob& k) {
 }  // namespace
 
 MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_(config) {
+  if (config_.robot) {
+    // The knobs of lib/sim/knobs.h edit the built-in robot's config fields, which a robot
+    // block's robot does not use: analysing with them would report effects that were never applied.
+    throw MakeInputError(config_.mjcf_path.empty() ? "simulation config" : config_.mjcf_path, "robot",
+                         "the sim-vs-real knobs are not available for a robot block's robot yet (only "
+                         "'dgmm simulate'); use dgmm sim2real --locate-only");
+  }
   sim_knobs_ = sim::EnumerateKnobs(config_);
   for (const auto& k : sim_knobs_) knobs_.push_back(FromSim(k));
   // Everything that determines a recording besides protocol, seed and knobs (those are in the
@@ -58,9 +65,7 @@ MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_
                                    "\n" + sim::SimConfigToJson(keyed));
   const sim::Simulator robot(config_);
   total_mass_kg_ = robot.total_mass_kg();
-  for (const auto& leg : robot.legs()) {
-    leg_reach_m_ = std::max(leg_reach_m_, leg.coxa_out_m + leg.femur_m + leg.tibia_m);
-  }
+  leg_reach_m_ = robot.leg_reach_m();
 }
 
 std::vector<sim::KnobValue> MujocoKnobSimulator::ToSim(const std::vector<sim2real::KnobValue>& values) const {

@@ -59,6 +59,9 @@ class ObjectReader {
     }
   }
 
+  // The value of `key` (marked as used), or nullptr.
+  const json* Raw(const char* key) { return Find(key); }
+
  private:
   const json* Find(const char* key) {
     used_.insert(key);
@@ -137,7 +140,8 @@ bool SimConfig::IsValid(std::string* error) const {
       !Check(Finite(settle_duration_s) && settle_duration_s >= 0 && settle_duration_s <= 60,
              "settle_duration_s: expected a value in [0, 60] s", error))
     return false;
-  const double cycles = command_duration_s / g.period_s;
+  const double period_s = robot ? robot->gait.period_s : g.period_s;  // the gait that runs
+  const double cycles = command_duration_s / period_s;
   if (!Check(Finite(command_duration_s) && command_duration_s > 0 && command_duration_s <= 60 &&
                  std::abs(cycles - std::round(cycles)) < 1e-6 && std::round(cycles) >= 1,
              "command_duration_s: expected a whole number (>= 1) of gait periods, at most 60 s",
@@ -221,6 +225,7 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
     n.String("actuator_prefix", &c.names.actuator_prefix);
     n.CheckNoUnknownKeys();
   }
+  if (const json* robot = r.Raw("robot")) c.robot = RobotDescriptionFromJson(robot->dump(), source_name);
   r.CheckNoUnknownKeys();
   std::string error;
   if (!c.IsValid(&error)) throw MakeInputError(source_name, "", error);
@@ -281,6 +286,7 @@ std::string SimConfigToJson(const SimConfig& c) {
   j["names"] = {{"torso_body", c.names.torso_body},
                 {"floor_geom", c.names.floor_geom},
                 {"actuator_prefix", c.names.actuator_prefix}};
+  if (c.robot) j["robot"] = json::parse(RobotDescriptionToJson(*c.robot));
   return j.dump(2) + "\n";
 }
 

@@ -4,7 +4,10 @@
 // Only lib/sim sees MuJoCo: this header is plain data.
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
+
+#include "sim/robot_description.h"
 
 namespace dgmm::sim {
 
@@ -88,6 +91,10 @@ struct SimConfig {
   double settle_duration_s = 0.5;     // standing still after each placement before reading z
   std::string mjcf_path;              // empty: the built-in robot (datasets/robots/scorpion.xml)
   RobotNames names;
+  // Any legged robot (robot_description.h): with it, the model's own physics is the nominal and
+  // only slope, timestep and robot.leg_gain are applied; friction, masses, actuators, gait and
+  // names above are then unused. Without it, the built-in eight-legged conventions.
+  std::optional<RobotDescription> robot;
 
   // False with a one-line reason (field and expected range) for non-finite or out-of-range values.
   bool IsValid(std::string* error) const;

@@ -4,12 +4,14 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/generic_walker.h"
 #include "sim/mujoco_model.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
 
 struct Simulator::Impl {
+  std::unique_ptr<GenericWalker> walker;  // a robot block's robot; else the built-in conventions
   SimConfig config;
   MjModelPtr model;
   MjDataPtr data;
@@ -129,6 +131,14 @@ Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std
   if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
   const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
   impl_->config = config;
+  if (config.robot) {
+    impl_->walker = std::make_unique<GenericWalker>(config, LoadRobotModel(config), source);
+    if (edit) edit(impl_->walker->model());
+    impl_->walker->Start();
+    const double a = config.slope_deg * M_PI / 180;
+    impl_->up = Eigen::Vector3d(std::sin(a), 0, std::cos(a));
+    return;
+  }
   impl_->model = LoadRobotModel(config);
   impl_->parts = FindRobotParts(impl_->model.get(), config, source);
   ApplyConfig(config, impl_->parts, impl_->model.get(), source);
@@ -145,6 +155,7 @@ Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std
 Simulator::~Simulator() = default;
 
 RunOutcome Simulator::Place(double x_m, double y_m, double heading_rad) {
+  if (impl_->walker) return impl_->walker->Place(x_m, y_m, heading_rad);
   Impl& s = *impl_;
   mjModel* m = s.model.get();
   mjData* d = s.data.get();
@@ -169,6 +180,7 @@ RunOutcome Simulator::Place(double x_m, double y_m, double heading_rad) {
 }
 
 RunOutcome Simulator::Stand(double seconds) {
+  if (impl_->walker) return impl_->walker->Stand(seconds);
   Impl& s = *impl_;
   const auto feet = s.NominalFeet();
   const int steps = static_cast<int>(std::lround(seconds / s.model->opt.timestep));
@@ -188,6 +200,11 @@ RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command, std::vector<Pos
 RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command,
                                  const std::function<void(const Simulator&)>& observer,
                                  int observe_every) {
+  if (impl_->walker) {
+    return impl_->walker->Run(command, [&](int step) {
+      if (observer && (step + 1) % std::max(1, observe_every) == 0) observer(*this);
+    });
+  }
   Impl& s = *impl_;
   const double dt = s.model->opt.timestep;
   const double duration = s.config.command_duration_s;
@@ -208,27 +225,39 @@ RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command,
       });
 }
 
-Pose Simulator::TorsoPose() const { return impl_->Torso(); }
+Pose Simulator::TorsoPose() const { return impl_->walker ? impl_->walker->RobotPose() : impl_->Torso(); }
 
 Eigen::Vector2d Simulator::TruePitchRoll() const {
-  return PitchRollFromGravity(impl_->Torso().rotation, impl_->up);
+  return PitchRollFromGravity(TorsoPose().rotation, impl_->up);
 }
 
 Eigen::Vector3d Simulator::Up() const { return impl_->up; }
-double Simulator::time_s() const { return impl_->time_s; }
+double Simulator::time_s() const { return impl_->walker ? impl_->walker->time_s() : impl_->time_s; }
 
 double Simulator::total_mass_kg() const {
+  const mjModel* m = impl_->walker ? impl_->walker->model() : impl_->model.get();
   double total = 0;
-  for (int b = 1; b < impl_->model->nbody; ++b) total += impl_->model->body_mass[b];
+  for (int b = 1; b < m->nbody; ++b) total += m->body_mass[b];
   return total;
+}
+
+double Simulator::leg_reach_m() const {
+  if (impl_->walker) return impl_->walker->robot().reach_m;
+  double reach = 0;
+  for (const auto& leg : impl_->parts.legs) reach = std::max(reach, leg.coxa_out_m + leg.femur_m + leg.tibia_m);
+  return reach;
+}
+
+int Simulator::leg_count() const {
+  return impl_->walker ? static_cast<int>(impl_->walker->robot().legs.size()) : kNumLegs;
 }
 
 const std::array<LegGeometry, kNumLegs>& Simulator::legs() const { return impl_->parts.legs; }
 const SimConfig& Simulator::config() const { return impl_->config; }
 
 std::vector<GeomSnapshot> Simulator::Geometry() const {
-  const mjModel* m = impl_->model.get();
-  const mjData* d = impl_->data.get();
+  const mjModel* m = impl_->walker ? impl_->walker->model() : impl_->model.get();
+  const mjData* d = impl_->walker ? impl_->walker->data() : impl_->data.get();
   std::vector<GeomSnapshot> geoms;
   for (int i = 0; i < m->ngeom; ++i) {
     if (m->geom_rgba[4 * i + 3] <= 0) continue;

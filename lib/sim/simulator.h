@@ -38,7 +38,8 @@ enum class RunOutcome { kCompleted, kFell, kUnstable };
 class Simulator {
  public:
   // Loads the built-in robot (or config.mjcf_path) and applies the config. Throws InputError for
-  // an invalid config, an unloadable MJCF or one that breaks the naming/kinematic conventions.
+  // an invalid config, an unloadable MJCF or one that breaks the naming/kinematic conventions
+  // (or, with a robot block, one its description does not fit: lib/sim/legged_robot.h).
   explicit Simulator(const SimConfig& config, const ModelEdit& edit = {});
   ~Simulator();
   Simulator(const Simulator&) = delete;
@@ -64,6 +65,10 @@ class Simulator {
   Eigen::Vector3d Up() const;            // unit vector against gravity, slope frame
   double time_s() const;                 // simulated time since construction
   double total_mass_kg() const;
+  // The longest leg's reach (m): hip to foot summed over the leg's links.
+  double leg_reach_m() const;
+  int leg_count() const;
+  // The built-in robot's legs (a robot block's robot: all zero; see leg_reach_m()).
   const std::array<LegGeometry, kNumLegs>& legs() const;
   const SimConfig& config() const;
 

@@ -1,0 +1,36 @@
+#pragma once
+// Timing of the generic gait (any number of legs): each leg's phase offset in the cycle and the
+// duty factor, from a named pattern or user phases, and each foot's offset from its stance
+// position over the cycle. MuJoCo-free.
+#include <Eigen/Core>
+#include <vector>
+
+#include "sim/robot_description.h"
+
+namespace dgmm::sim {
+
+// Where a leg is, to order legs for the named patterns: side +1 left / -1 right, and its foot's
+// forward coordinate (robot frame, m).
+struct LegPlace {
+  int side = 1;
+  double forward_m = 0;
+};
+
+struct GaitTiming {
+  std::vector<double> phase;  // per leg, in [0, 1)
+  double duty = 0.5;          // share of the cycle each foot is on the ground
+};
+
+// The pattern's timing for these legs: trot / crawl need 4 legs, tripod / tetrapod / wave 6,
+// alternating_tetrapod 8, each half on either side; auto picks trot, tripod or the alternating
+// tetrapod by the leg count; custom takes gait.phases (one per leg). Throws InputError
+// "<source>: robot.gait.pattern: ..." when the pattern needs another number of legs.
+GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>& legs, const std::string& source);
+
+// A foot's offset from its stance position at fraction u in [0, 1) of its own cycle (u = 0:
+// touch-down): on the ground (u < duty) it moves from +d/2 to -d/2 at constant speed; in the air
+// it returns along a cosine profile and lifts by `lift` * sin(pi s). d is the foot's travel
+// relative to the torso per stance.
+Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, double lift);
+
+}  // namespace dgmm::sim

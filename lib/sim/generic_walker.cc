@@ -1,0 +1,135 @@
+#include "sim/generic_walker.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "sim/simulator.h"
+
+namespace dgmm::sim {
+
+GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const std::string& source)
+    : config_(config), model_(std::move(model)) {
+  robot_ = BindRobot(model_.get(), *config.robot, source);
+  ApplyExperiment(*config.robot, robot_, config.slope_deg, config.timestep_s, model_.get());
+  const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
+  control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
+}
+
+void GenericWalker::Start() {
+  data_.reset(mj_makeData(model_.get()));
+  scratch_.reset(mj_makeData(model_.get()));
+  for (int k = 0; k < 7; ++k) scratch_->qpos[robot_.torso_qpos + k] = k == 3 ? 1 : 0;  // torso frame = world
+  mj_setConst(model_.get(), data_.get());
+}
+
+bool GenericWalker::Step() {
+  mj_step(model_.get(), data_.get());
+  time_s_ += model_->opt.timestep;
+  bool ok = true;
+  for (int w = 0; w < mjNWARNING; ++w) {
+    if (data_->warning[w].number > 0) ok = false;
+    data_->warning[w].number = 0;
+  }
+  return ok;
+}
+
+Pose GenericWalker::RobotPose() const {
+  Pose pose;
+  const int b = robot_.torso_body;
+  pose.position_m = Eigen::Vector3d(data_->xpos[3 * b], data_->xpos[3 * b + 1], data_->xpos[3 * b + 2]);
+  const Eigen::Matrix3d torso = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(data_->xmat + 9 * b);
+  pose.rotation = torso * robot_.robot_in_torso;
+  return pose;
+}
+
+bool GenericWalker::Fallen() const {
+  const Pose pose = RobotPose();
+  const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
+  const double kMinHeightShare = 0.4;  // of the stance height
+  return pose.rotation(2, 2) < kMaxTiltCos || pose.position_m.z() < kMinHeightShare * robot_.stance_height_m;
+}
+
+void GenericWalker::HoldStance() {
+  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+    const LegChain& leg = robot_.legs[i];
+    q_[i] = leg.stance_q;
+    for (std::size_t k = 0; k < leg.actuators.size(); ++k) data_->ctrl[leg.actuators[k]] = q_[i][k];
+  }
+}
+
+RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
+  mjModel* m = model_.get();
+  mjData* d = data_.get();
+  mj_resetData(m, d);
+  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
+  q_.resize(robot_.legs.size());
+  double extent = 0;
+  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+    const LegChain& leg = robot_.legs[i];
+    for (std::size_t k = 0; k < leg.qpos.size(); ++k) d->qpos[leg.qpos[k]] = leg.stance_q[k];
+    extent = std::max(extent, leg.foot_extent_m);
+  }
+  const Eigen::Matrix3d world = Eigen::AngleAxisd(heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
+                                robot_.robot_in_torso.transpose();
+  const Eigen::Quaterniond q(world);
+  const double kDrop = 0.02 * robot_.reach_m;  // released just above the ground
+  const int a = robot_.torso_qpos;
+  d->qpos[a + 0] = x_m;
+  d->qpos[a + 1] = y_m;
+  d->qpos[a + 2] = robot_.stance_height_m + extent + kDrop;
+  d->qpos[a + 3] = q.w();
+  d->qpos[a + 4] = q.x();
+  d->qpos[a + 5] = q.y();
+  d->qpos[a + 6] = q.z();
+  HoldStance();
+  mj_forward(m, d);
+  return Stand(config_.settle_duration_s);
+}
+
+RunOutcome GenericWalker::Stand(double seconds) {
+  HoldStance();
+  const int steps = static_cast<int>(std::lround(seconds / model_->opt.timestep));
+  for (int s = 0; s < steps; ++s) {
+    if (!Step()) return RunOutcome::kUnstable;
+    if (Fallen()) return RunOutcome::kFell;
+  }
+  return RunOutcome::kCompleted;
+}
+
+// Foot targets of the generic gait at time t of a command, through inverse kinematics to joint
+// targets: each foot travels d_i = duty (stride (long, lat) + turn_rad turn z x p_i) per stance,
+// so the torso moves stride per cycle and turns turn_rad per cycle; a ramp of a tenth of a cycle at
+// either end of the command starts and ends the pattern at the stance.
+void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration) {
+  const double period = config_.robot->gait.period_s;
+  const double ramp = 0.1 * period;
+  const double envelope = std::clamp(std::min(t, duration - t) / ramp, 0.0, 1.0);
+  const double duty = robot_.timing.duty;
+  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+    const LegChain& leg = robot_.legs[i];
+    const Eigen::Vector2d p = leg.stance_m.head<2>();
+    const Eigen::Vector2d d =
+        duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) + config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
+    const double u = t / period - robot_.timing.phase[i];
+    const Eigen::Vector3d foot = leg.stance_m + envelope * FootOffset(u, duty, d, robot_.step_height_m);
+    SolveLegIk(model_.get(), scratch_.get(), leg, robot_.robot_in_torso * foot, &q_[i], 8);
+    for (std::size_t k = 0; k < leg.actuators.size(); ++k) data_->ctrl[leg.actuators[k]] = q_[i][k];
+  }
+}
+
+RunOutcome GenericWalker::Run(const Eigen::Vector3d& command, const std::function<void(int)>& observe) {
+  const double dt = model_->opt.timestep;
+  const double duration = config_.command_duration_s;
+  const int steps = static_cast<int>(std::lround(duration / dt));
+  const Eigen::Vector3d c = command.cwiseMax(-1.0).cwiseMin(1.0);
+  for (int s = 0; s < steps; ++s) {
+    if (s % control_every_ == 0) Control(c, (s + 1) * dt, duration);
+    if (!Step()) return RunOutcome::kUnstable;
+    if (observe) observe(s);
+    if (Fallen()) return RunOutcome::kFell;
+  }
+  return RunOutcome::kCompleted;
+}
+
+}  // namespace dgmm::sim

@@ -1,0 +1,52 @@
+#pragma once
+// Internal to dgmm_sim: any legged robot of a RobotDescription walking on the slope with the
+// generic gait (legged_robot.h). Simulator forwards to it when the config has a robot block.
+#include <Eigen/Core>
+#include <functional>
+#include <vector>
+
+#include "sim/legged_robot.h"
+#include "sim/pose.h"
+#include "sim/sim_config.h"
+
+namespace dgmm::sim {
+
+enum class RunOutcome;  // simulator.h
+
+class GenericWalker {
+ public:
+  // Binds config.robot to `model` (already compiled; the walker owns it from here) and applies
+  // the experiment (slope, timestep, leg gains). Throws InputError naming the part at fault.
+  GenericWalker(const SimConfig& config, MjModelPtr model, const std::string& source);
+
+  mjModel* model() { return model_.get(); }
+  // Creates the state (after any edit of the model).
+  void Start();
+
+  RunOutcome Place(double x_m, double y_m, double heading_rad);
+  RunOutcome Stand(double seconds);
+  // Runs the command for config.command_duration_s, calling `observe(step)` after every step.
+  RunOutcome Run(const Eigen::Vector3d& command, const std::function<void(int)>& observe);
+
+  Pose RobotPose() const;  // the robot frame (forward, left, up) in the slope frame
+  double time_s() const { return time_s_; }
+  const mjModel* model() const { return model_.get(); }
+  const mjData* data() const { return data_.get(); }
+  const LeggedRobot& robot() const { return robot_; }
+
+ private:
+  bool Step();
+  bool Fallen() const;
+  void Control(const Eigen::Vector3d& command, double t, double duration);
+  void HoldStance();
+
+  SimConfig config_;
+  MjModelPtr model_;
+  MjDataPtr data_, scratch_;
+  LeggedRobot robot_;
+  std::vector<Eigen::VectorXd> q_;  // each leg's joint targets
+  double time_s_ = 0;
+  int control_every_ = 1;
+};
+
+}  // namespace dgmm::sim

@@ -1,0 +1,316 @@
+#include "sim/legged_robot.h"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+Eigen::Vector3d Vec(const mjtNum* v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
+Eigen::Matrix3d Mat(const mjtNum* m) { return Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(m); }
+
+std::string LegPart(int i, const LegDescription& leg) {
+  return "robot.legs[" + std::to_string(i) + "] (" + leg.name + ")";
+}
+
+int Find(const mjModel* m, mjtObj type, const std::string& name, const std::string& kind, const std::string& field,
+         const std::string& source) {
+  const int id = mj_name2id(m, type, name.c_str());
+  if (id < 0) throw MakeInputError(source, field, "the model has no " + kind + " named \"" + name + "\"");
+  return id;
+}
+
+bool IsDescendant(const mjModel* m, int body, int ancestor) {
+  for (int b = body; b > 0; b = m->body_parentid[b]) {
+    if (b == ancestor) return true;
+  }
+  return ancestor == 0;
+}
+
+// A position servo: force = gain * ctrl - gain * q (MuJoCo's <position>).
+bool IsPositionServo(const mjModel* m, int a) {
+  return m->actuator_gaintype[a] == mjGAIN_FIXED && m->actuator_biastype[a] == mjBIAS_AFFINE &&
+         m->actuator_biasprm[mjNBIAS * a + 1] < 0;
+}
+
+// The actuator driving `joint`, or -1.
+int ActuatorOf(const mjModel* m, int joint) {
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_trnid[2 * a] == joint) return a;
+  }
+  return -1;
+}
+
+// How far the geom reaches below its centre along world z (the contact extent of a foot).
+double ExtentBelow(const mjModel* m, const mjData* d, int g) {
+  const mjtNum* s = m->geom_size + 3 * g;
+  const Eigen::Matrix3d r = Mat(d->geom_xmat + 9 * g);
+  const Eigen::Vector3d z = r.row(2).transpose();  // world z in the geom frame
+  switch (m->geom_type[g]) {
+    case mjGEOM_SPHERE: return s[0];
+    case mjGEOM_CAPSULE: return s[0] + s[1] * std::abs(z.z());
+    case mjGEOM_CYLINDER: return s[0] * std::sqrt(std::max(0.0, 1 - z.z() * z.z())) + s[1] * std::abs(z.z());
+    case mjGEOM_BOX: return s[0] * std::abs(z.x()) + s[1] * std::abs(z.y()) + s[2] * std::abs(z.z());
+    case mjGEOM_ELLIPSOID: return Eigen::Vector3d(s[0] * z.x(), s[1] * z.y(), s[2] * z.z()).norm();
+    default: return m->geom_rbound[g];  // meshes and the rest: the bounding sphere
+  }
+}
+
+void BindFoot(const mjModel* m, const FootDescription& foot, const std::string& part, const std::string& source,
+              LegChain* leg) {
+  if (!foot.site.empty()) {
+    leg->foot_site = Find(m, mjOBJ_SITE, foot.site, "site", part + ".foot.site", source);
+    leg->foot_body = m->site_bodyid[leg->foot_site];
+  } else if (!foot.geom.empty()) {
+    leg->foot_geom = Find(m, mjOBJ_GEOM, foot.geom, "geom", part + ".foot.geom", source);
+    leg->foot_body = m->geom_bodyid[leg->foot_geom];
+  } else {
+    leg->foot_body = Find(m, mjOBJ_BODY, foot.body, "body", part + ".foot.body", source);
+    leg->foot_offset_m = foot.offset_m;
+  }
+}
+
+// Joints, actuators and foot of leg i, checked to lie on one torso-to-foot chain.
+LegChain BindChain(const mjModel* m, const RobotDescription& r, int i, int torso, const std::string& source) {
+  const LegDescription& desc = r.legs[i];
+  const std::string part = LegPart(i, desc);
+  LegChain leg;
+  leg.name = desc.name;
+  BindFoot(m, desc.foot, part, source, &leg);
+  int parent_body = torso;
+  for (std::size_t k = 0; k < desc.joints.size(); ++k) {
+    const int j = Find(m, mjOBJ_JOINT, desc.joints[k], "joint", part + ".joints", source);
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) {
+      throw MakeInputError(source, part + ".joints", "joint \"" + desc.joints[k] + "\" is not a hinge or slide joint");
+    }
+    const int body = m->jnt_bodyid[j];
+    if (body == torso || !IsDescendant(m, body, parent_body) || !IsDescendant(m, leg.foot_body, body)) {
+      throw MakeInputError(source, part + ".joints",
+                           "joint \"" + desc.joints[k] + "\" is not on the chain from the torso to the foot (in order)");
+    }
+    parent_body = body;
+    int a = -1;
+    if (desc.actuators.empty()) {
+      a = ActuatorOf(m, j);
+      if (a < 0) {
+        throw MakeInputError(source, part + ".joints",
+                             "no actuator drives joint \"" + desc.joints[k] +
+                                 "\" (add one, or model the leg without it and list the joint in robot.passive_joints)");
+      }
+    } else {
+      a = Find(m, mjOBJ_ACTUATOR, desc.actuators[k], "actuator", part + ".actuators", source);
+      if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_trnid[2 * a] != j) {
+        throw MakeInputError(source, part + ".actuators",
+                             "actuator \"" + desc.actuators[k] + "\" does not drive joint \"" + desc.joints[k] + "\"");
+      }
+    }
+    if (!IsPositionServo(m, a)) {
+      const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+      throw MakeInputError(source, part + ".actuators",
+                           std::string("actuator \"") + (name ? name : "?") +
+                               "\" is not a position servo (motor or other actuation): the generic gait sends joint "
+                               "angles; a replay controller for torques is not available yet");
+    }
+    leg.joints.push_back(j);
+    leg.qpos.push_back(m->jnt_qposadr[j]);
+    leg.dofs.push_back(m->jnt_dofadr[j]);
+    leg.actuators.push_back(a);
+  }
+  return leg;
+}
+
+// Every joint is a leg's, passive or the torso's free joint; every actuator drives a leg joint.
+void CheckEverythingAccounted(const mjModel* m, const RobotDescription& r, const LeggedRobot& bound,
+                              const std::string& source) {
+  std::set<int> leg_joints, leg_actuators(bound.leg_actuators.begin(), bound.leg_actuators.end()), passive;
+  for (const auto& leg : bound.legs) leg_joints.insert(leg.joints.begin(), leg.joints.end());
+  for (const auto& name : r.passive_joints) {
+    const int j = Find(m, mjOBJ_JOINT, name, "joint", "robot.passive_joints", source);
+    if (leg_joints.count(j)) {
+      throw MakeInputError(source, "robot.passive_joints", "joint \"" + name + "\" is also a leg's driven joint");
+    }
+    passive.insert(j);
+  }
+  for (int j = 0; j < m->njnt; ++j) {
+    if (m->jnt_type[j] == mjJNT_FREE || leg_joints.count(j) || passive.count(j)) continue;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    throw MakeInputError(source, "robot.legs",
+                         std::string("joint \"") + (name ? name : "(unnamed)") +
+                             "\" belongs to no leg and is not declared in robot.passive_joints");
+  }
+  for (int a = 0; a < m->nu; ++a) {
+    if (leg_actuators.count(a)) continue;
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+    throw MakeInputError(source, "robot.legs",
+                         std::string("actuator \"") + (name ? name : "(unnamed)") + "\" drives no leg's joint");
+  }
+}
+
+// Forward/left/up of the robot in the torso frame.
+Eigen::Matrix3d RobotFrame(const Eigen::Vector3d& forward) {
+  Eigen::Matrix3d r;
+  r.col(0) = forward.normalized();
+  r.col(2) = Eigen::Vector3d::UnitZ();
+  r.col(1) = r.col(2).cross(r.col(0));
+  return r;
+}
+
+// Rest-pose geometry of every leg: reach, side (checked against the declared one), foot extent.
+void MeasureRest(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* bound) {
+  MjDataPtr d(mj_makeData(m));
+  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
+  for (int k = 0; k < 7; ++k) d->qpos[bound->torso_qpos + k] = k == 3 ? 1 : 0;
+  mj_kinematics(m, d.get());
+  for (std::size_t i = 0; i < bound->legs.size(); ++i) {
+    LegChain& leg = bound->legs[i];
+    Eigen::Vector3d last = Vec(d->xanchor + 3 * leg.joints[0]);
+    for (std::size_t k = 1; k < leg.joints.size(); ++k) {
+      const Eigen::Vector3d a = Vec(d->xanchor + 3 * leg.joints[k]);
+      leg.reach_m += (a - last).norm();
+      last = a;
+    }
+    const Eigen::Vector3d foot = FootPoint(m, d.get(), leg);
+    leg.reach_m += (foot - last).norm();
+    leg.foot_extent_m = leg.foot_geom >= 0 ? ExtentBelow(m, d.get(), leg.foot_geom) : 0;
+    const Eigen::Vector3d in_robot = bound->robot_in_torso.transpose() * foot;
+    const int side = in_robot.y() >= 0 ? 1 : -1;
+    const std::string& declared = r.legs[i].side;
+    if (!declared.empty() && (declared == "left" ? 1 : -1) != side) {
+      throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]) + ".side",
+                           "declared " + declared + " but the foot is on the " + (side > 0 ? "left" : "right") +
+                               " of the forward axis");
+    }
+    leg.side = side;
+    leg.stance_m = in_robot;
+    leg.stance_q.resize(static_cast<int>(leg.qpos.size()));
+    for (std::size_t k = 0; k < leg.qpos.size(); ++k) leg.stance_q[k] = d->qpos[leg.qpos[k]];
+    bound->reach_m = std::max(bound->reach_m, leg.reach_m);
+    if (leg.reach_m < 1e-3) {
+      throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]), "the leg has no length");
+    }
+  }
+}
+
+// Stance height and gait lengths from the description (relative to reach unless in metres).
+void ChooseLengths(const RobotDescription& r, LeggedRobot* b, const std::string& source) {
+  const auto& g = r.gait;
+  double rest_drop = 0;
+  for (const auto& leg : b->legs) rest_drop = std::max(rest_drop, -leg.stance_m.z());
+  b->stance_height_m = g.stance_height_m > 0        ? g.stance_height_m
+                       : g.stance_height_reach > 0 ? g.stance_height_reach * b->reach_m
+                                                   : 0.9 * rest_drop;
+  if (b->stance_height_m < 0.05 * b->reach_m) {
+    throw MakeInputError(source, "robot.gait.stance_height_m",
+                         "the feet are not below the torso at the model's rest pose: give a stance height");
+  }
+  b->stride_m = g.stride_m > 0 ? g.stride_m : g.stride_reach * b->reach_m;
+  b->step_height_m = g.step_height_m > 0 ? g.step_height_m : g.step_height_reach * b->reach_m;
+}
+
+// Every foot must reach its stance point: inverse kinematics from the rest pose.
+void SolveStance(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* b) {
+  MjDataPtr d(mj_makeData(m));
+  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
+  for (int k = 0; k < 7; ++k) d->qpos[b->torso_qpos + k] = k == 3 ? 1 : 0;
+  for (std::size_t i = 0; i < b->legs.size(); ++i) {
+    LegChain& leg = b->legs[i];
+    leg.stance_m.z() = -b->stance_height_m;
+    const double residual = SolveLegIk(m, d.get(), leg, b->robot_in_torso * leg.stance_m, &leg.stance_q, 200);
+    if (residual > 0.05 * leg.reach_m) {
+      char what[160];
+      std::snprintf(what, sizeof what, "the foot cannot reach the ground %.3g m below the torso (off by %.3g m)",
+                    b->stance_height_m, residual);
+      throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]), what);
+    }
+  }
+}
+
+}  // namespace
+
+Eigen::Vector3d FootPoint(const mjModel* m, const mjData* d, const LegChain& leg) {
+  if (leg.foot_site >= 0) return Vec(d->site_xpos + 3 * leg.foot_site);
+  if (leg.foot_geom >= 0) return Vec(d->geom_xpos + 3 * leg.foot_geom);
+  return Vec(d->xpos + 3 * leg.foot_body) + Mat(d->xmat + 9 * leg.foot_body) * leg.foot_offset_m;
+}
+
+double SolveLegIk(const mjModel* m, mjData* d, const LegChain& leg, const Eigen::Vector3d& target,
+                  Eigen::VectorXd* q, int iterations) {
+  const int n = static_cast<int>(leg.qpos.size());
+  std::vector<mjtNum> jacp(3 * m->nv);
+  const double lambda = 0.02 * std::max(leg.reach_m, 1e-3);
+  double residual = 0;
+  for (int it = 0; it <= iterations; ++it) {
+    for (int k = 0; k < n; ++k) d->qpos[leg.qpos[k]] = (*q)[k];
+    mj_kinematics(m, d);
+    mj_comPos(m, d);
+    const Eigen::Vector3d foot = FootPoint(m, d, leg);
+    const Eigen::Vector3d e = target - foot;
+    residual = e.norm();
+    if (it == iterations || residual < 1e-5 * leg.reach_m) break;
+    mj_jac(m, d, jacp.data(), nullptr, foot.data(), leg.foot_body);
+    Eigen::MatrixXd j(3, n);
+    for (int k = 0; k < n; ++k) {
+      for (int r = 0; r < 3; ++r) j(r, k) = jacp[r * m->nv + leg.dofs[k]];
+    }
+    const Eigen::Matrix3d a = j * j.transpose() + lambda * lambda * Eigen::Matrix3d::Identity();
+    Eigen::VectorXd dq = j.transpose() * a.ldlt().solve(e);
+    const double max_step = 0.3;  // rad (or m for slides) per iteration
+    if (dq.cwiseAbs().maxCoeff() > max_step) dq *= max_step / dq.cwiseAbs().maxCoeff();
+    for (int k = 0; k < n; ++k) {
+      double v = (*q)[k] + dq[k];
+      const int jn = leg.joints[k];
+      if (m->jnt_limited[jn]) v = std::clamp(v, m->jnt_range[2 * jn], m->jnt_range[2 * jn + 1]);
+      (*q)[k] = v;
+    }
+  }
+  return residual;
+}
+
+LeggedRobot BindRobot(const mjModel* m, const RobotDescription& r, const std::string& source) {
+  LeggedRobot b;
+  b.torso_body = Find(m, mjOBJ_BODY, r.torso_body, "body", "robot.torso_body", source);
+  const int root = m->body_jntadr[b.torso_body];
+  if (root < 0 || m->jnt_type[root] != mjJNT_FREE) {
+    throw MakeInputError(source, "robot.torso_body", "the torso body \"" + r.torso_body + "\" needs a free joint");
+  }
+  b.torso_qpos = m->jnt_qposadr[root];
+  b.torso_dof = m->jnt_dofadr[root];
+  b.floor_geom = Find(m, mjOBJ_GEOM, r.floor_geom, "geom", "robot.floor_geom", source);
+  b.robot_in_torso = RobotFrame(r.forward_axis);
+  for (int i = 0; i < static_cast<int>(r.legs.size()); ++i) {
+    b.legs.push_back(BindChain(m, r, i, b.torso_body, source));
+    b.leg_actuators.insert(b.leg_actuators.end(), b.legs.back().actuators.begin(), b.legs.back().actuators.end());
+  }
+  CheckEverythingAccounted(m, r, b, source);
+  MeasureRest(m, r, source, &b);
+  std::vector<LegPlace> places;
+  for (const auto& leg : b.legs) places.push_back({leg.side, leg.stance_m.x()});
+  b.timing = ResolveGait(r.gait, places, source);
+  ChooseLengths(r, &b, source);
+  SolveStance(m, r, source, &b);
+  return b;
+}
+
+void ApplyExperiment(const RobotDescription& r, const LeggedRobot& b, double slope_deg, double timestep_s,
+                     mjModel* m) {
+  m->opt.timestep = timestep_s;
+  const double g = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]).norm();
+  const double slope = slope_deg * M_PI / 180;
+  m->opt.gravity[0] = -g * std::sin(slope);  // the slope frame: downhill is -x
+  m->opt.gravity[1] = 0;
+  m->opt.gravity[2] = -g * std::cos(slope);
+  for (const auto& leg : b.legs) {
+    const auto it = r.leg_gain.find(leg.name);
+    if (it == r.leg_gain.end() || it->second == 1.0) continue;
+    for (int a : leg.actuators) {
+      m->actuator_gainprm[mjNGAIN * a] *= it->second;
+      m->actuator_biasprm[mjNBIAS * a + 1] *= it->second;
+    }
+  }
+}
+
+}  // namespace dgmm::sim

@@ -1,0 +1,59 @@
+#pragma once
+// Internal to dgmm_sim (includes MuJoCo): a RobotDescription bound to a compiled model and
+// checked against it, and the generic gait that walks it (numerical inverse kinematics on each
+// foot's Jacobian, timing from gait_table.h). Used by Simulator when a config has a robot block.
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "sim/gait_table.h"
+#include "sim/mujoco_model.h"
+#include "sim/robot_description.h"
+
+namespace dgmm::sim {
+
+struct LegChain {
+  std::string name;
+  std::vector<int> joints, qpos, dofs, actuators;
+  int foot_site = -1, foot_geom = -1, foot_body = -1;
+  Eigen::Vector3d foot_offset_m = Eigen::Vector3d::Zero();  // in foot_body's frame
+  int side = 1;                    // +1 left, -1 right of the forward axis
+  double reach_m = 0;              // joint-to-joint and last joint-to-foot lengths at rest, summed
+  double foot_extent_m = 0;        // lowest contact point below the foot point
+  Eigen::Vector3d stance_m = Eigen::Vector3d::Zero();  // standing foot position, robot frame
+  Eigen::VectorXd stance_q;        // the leg's joint values there
+};
+
+struct LeggedRobot {
+  int torso_body = -1, torso_qpos = -1, torso_dof = -1, floor_geom = -1;
+  Eigen::Matrix3d robot_in_torso = Eigen::Matrix3d::Identity();  // columns: forward, left, up
+  std::vector<LegChain> legs;
+  std::vector<int> leg_actuators;  // every actuator a leg drives
+  GaitTiming timing;
+  double reach_m = 0, stance_height_m = 0, stride_m = 0, step_height_m = 0;
+};
+
+// Binds and validates (one-line InputError "<source>: robot.<part>: <problem>"): parts exist and
+// are of the right kind, each leg's joints lie on its torso-to-foot chain, every joint is driven
+// by a position servo of its leg or declared passive, no actuator drives anything else, declared
+// sides agree with the geometry, the gait fits the legs and every foot reaches the ground at the
+// stance height.
+LeggedRobot BindRobot(const mjModel* model, const RobotDescription& robot, const std::string& source);
+
+// The model's own physics kept; only what the experiment sets: timestep and the slope (gravity
+// tilted, magnitude kept), and per-leg gains (robot.leg_gain) on the leg's servos.
+void ApplyExperiment(const RobotDescription& robot, const LeggedRobot& bound, double slope_deg,
+                     double timestep_s, mjModel* model);
+
+// Damped least squares on the foot's Jacobian restricted to the leg's joints, joint ranges
+// respected: moves `q` (the leg's joint values) towards placing the foot at `target_m` (torso
+// frame) in `iterations` steps, using `scratch` (torso at the origin). Returns the residual (m).
+double SolveLegIk(const mjModel* model, mjData* scratch, const LegChain& leg, const Eigen::Vector3d& target_m,
+                  Eigen::VectorXd* q, int iterations);
+
+// Foot point of a leg in the world frame of `data`.
+Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegChain& leg);
+
+}  // namespace dgmm::sim

@@ -1,0 +1,66 @@
+#pragma once
+// A legged robot described as data (the optional `robot` block of a simulation config): which
+// MJCF parts are the torso, the floor and each leg, and how the generic gait drives them. A config
+// with this block is simulated with the model's own physics (docs/simulation.md, "Bring your own
+// robot"); without it, the built-in eight-legged conventions of sim_config.h apply unchanged.
+// Plain data: no MuJoCo here (the model is checked against it in robot_model.h).
+#include <Eigen/Core>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace dgmm::sim {
+
+// Where a leg touches the ground: a site, a geom, or a point in a body's frame.
+struct FootDescription {
+  std::string site, geom, body;                          // exactly one is set
+  Eigen::Vector3d offset_m = Eigen::Vector3d::Zero();    // with `body` only
+};
+
+struct LegDescription {
+  std::string name;                     // e.g. "front_left"; unique; names per-leg knobs
+  std::vector<std::string> joints;      // the leg's hinge/slide joints, torso to foot
+  std::vector<std::string> actuators;   // one per joint; empty: the actuator driving each joint
+  FootDescription foot;
+  std::string side;                     // "left", "right" or "" (taken from the geometry)
+};
+
+// Timing of the generic gait: each leg's phase in [0, 1) of the cycle and the duty factor (share
+// of the cycle a foot is on the ground). Named tables exist for 4, 6 and 8 legs
+// (gait_table.h); "custom" takes `phases`.
+struct GaitDescription {
+  std::string pattern = "auto";  // auto | trot | crawl | tripod | tetrapod | wave | alternating_tetrapod | custom
+  std::vector<double> phases;    // custom: one per leg, in the order of `legs`
+  double duty_factor = 0;        // (0, 1); 0: the pattern's own
+  double period_s = 0.6;         // one full cycle
+  // Lengths relative to the robot's leg reach (the longest torso-to-foot chain at the model's
+  // rest pose) unless the *_m field is set (> 0).
+  double stride_reach = 0.3;     // torso travel per cycle at |command| = 1
+  double stride_m = 0;
+  double step_height_reach = 0.15;
+  double step_height_m = 0;
+  double stance_height_reach = 0;  // torso above the feet; 0: the model's rest pose, 90% extended
+  double stance_height_m = 0;
+  double turn_rad = 0.3;           // yaw per cycle at |turn| = 1
+};
+
+struct RobotDescription {
+  std::string torso_body = "torso";
+  std::string floor_geom = "floor";
+  Eigen::Vector3d forward_axis = Eigen::Vector3d::UnitX();  // torso frame
+  std::vector<LegDescription> legs;
+  std::vector<std::string> passive_joints;  // joints deliberately left undriven
+  GaitDescription gait;
+  std::map<std::string, double> leg_gain;   // by leg name: scales the leg's actuator gains
+  // The model's physics is the nominal; true applies the config's friction, masses, gains and
+  // damping over it (the built-in robot's behaviour).
+  bool overwrite_physics = false;
+};
+
+// Parses the `robot` block (JSON text of one object). Unknown keys, missing names, duplicate leg
+// names and bad numbers are InputError "<source>: robot.<field>: <problem>".
+RobotDescription RobotDescriptionFromJson(const std::string& json_text, const std::string& source);
+// The block as a JSON object text (round-trips through RobotDescriptionFromJson).
+std::string RobotDescriptionToJson(const RobotDescription& robot);
+
+}  // namespace dgmm::sim

@@ -1,0 +1,73 @@
+// Timing of the generic gait (lib/sim/gait_table.h).
+#include "sim/gait_table.h"
+
+#include <gtest/gtest.h>
+
+namespace dgmm::sim {
+namespace {
+
+// Six legs in the order front-left, middle-left, rear-left, front-right, middle-right, rear-right.
+std::vector<LegPlace> Hexapod() {
+  return {{1, 0.1}, {1, 0}, {1, -0.1}, {-1, 0.1}, {-1, 0}, {-1, -0.1}};
+}
+
+TEST(GaitTable, TripodAlternatesAlongEachSideAndAcross) {
+  GaitDescription g;
+  g.pattern = "tripod";
+  const GaitTiming t = ResolveGait(g, Hexapod(), "test");
+  EXPECT_EQ(t.phase, (std::vector<double>{0, 0.5, 0, 0.5, 0, 0.5}));
+  EXPECT_DOUBLE_EQ(t.duty, 0.5);
+}
+
+TEST(GaitTable, LegsAreOrderedByPositionNotByListOrder) {
+  std::vector<LegPlace> shuffled = {{-1, -0.1}, {1, 0}, {-1, 0.1}, {1, 0.1}, {-1, 0}, {1, -0.1}};
+  GaitDescription g;
+  g.pattern = "wave";
+  const GaitTiming t = ResolveGait(g, shuffled, "test");
+  // Wave: rear left first, then middle and front left, then the right side back to front.
+  EXPECT_NEAR(t.phase[5], 0.0, 1e-12);
+  EXPECT_NEAR(t.phase[1], 1.0 / 6, 1e-12);
+  EXPECT_NEAR(t.phase[3], 2.0 / 6, 1e-12);
+  EXPECT_NEAR(t.phase[0], 3.0 / 6, 1e-12);
+  EXPECT_NEAR(t.phase[2], 5.0 / 6, 1e-12);
+}
+
+TEST(GaitTable, TrotPairsDiagonalsAndAutoPicksByLegCount) {
+  const std::vector<LegPlace> quad = {{1, 0.2}, {-1, 0.2}, {1, -0.2}, {-1, -0.2}};
+  const GaitTiming t = ResolveGait(GaitDescription{}, quad, "test");  // auto: trot
+  EXPECT_EQ(t.phase[0], t.phase[3]);
+  EXPECT_EQ(t.phase[1], t.phase[2]);
+  EXPECT_NE(t.phase[0], t.phase[1]);
+}
+
+TEST(GaitTable, APatternForAnotherLegCountIsRefusedNamingIt) {
+  GaitDescription g;
+  g.pattern = "trot";
+  try {
+    ResolveGait(g, Hexapod(), "robot.json");
+    FAIL();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("robot.gait.pattern"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("needs 4 legs"), std::string::npos) << e.what();
+  }
+  g.pattern = "custom";
+  g.phases = {0, 0.5};
+  EXPECT_THROW(ResolveGait(g, Hexapod(), "robot.json"), std::exception);
+  g.pattern = "auto";
+  g.phases.clear();
+  EXPECT_THROW(ResolveGait(g, {{1, 0}, {-1, 0}, {1, 0.1}, {-1, 0.1}, {1, 0.2}}, "robot.json"), std::exception);
+}
+
+TEST(GaitTable, FootOffsetIsContinuousAndOnTheGroundInStance) {
+  const Eigen::Vector2d d(0.04, -0.01);
+  const double duty = 0.6, lift = 0.03;
+  EXPECT_TRUE(FootOffset(0.0, duty, d, lift).isApprox(Eigen::Vector3d(0.02, -0.005, 0)));
+  EXPECT_TRUE(FootOffset(duty - 1e-9, duty, d, lift).isApprox(Eigen::Vector3d(-0.02, 0.005, 0), 1e-6));
+  EXPECT_TRUE(FootOffset(1 - 1e-9, duty, d, lift).isApprox(FootOffset(0.0, duty, d, lift), 1e-6));
+  for (double u = 0; u < duty; u += 0.05) EXPECT_EQ(FootOffset(u, duty, d, lift).z(), 0) << u;
+  EXPECT_NEAR(FootOffset(0.8, duty, d, lift).z(), lift, 1e-12);  // the middle of the swing
+  EXPECT_TRUE(FootOffset(-0.3, duty, d, lift).isApprox(FootOffset(0.7, duty, d, lift)));
+}
+
+}  // namespace
+}  // namespace dgmm::sim

@@ -1,0 +1,175 @@
+// Any legged robot described in a config's robot block (lib/sim/robot_description.h,
+// legged_robot.h, generic_walker.h), on the project's own hexapod (datasets/robots/hexapod.xml)
+// and variants of it that must be refused.
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include "sim/legged_robot.h"
+#include "sim/sim_config.h"
+#include "sim/simulator.h"
+
+namespace dgmm::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+const fs::path kRobots = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots";
+
+std::string ReadText(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+SimConfig Hexapod(double slope_deg = 0) {
+  SimConfig c = LoadSimConfig((kRobots / "hexapod.json").string());
+  c.slope_deg = slope_deg;
+  return c;
+}
+
+// The hexapod's MJCF with `from` replaced by `to`, written to a temporary file; the config's
+// robot block edited by `edit`. Returns the error message of building a Simulator ("" if none).
+template <typename Edit>
+std::string ErrorOf(const std::string& from, const std::string& to, Edit edit) {
+  std::string xml = ReadText(kRobots / "hexapod.xml");
+  if (!from.empty()) {
+    const auto at = xml.find(from);
+    if (at == std::string::npos) return "test setup: text not found: " + from;
+    xml.replace(at, from.size(), to);
+  }
+  const fs::path path = fs::temp_directory_path() / ("dgmm_legged_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  SimConfig c = Hexapod();
+  c.mjcf_path = path.string();
+  edit(&*c.robot);
+  std::string error;
+  try {
+    Simulator sim(c);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  fs::remove(path);
+  return error;
+}
+std::string ErrorOf(const std::string& from, const std::string& to) {
+  return ErrorOf(from, to, [](RobotDescription*) {});
+}
+
+TEST(LeggedRobot, TheHexapodWalksAsCommandedOnFlatGround) {
+  Simulator sim(Hexapod());
+  const RobotDescription& r = *sim.config().robot;
+  const double cycles = sim.config().command_duration_s / r.gait.period_s;
+  const double stride = r.gait.stride_reach * sim.leg_reach_m() * cycles;  // per command at |c| = 1
+  ASSERT_EQ(sim.leg_count(), 6);
+  ASSERT_EQ(sim.Place(0, 0, 0), RunOutcome::kCompleted);
+  const Pose start = sim.TorsoPose();
+  ASSERT_EQ(sim.RunCommand(Eigen::Vector3d(0.5, 0, 0)), RunOutcome::kCompleted);
+  const Eigen::Vector3d moved = start.rotation.transpose() * (sim.TorsoPose().position_m - start.position_m);
+  EXPECT_NEAR(moved.x() / (0.5 * stride), 1.0, 0.25);
+  EXPECT_LT(std::abs(moved.y()) / (0.5 * stride), 0.15);
+  ASSERT_EQ(sim.Place(0, 0, 0), RunOutcome::kCompleted);
+  const Pose before = sim.TorsoPose();
+  ASSERT_EQ(sim.RunCommand(Eigen::Vector3d(0, 0, -0.5)), RunOutcome::kCompleted);
+  const Eigen::Matrix3d turn = before.rotation.transpose() * sim.TorsoPose().rotation;
+  const double yaw = std::atan2(turn(1, 0), turn(0, 0));
+  EXPECT_NEAR(yaw / (-0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
+}
+
+TEST(LeggedRobot, TheModelsOwnPhysicsIsKeptExceptWhatTheExperimentSets) {
+  const SimConfig c = Hexapod(10);
+  MjModelPtr original = LoadRobotModel(c);
+  MjModelPtr applied = LoadRobotModel(c);
+  const LeggedRobot bound = BindRobot(applied.get(), *c.robot, "hexapod");
+  ApplyExperiment(*c.robot, bound, c.slope_deg, 0.001, applied.get());
+  const mjModel* a = original.get();
+  const mjModel* b = applied.get();
+  auto same = [](const mjtNum* x, const mjtNum* y, int n) { return std::memcmp(x, y, sizeof(mjtNum) * n) == 0; };
+  EXPECT_TRUE(same(a->body_mass, b->body_mass, a->nbody));
+  EXPECT_TRUE(same(a->body_inertia, b->body_inertia, 3 * a->nbody));
+  EXPECT_TRUE(same(a->geom_friction, b->geom_friction, 3 * a->ngeom));
+  EXPECT_TRUE(same(a->geom_solref, b->geom_solref, mjNREF * a->ngeom));
+  EXPECT_TRUE(same(a->dof_damping, b->dof_damping, a->nv));
+  EXPECT_TRUE(same(a->dof_armature, b->dof_armature, a->nv));
+  EXPECT_TRUE(same(a->actuator_gainprm, b->actuator_gainprm, mjNGAIN * a->nu));
+  EXPECT_TRUE(same(a->actuator_biasprm, b->actuator_biasprm, mjNBIAS * a->nu));
+  EXPECT_TRUE(same(a->actuator_forcerange, b->actuator_forcerange, 2 * a->nu));
+  EXPECT_TRUE(same(a->jnt_range, b->jnt_range, 2 * a->njnt));
+  EXPECT_EQ(b->opt.timestep, 0.001);
+  EXPECT_NEAR(std::hypot(b->opt.gravity[0], b->opt.gravity[2]), std::abs(a->opt.gravity[2]), 1e-12);
+  EXPECT_NEAR(std::atan2(-b->opt.gravity[0], -b->opt.gravity[2]) * 180 / M_PI, 10, 1e-9);
+}
+
+TEST(LeggedRobot, ALegGainScalesThatLegsServosOnly) {
+  SimConfig c = Hexapod();
+  c.robot->leg_gain["middle_right"] = 0.5;
+  MjModelPtr m = LoadRobotModel(c);
+  MjModelPtr original = LoadRobotModel(c);
+  const LeggedRobot bound = BindRobot(m.get(), *c.robot, "hexapod");
+  ApplyExperiment(*c.robot, bound, 0, c.timestep_s, m.get());
+  for (const auto& leg : bound.legs) {
+    for (int a : leg.actuators) {
+      const double ratio = m->actuator_gainprm[mjNGAIN * a] / original->actuator_gainprm[mjNGAIN * a];
+      EXPECT_DOUBLE_EQ(ratio, leg.name == "middle_right" ? 0.5 : 1.0) << leg.name;
+    }
+  }
+}
+
+TEST(LeggedRobot, FootExtentForCapsuleAndBoxFeet) {
+  const SimConfig c = Hexapod();
+  MjModelPtr m = LoadRobotModel(c);
+  const LeggedRobot bound = BindRobot(m.get(), *c.robot, "hexapod");
+  for (const auto& leg : bound.legs) {
+    // Capsule feet lie horizontally (radius 0.01 m); box feet are 0.008 m half-high.
+    const double expected = leg.name.rfind("middle", 0) == 0 ? 0.008 : 0.01;
+    EXPECT_NEAR(leg.foot_extent_m, expected, 1e-3) << leg.name;
+  }
+  EXPECT_NEAR(bound.reach_m, 0.297, 0.01);
+}
+
+TEST(LeggedRobot, BadRobotsAreRefusedNamingThePart) {
+  auto expect = [](const std::string& error, const std::string& part) {
+    EXPECT_NE(error.find(part), std::string::npos) << "expected \"" << part << "\" in: " << error;
+  };
+  // An undriven joint not declared passive, e.g. a ninth joint on a leg or extra legs.
+  expect(ErrorOf("<geom name=\"rear_right_foot\"",
+                 "<body name=\"ankle\"><joint name=\"extra\" type=\"hinge\" axis=\"0 1 0\" range=\"-10 10\"/>"
+                 "<geom type=\"sphere\" size=\"0.005\" mass=\"0.01\"/></body><geom name=\"rear_right_foot\""),
+         "joint \"extra\" belongs to no leg");
+  // ...accepted once declared passive.
+  EXPECT_EQ(ErrorOf("<geom name=\"rear_right_foot\"",
+                    "<body name=\"ankle\"><joint name=\"extra\" type=\"hinge\" axis=\"0 1 0\" range=\"-10 10\"/>"
+                    "<geom type=\"sphere\" size=\"0.005\" mass=\"0.01\"/></body><geom name=\"rear_right_foot\"",
+                    [](RobotDescription* r) { r->passive_joints.push_back("extra"); }),
+            "");
+  // An actuator driving nothing a leg declares.
+  expect(ErrorOf("", "", [](RobotDescription* r) { r->legs.pop_back(); r->gait.pattern = "custom";
+                                                   r->gait.phases = {0, 0.2, 0.4, 0.6, 0.8}; }),
+         "belongs to no leg");
+  // A motor instead of a position servo.
+  expect(ErrorOf("<position name=\"front_left_knee\" joint=\"front_left_knee\"/>",
+                 "<motor name=\"front_left_knee\" joint=\"front_left_knee\"/>"),
+         "not a position servo");
+  // A joint off the leg's chain.
+  expect(ErrorOf("", "", [](RobotDescription* r) { r->legs[0].joints[2] = "front_right_knee"; }),
+         "robot.legs[0] (front_left).joints");
+  // A declared side contradicting the geometry.
+  expect(ErrorOf("", "", [](RobotDescription* r) { r->legs[1].side = "right"; }), "robot.legs[1] (middle_left).side");
+  // A foot that cannot reach the ground at the stance height (a short leg).
+  expect(ErrorOf("", "", [](RobotDescription* r) { r->gait.stance_height_m = 0.5; }), "cannot reach the ground");
+  // A missing foot.
+  expect(ErrorOf("", "", [](RobotDescription* r) { r->legs[2].foot.geom = "no_such_foot"; }),
+         "robot.legs[2] (rear_left).foot.geom");
+  // A gait for another number of legs.
+  expect(ErrorOf("", "", [](RobotDescription* r) { r->gait.pattern = "trot"; }), "needs 4 legs");
+}
+
+}  // namespace
+}  // namespace dgmm::sim
