@@ -234,6 +234,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   meta["abandoned_placements"] = std::to_string(sum.abandoned_placements);
   meta["simulated_seconds"] = std::to_string(sum.simulated_seconds);
   meta["robot_mass_kg"] = std::to_string(sim.total_mass_kg());
+  if (config.robot) meta["robot_leg_reach_m"] = std::to_string(sim.leg_reach_m());
   meta["sim_config"] = SimConfigToJson(config);
   meta["x_frame"] = "torso body frame at the start of each execution (x forward, y left, z up); "
                     "angles ZYX Euler of the relative rotation";

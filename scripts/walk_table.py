@@ -1,0 +1,85 @@
+#!/usr/bin/env python3
+"""Does a robot described by a config's robot block walk as commanded? For each (slope, gait
+pattern) it records the paper protocol with `dgmm simulate` and compares the mean pose change of
+the pure commands (forward, lateral, turn at +-0.5) with what the gait commands: torso travel per
+cycle = stride, yaw per cycle = turn_rad (docs/simulation.md, "Bring your own robot"). Prints a
+Markdown table; a ratio is measured / commanded (1 = as commanded), cross-talk is the largest
+off-axis travel relative to the commanded travel.
+
+Usage: scripts/walk_table.py [--build build] [--config datasets/robots/hexapod.json]
+                             [--patterns tripod,tetrapod,wave] [--slopes 0,10] [--seed 1]
+"""
+import argparse, json, os, subprocess, sys, tempfile
+
+import h5py
+import numpy as np
+
+
+def record(dgmm, config, out, seed):
+    subprocess.run([dgmm, "--quiet", "simulate", "--config", config, "--protocol", "paper", "--seed", str(seed),
+                    "-o", out], check=True, stdout=subprocess.DEVNULL)
+
+
+def rows_of(path, stride, turn, cycles):
+    f = h5py.File(path, "r")
+    values, command, x = f["commands/values"][:], f["command"][:], f["x"][:]
+    out = {}
+    for c, v in enumerate(values):
+        m = command == c
+        if not m.any() or np.count_nonzero(v) != 1:
+            continue
+        k = int(np.flatnonzero(v)[0])
+        mean = x[m].mean(0)
+        if k < 2:
+            want = v[k] * stride * cycles
+            ratio = mean[k] / want
+            cross = abs(mean[1 - k]) / abs(want)
+        else:
+            want = v[2] * turn * cycles
+            ratio = mean[5] / want
+            cross = max(abs(mean[0]), abs(mean[1])) / (stride * cycles * abs(v[2]))
+        out[("forward", "lateral", "turn")[k] + (" +" if v[k] > 0 else " -")] = (ratio, cross)
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--config", default="datasets/robots/hexapod.json")
+    ap.add_argument("--patterns", default="tripod,tetrapod,wave")
+    ap.add_argument("--slopes", default="0,10")
+    ap.add_argument("--seed", type=int, default=1)
+    a = ap.parse_args()
+    dgmm = os.path.join(a.build, "app", "dgmm")
+    base = json.load(open(a.config))
+    base["mjcf_path"] = os.path.abspath(os.path.join(os.path.dirname(a.config), base["mjcf_path"]))
+    tmp = tempfile.mkdtemp()
+    print(f"Robot: {a.config}; paper protocol, seed {a.seed}; ratio = measured / commanded, cross = off-axis share\n")
+    header = None
+    for slope in [float(s) for s in a.slopes.split(",")]:
+        for pattern in a.patterns.split(","):
+            cfg = json.loads(json.dumps(base))
+            cfg["slope_deg"] = slope
+            cfg["robot"]["gait"]["pattern"] = pattern
+            path = os.path.join(tmp, f"{pattern}_{slope:g}.json")
+            json.dump(cfg, open(path, "w"))
+            out = os.path.join(tmp, f"{pattern}_{slope:g}.h5")
+            record(dgmm, path, out, a.seed)
+            # The leg reach the simulator derived from the model (set metadata).
+            reach_attr = h5py.File(out, "r")["metadata"].attrs["robot_leg_reach_m"]
+            reach = float(reach_attr.decode() if isinstance(reach_attr, bytes) else reach_attr)
+            g = cfg["robot"]["gait"]
+            stride = g.get("stride_m") or g["stride_reach"] * reach
+            cycles = cfg["command_duration_s"] / g["period_s"]
+            rows = rows_of(out, stride, g["turn_rad"], cycles)
+            if header is None:
+                header = sorted(rows)
+                print("| slope | gait | " + " | ".join(header) + " | worst cross-talk |")
+                print("|---|---|" + "---|" * (len(header) + 1))
+            cells = " | ".join(f"{rows[k][0]:.2f}" for k in header)
+            print(f"| {slope:g} deg | {pattern} | {cells} | {max(r[1] for r in rows.values()):.2f} |")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
