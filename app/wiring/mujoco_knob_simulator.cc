@@ -39,7 +39,7 @@ sim2real::Knob FromSim(const sim::Knob& k) {
   // Offsets may have either sign; every other knob is a non-negative physical quantity.
   const bool offset = k.kind == sim::KnobKind::kPayloadX || k.kind == sim::KnobKind::kPayloadY;
   if (!offset) out.physical_min = 0;
-  if (k.kind == sim::KnobKind::kLegGain) out.leg = "leg" + std::to_string(k.index);
+  if (k.kind == sim::KnobKind::kLegGain) out.leg = k.leg;
   if (k.kind == sim::KnobKind::kSideGain) out.side = k.index == 0 ? "left" : "right";
   return out;
 }
@@ -47,13 +47,6 @@ sim2real::Knob FromSim(const sim::Knob& k) {
 }  // namespace
 
 MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_(config) {
-  if (config_.robot) {
-    // The knobs of lib/sim/knobs.h edit the built-in robot's config fields, which a robot
-    // block's robot does not use: analysing with them would report effects that were never applied.
-    throw MakeInputError(config_.mjcf_path.empty() ? "simulation config" : config_.mjcf_path, "robot",
-                         "the sim-vs-real knobs are not available for a robot block's robot yet (only "
-                         "'dgmm simulate'); use dgmm sim2real --locate-only");
-  }
   sim_knobs_ = sim::EnumerateKnobs(config_);
   for (const auto& k : sim_knobs_) knobs_.push_back(FromSim(k));
   // Everything that determines a recording besides protocol, seed and knobs (those are in the

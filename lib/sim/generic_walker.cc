@@ -11,7 +11,7 @@ namespace dgmm::sim {
 GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const std::string& source)
     : config_(config), model_(std::move(model)) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
-  ApplyExperiment(*config.robot, robot_, config.slope_deg, config.timestep_s, model_.get());
+  ApplyExperiment(config, robot_, model_.get());
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
   control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
 }
@@ -24,14 +24,8 @@ void GenericWalker::Start() {
 }
 
 bool GenericWalker::Step() {
-  mj_step(model_.get(), data_.get());
   time_s_ += model_->opt.timestep;
-  bool ok = true;
-  for (int w = 0; w < mjNWARNING; ++w) {
-    if (data_->warning[w].number > 0) ok = false;
-    data_->warning[w].number = 0;
-  }
-  return ok;
+  return StepChecked(model_.get(), data_.get());
 }
 
 Pose GenericWalker::RobotPose() const {

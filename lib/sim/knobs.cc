@@ -62,11 +62,13 @@ std::string RobotMjcfText(const SimConfig& config) {
 }
 
 double PayloadProbeMass(const SimConfig& config) {
+  if (config.robot) return 0.15 * Simulator(config).total_mass_kg();
   const auto& m = config.masses;
   return 0.15 * (m.torso_kg + kNumLegs * (m.coxa_kg + m.femur_kg + m.tibia_kg));
 }
 
 std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
+  if (config.robot) return EnumerateRobotKnobs(config);
   const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
   MjModelPtr model = LoadRobotModel(config);
   const RobotParts parts = FindRobotParts(model.get(), config, source);
@@ -123,6 +125,7 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
     const double g = config.actuators.leg_gain[leg];
     knobs.push_back(MakeKnob(KnobKind::kLegGain, leg, "actuators.leg" + std::to_string(leg) + ".gain",
                              "actuator_gain", "", g, 0.05 * g, 1.5 * g, {0.5 * g}));
+    knobs.back().leg = "leg" + std::to_string(leg);
     side_has[m->body_pos[3 * root + 1] > 0 ? 0 : 1] = true;
   }
   const char* side_name[2] = {"left", "right"};
@@ -153,6 +156,7 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
 
 SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
                      const std::vector<KnobValue>& values, ModelEdit* edit) {
+  if (config.robot) return ApplyRobotKnobs(config, knobs, values, edit);
   SimConfig c = config;
   double mass_scale = 1, damping_scale = 1;
   double solref_time = NAN, solref_damp = NAN, solimp_dmax = NAN, solimp_width = NAN;
@@ -196,6 +200,7 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
       case KnobKind::kFloorSolimpWidth: solimp_width = v.value; break;
       case KnobKind::kLatency: c.actuators.latency_s = v.value; break;
       case KnobKind::kBacklash: c.actuators.backlash_rad = v.value; break;
+      case KnobKind::kFrictionScale: break;  // a robot block's knob only
       case KnobKind::kTrackerNoiseScale: {
         const auto& n = config.noise;
         c.noise.tracker_position_sd_m = n.tracker_position_sd_m * v.value;

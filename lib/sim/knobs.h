@@ -36,6 +36,7 @@ enum class KnobKind {
   kLatency,            // actuation latency [s] (actuators.latency_s)
   kBacklash,           // gear-train free play of every leg joint [rad] (actuators.backlash_rad)
   kTrackerNoiseScale,  // factor on the four tracker sd's of config.noise (not the IMU's)
+  kFrictionScale,      // factor on every geom's sliding friction (a robot block's robot)
 };
 
 // Confusion-matrix family of a knob (docs/sim2real.md, "report.json verdict").
@@ -49,6 +50,8 @@ struct Knob {
   double nominal = 0;        // value in the nominal config / model
   double lo = 0, hi = 0;     // physical range searched
   std::vector<double> probes;  // values simulated for the signature (one signature each)
+  std::string leg;             // kLegGain: the leg's name ("leg3" for the built-in robot)
+  std::vector<std::string> members;  // kSideGain of a robot block's robot: the side's leg names
 };
 
 struct KnobValue {
@@ -65,6 +68,15 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config);
 SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
                      const std::vector<KnobValue>& values, ModelEdit* edit);
 
+// The same for a config with a robot block (robot_knobs.cc; EnumerateKnobs and ApplyKnobs call
+// them): factors on the model's own values (every geom's friction, every body's mass, the leg
+// servos' gains and the leg joints' damping), a payload on the torso as a fraction of the model's
+// total mass at offsets relative to the leg reach, per-leg gains named by leg name, per-side gains
+// by the side rule of legged_robot.h, the floor's contact parameters and the tracker's noise.
+std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config);
+SimConfig ApplyRobotKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
+                          const std::vector<KnobValue>& values, ModelEdit* edit);
+
 // SimulateProtocol with the knobs set (same seed: paired with the nominal run).
 SampleSet SimulateWithKnobs(const SimConfig& config, const ProtocolOptions& options,
                             const std::vector<Knob>& knobs, const std::vector<KnobValue>& values);
@@ -73,7 +85,7 @@ SampleSet SimulateWithKnobs(const SimConfig& config, const ProtocolOptions& opti
 // a cache of simulations. Throws InputError when the file cannot be read.
 std::string RobotMjcfText(const SimConfig& config);
 
-// Mass of the payload probes [kg]: 15% of the robot's mass.
+// Mass of the payload probes [kg]: 15% of the robot's mass (the model's, with a robot block).
 double PayloadProbeMass(const SimConfig& config);
 
 }  // namespace dgmm::sim

@@ -295,11 +295,24 @@ LeggedRobot BindRobot(const mjModel* m, const RobotDescription& r, const std::st
   return b;
 }
 
-void ApplyExperiment(const RobotDescription& r, const LeggedRobot& b, double slope_deg, double timestep_s,
-                     mjModel* m) {
-  m->opt.timestep = timestep_s;
+void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass) {
+  const double m0 = m->body_mass[torso];
+  const Eigen::Vector3d c0(m->body_ipos[3 * torso], m->body_ipos[3 * torso + 1], m->body_ipos[3 * torso + 2]);
+  const Eigen::Vector3d c = (m0 * c0 + mass * p) / (m0 + mass);
+  const double kRadius = 0.03;  // m: a compact block
+  auto perp = [](const Eigen::Vector3d& d, int k) { return d.squaredNorm() - d[k] * d[k]; };
+  for (int k = 0; k < 3; ++k) {
+    m->body_inertia[3 * torso + k] += m0 * perp(c0 - c, k) + mass * perp(p - c, k) + 0.4 * mass * kRadius * kRadius;
+    m->body_ipos[3 * torso + k] = c[k];
+  }
+  m->body_mass[torso] = m0 + mass;
+}
+
+void ApplyExperiment(const SimConfig& config, const LeggedRobot& b, mjModel* m) {
+  const RobotDescription& r = *config.robot;
+  m->opt.timestep = config.timestep_s;
   const double g = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]).norm();
-  const double slope = slope_deg * M_PI / 180;
+  const double slope = config.slope_deg * M_PI / 180;
   m->opt.gravity[0] = -g * std::sin(slope);  // the slope frame: downhill is -x
   m->opt.gravity[1] = 0;
   m->opt.gravity[2] = -g * std::cos(slope);
@@ -309,6 +322,16 @@ void ApplyExperiment(const RobotDescription& r, const LeggedRobot& b, double slo
     for (int a : leg.actuators) {
       m->actuator_gainprm[mjNGAIN * a] *= it->second;
       m->actuator_biasprm[mjNBIAS * a + 1] *= it->second;
+    }
+  }
+  if (config.payload.mass_kg > 0) {
+    AddPayload(m, b.torso_body, b.robot_in_torso * config.payload.position_body_m, config.payload.mass_kg);
+  }
+  if (r.overwrite_physics) {
+    for (int i = 0; i < m->ngeom; ++i) {
+      m->geom_friction[3 * i + 0] = config.friction.sliding;
+      m->geom_friction[3 * i + 1] = config.friction.torsional;
+      m->geom_friction[3 * i + 2] = config.friction.rolling;
     }
   }
 }

@@ -11,6 +11,7 @@
 #include "sim/gait_table.h"
 #include "sim/mujoco_model.h"
 #include "sim/robot_description.h"
+#include "sim/sim_config.h"
 
 namespace dgmm::sim {
 
@@ -43,9 +44,15 @@ struct LeggedRobot {
 LeggedRobot BindRobot(const mjModel* model, const RobotDescription& robot, const std::string& source);
 
 // The model's own physics kept; only what the experiment sets: timestep and the slope (gravity
-// tilted, magnitude kept), and per-leg gains (robot.leg_gain) on the leg's servos.
-void ApplyExperiment(const RobotDescription& robot, const LeggedRobot& bound, double slope_deg,
-                     double timestep_s, mjModel* model);
+// tilted, magnitude kept), per-leg gains (robot.leg_gain) on the leg's servos and a payload
+// (config.payload: mass on the torso at (forward, left, up) offsets). With
+// robot.overwrite_physics, config.friction replaces every geom's friction.
+void ApplyExperiment(const SimConfig& config, const LeggedRobot& bound, mjModel* model);
+
+// A compact payload (3 cm) rigidly added to body `torso` at `p_m` (body frame): the body's mass,
+// centre of mass and inertia (parallel axes, in its principal frame: an approximation when that
+// frame is rotated) updated.
+void AddPayload(mjModel* model, int torso, const Eigen::Vector3d& p_m, double mass_kg);
 
 // Damped least squares on the foot's Jacobian restricted to the leg's joints, joint ranges
 // respected: moves `q` (the leg's joint values) towards placing the foot at `target_m` (torso

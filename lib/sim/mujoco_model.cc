@@ -72,6 +72,16 @@ MjModelPtr LoadRobotModel(const SimConfig& config) {
   return model;
 }
 
+bool StepChecked(const mjModel* m, mjData* d) {
+  mj_step(m, d);
+  bool ok = true;
+  for (int w = 0; w < mjNWARNING; ++w) {
+    if (d->warning[w].number > 0) ok = false;
+    d->warning[w].number = 0;
+  }
+  return ok;
+}
+
 std::string CompiledModelBytes(const SimConfig& config) {
   const MjModelPtr model = LoadRobotModel(config);
   std::string bytes(static_cast<std::size_t>(mj_sizeModel(model.get())), '\0');

@@ -30,6 +30,10 @@ MjModelPtr LoadMjcfString(const std::string& xml, const std::string& source_name
 // Compiles config.mjcf_path, or the built-in robot when it is empty.
 MjModelPtr LoadRobotModel(const SimConfig& config);
 
+// One mj_step; false when MuJoCo raised a warning in it (bad numbers, full contact buffers). The
+// warning counters are cleared.
+bool StepChecked(const mjModel* model, mjData* data);
+
 // Ids of the parts the controller drives, found by the names of docs/simulation.md.
 struct RobotParts {
   int torso_body = -1;

@@ -88,14 +88,8 @@ struct Simulator::Impl {
   // One physics step; false on a MuJoCo warning (bad numbers, full contact buffers).
   bool Step() {
     ApplyBacklash();
-    mj_step(model.get(), data.get());
     time_s += model->opt.timestep;
-    bool ok = true;
-    for (int w = 0; w < mjNWARNING; ++w) {
-      if (data->warning[w].number > 0) ok = false;
-      data->warning[w].number = 0;
-    }
-    return ok;
+    return StepChecked(model.get(), data.get());
   }
   bool Fallen() const {
     const Pose pose = Torso();

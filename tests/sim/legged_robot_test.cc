@@ -88,7 +88,9 @@ TEST(LeggedRobot, TheModelsOwnPhysicsIsKeptExceptWhatTheExperimentSets) {
   MjModelPtr original = LoadRobotModel(c);
   MjModelPtr applied = LoadRobotModel(c);
   const LeggedRobot bound = BindRobot(applied.get(), *c.robot, "hexapod");
-  ApplyExperiment(*c.robot, bound, c.slope_deg, 0.001, applied.get());
+  SimConfig experiment = c;
+  experiment.timestep_s = 0.001;
+  ApplyExperiment(experiment, bound, applied.get());
   const mjModel* a = original.get();
   const mjModel* b = applied.get();
   auto same = [](const mjtNum* x, const mjtNum* y, int n) { return std::memcmp(x, y, sizeof(mjtNum) * n) == 0; };
@@ -113,7 +115,7 @@ TEST(LeggedRobot, ALegGainScalesThatLegsServosOnly) {
   MjModelPtr m = LoadRobotModel(c);
   MjModelPtr original = LoadRobotModel(c);
   const LeggedRobot bound = BindRobot(m.get(), *c.robot, "hexapod");
-  ApplyExperiment(*c.robot, bound, 0, c.timestep_s, m.get());
+  ApplyExperiment(c, bound, m.get());
   for (const auto& leg : bound.legs) {
     for (int a : leg.actuators) {
       const double ratio = m->actuator_gainprm[mjNGAIN * a] / original->actuator_gainprm[mjNGAIN * a];

@@ -1,0 +1,175 @@
+// Knobs of a robot described by a config's robot block (knobs.h): factors on the model's own
+// physics, scaled by the model (total mass, leg reach), per-leg knobs named by leg name.
+#include <mujoco/mujoco.h>
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "sim/knobs.h"
+#include "sim/legged_robot.h"
+#include "util/error.h"
+
+namespace dgmm::sim {
+namespace {
+
+Knob Make(KnobKind kind, int index, std::string name, std::string family, std::string unit, double nominal,
+          double lo, double hi, std::vector<double> probes) {
+  Knob k;
+  k.kind = kind;
+  k.index = index;
+  k.name = std::move(name);
+  k.family = std::move(family);
+  k.unit = std::move(unit);
+  k.nominal = nominal;
+  k.lo = lo;
+  k.hi = hi;
+  k.probes = std::move(probes);
+  return k;
+}
+
+void AddContactKnobs(const mjModel* m, int floor, std::vector<Knob>* knobs) {
+  const double tc = m->geom_solref[mjNREF * floor + 0];
+  const double dr = m->geom_solref[mjNREF * floor + 1];
+  if (tc > 0) {
+    knobs->push_back(Make(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s", tc,
+                          std::max(2.5 * m->opt.timestep, 0.25 * tc), 8 * tc, {3 * tc}));
+    knobs->push_back(Make(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "", dr, 0.1 * dr,
+                          4 * dr, {0.3 * dr}));
+  }
+}
+
+void AddLegKnobs(const SimConfig& config, const LeggedRobot& bound, std::vector<Knob>* knobs) {
+  Knob side[2] = {Make(KnobKind::kSideGain, 0, "actuators.left_side.gain", "actuator_gain", "", 1.0, 0.05, 1.5, {0.6}),
+                  Make(KnobKind::kSideGain, 1, "actuators.right_side.gain", "actuator_gain", "", 1.0, 0.05, 1.5,
+                       {0.6})};
+  for (int i = 0; i < static_cast<int>(bound.legs.size()); ++i) {
+    const std::string& name = bound.legs[i].name;
+    const auto it = config.robot->leg_gain.find(name);
+    const double g = it == config.robot->leg_gain.end() ? 1.0 : it->second;
+    knobs->push_back(Make(KnobKind::kLegGain, i, "actuators." + name + ".gain", "actuator_gain", "", g, 0.05 * g,
+                          1.5 * g, {0.5 * g}));
+    knobs->back().leg = name;
+    side[bound.legs[i].side > 0 ? 0 : 1].members.push_back(name);
+  }
+  for (auto& s : side) {
+    if (!s.members.empty()) knobs->push_back(s);
+  }
+}
+
+// What ApplyRobotKnobs collects from the values before building the model edit.
+struct RobotEdit {
+  double friction = 1, mass = 1, kp = 1, damping = 1;
+  double solref_time = NAN, solref_damp = NAN;
+  bool any() const {
+    return friction != 1 || mass != 1 || kp != 1 || damping != 1 || std::isfinite(solref_time) ||
+           std::isfinite(solref_damp);
+  }
+};
+
+ModelEdit MakeEdit(const SimConfig& config, const RobotEdit& e) {
+  const RobotDescription robot = *config.robot;
+  return [robot, e](mjModel_* m) {
+    for (int g = 0; g < m->ngeom; ++g) m->geom_friction[3 * g] *= e.friction;
+    for (int b = 1; b < m->nbody; ++b) {
+      m->body_mass[b] *= e.mass;
+      for (int k = 0; k < 3; ++k) m->body_inertia[3 * b + k] *= e.mass;
+    }
+    for (const auto& leg : robot.legs) {
+      for (const auto& joint : leg.joints) {
+        const int j = mj_name2id(m, mjOBJ_JOINT, joint.c_str());
+        if (j < 0) continue;
+        m->dof_damping[m->jnt_dofadr[j]] *= e.damping;
+        for (int a = 0; a < m->nu; ++a) {
+          if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_trnid[2 * a] != j) continue;
+          m->actuator_gainprm[mjNGAIN * a] *= e.kp;
+          m->actuator_biasprm[mjNBIAS * a + 1] *= e.kp;
+        }
+      }
+    }
+    const int floor = mj_name2id(m, mjOBJ_GEOM, robot.floor_geom.c_str());
+    if (floor >= 0 && std::isfinite(e.solref_time)) m->geom_solref[mjNREF * floor + 0] = e.solref_time;
+    if (floor >= 0 && std::isfinite(e.solref_damp)) m->geom_solref[mjNREF * floor + 1] = e.solref_damp;
+  };
+}
+
+}  // namespace
+
+std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
+  const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
+  MjModelPtr model = LoadRobotModel(config);
+  const LeggedRobot bound = BindRobot(model.get(), *config.robot, source);
+  const mjModel* m = model.get();
+  double total_kg = 0;
+  for (int b = 1; b < m->nbody; ++b) total_kg += m->body_mass[b];
+  const double reach = bound.reach_m;
+  std::vector<Knob> knobs;
+  knobs.push_back(Make(KnobKind::kFrictionScale, -1, "geoms.friction_scale", "friction", "", 1.0, 0.2, 2.0, {0.6, 1.5}));
+  AddContactKnobs(m, bound.floor_geom, &knobs);
+  knobs.push_back(Make(KnobKind::kMassScale, -1, "bodies.mass_scale", "mass", "", 1.0, 0.4, 2.5, {0.7, 1.4}));
+  const double probe_kg = 0.15 * total_kg;
+  const auto& p = config.payload;
+  knobs.push_back(Make(KnobKind::kPayloadMass, -1, "payload.mass_kg", "payload", "kg", p.mass_kg, 0.0, 4 * probe_kg,
+                       {p.mass_kg + probe_kg}));
+  knobs.push_back(Make(KnobKind::kPayloadX, -1, "payload.position_x_m", "payload", "m", p.position_body_m.x(), -0.6 * reach,
+                       0.6 * reach, {0.2 * reach}));
+  knobs.push_back(Make(KnobKind::kPayloadY, -1, "payload.position_y_m", "payload", "m", p.position_body_m.y(), -0.4 * reach,
+                       0.4 * reach, {0.15 * reach}));
+  AddLegKnobs(config, bound, &knobs);
+  knobs.push_back(Make(KnobKind::kKpScale, -1, "actuators.kp_scale", "actuator_gain", "", 1.0, 0.2, 2.5, {0.6, 1.5}));
+  knobs.push_back(Make(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0, 0.05, 10.0,
+                       {0.25, 4.0}));
+  const auto& n = config.noise;
+  if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
+      n.tracker_pitch_sd_rad > 0) {
+    knobs.push_back(Make(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0, 0.5, 5.0,
+                         {2.0}));
+  }
+  return knobs;
+}
+
+SimConfig ApplyRobotKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
+                          const std::vector<KnobValue>& values, ModelEdit* edit) {
+  SimConfig c = config;
+  RobotEdit e;
+  bool payload = false;
+  double payload_kg = NAN;
+  for (const auto& v : values) {
+    const Knob& k = knobs.at(v.knob);
+    switch (k.kind) {
+      case KnobKind::kFrictionScale: e.friction = v.value; break;
+      case KnobKind::kMassScale: e.mass = v.value; break;
+      case KnobKind::kKpScale: e.kp = v.value; break;
+      case KnobKind::kDampingScale: e.damping = v.value; break;
+      case KnobKind::kFloorSolrefTime: e.solref_time = v.value; break;
+      case KnobKind::kFloorSolrefDamping: e.solref_damp = v.value; break;
+      // The payload is the experiment's (config.payload, applied by legged_robot.h).
+      case KnobKind::kPayloadMass: payload = true; payload_kg = v.value; break;
+      case KnobKind::kPayloadX: payload = true; c.payload.position_body_m.x() = v.value; break;
+      case KnobKind::kPayloadY: payload = true; c.payload.position_body_m.y() = v.value; break;
+      case KnobKind::kLegGain: c.robot->leg_gain[k.leg] = v.value; break;
+      case KnobKind::kSideGain:
+        for (const auto& leg : k.members) {
+          const auto it = config.robot->leg_gain.find(leg);
+          c.robot->leg_gain[leg] = (it == config.robot->leg_gain.end() ? 1.0 : it->second) * v.value;
+        }
+        break;
+      case KnobKind::kTrackerNoiseScale: {
+        const auto& n = config.noise;
+        c.noise.tracker_position_sd_m = n.tracker_position_sd_m * v.value;
+        c.noise.tracker_yaw_sd_rad = n.tracker_yaw_sd_rad * v.value;
+        c.noise.tracker_roll_sd_rad = n.tracker_roll_sd_rad * v.value;
+        c.noise.tracker_pitch_sd_rad = n.tracker_pitch_sd_rad * v.value;
+        break;
+      }
+      default:
+        throw MakeInputError(config.mjcf_path, k.name, "not a knob of a robot block's robot");
+    }
+  }
+  // Offsets alone carry the probe mass (as for the built-in robot).
+  if (payload) c.payload.mass_kg = std::isfinite(payload_kg) ? payload_kg : std::max(config.payload.mass_kg, PayloadProbeMass(config));
+  if (edit) *edit = e.any() ? MakeEdit(config, e) : ModelEdit{};
+  return c;
+}
+
+}  // namespace dgmm::sim
