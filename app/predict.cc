@@ -1,0 +1,147 @@
+// `dgmm predict`: where a sequence of commands takes the robot, with how sure the model is: the
+// pose distribution after each command (lib/predict/predict.h), as JSON and a table.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <sstream>
+
+#include "app/command.h"
+#include "io/model_io.h"
+#include "predict/predict.h"
+#include "util/atomic_file.h"
+#include "util/error.h"
+
+namespace dgmm::app {
+namespace {
+
+struct PredictArgs {
+  std::string model, commands, terrain, output, pose_dims;
+  std::vector<double> start{0, 0, 0};
+  int trajectories = 1000;
+  std::uint64_t seed = 1;
+};
+
+std::vector<std::string> SplitOn(const std::string& text, char separator) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  for (std::string item; std::getline(in, item, separator);) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+// Command labels separated by ';' (labels themselves contain commas), each optionally "label*N".
+std::vector<int> ParseCommands(const MotionModel& model, const std::string& text) {
+  std::vector<int> ids;
+  for (const std::string& item : SplitOn(text, ';')) {
+    const auto star = item.rfind('*');
+    const std::string label = star == std::string::npos ? item : item.substr(0, star);
+    const int times = star == std::string::npos ? 1 : std::atoi(item.c_str() + star + 1);
+    int id = -1;
+    for (const auto& [c, l] : model.command_labels) {
+      if (l == label) id = c;
+    }
+    if (id < 0) throw MakeInputError("--commands", label, "the model has no command with this label (dgmm info lists them)");
+    if (times < 1 || times > 10000) throw MakeInputError("--commands", item, "expected label*N with N in 1..10000");
+    ids.insert(ids.end(), times, id);
+  }
+  if (ids.empty()) throw MakeInputError("--commands", "", "expected at least one command label");
+  return ids;
+}
+
+// "pitch=0.1,roll=0" by the model's terrain names.
+Eigen::VectorXd ParseTerrain(const MotionModel& model, const std::string& text) {
+  if (text.empty()) return {};
+  if (model.terrain_dim == 0) throw MakeInputError("--terrain", "", "the model was fitted without terrain");
+  Eigen::VectorXd z = Eigen::VectorXd::Constant(model.terrain_dim, NAN);
+  for (const std::string& item : SplitOn(text, ',')) {
+    const auto eq = item.find('=');
+    const std::string name = item.substr(0, eq);
+    int d = -1;
+    for (int i = 0; i < model.terrain_dim; ++i) {
+      if (model.terrain_names[i] == name) d = i;
+    }
+    if (eq == std::string::npos || d < 0) {
+      throw MakeInputError("--terrain", item, "expected name=value with a terrain name of the model");
+    }
+    z[d] = std::atof(item.c_str() + eq + 1);
+  }
+  if (!z.allFinite()) throw MakeInputError("--terrain", text, "expected a value for every terrain dimension");
+  return z;
+}
+
+nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, const predict::Prediction& p,
+                      const PredictArgs& args) {
+  nlohmann::json steps = nlohmann::json::array();
+  for (std::size_t k = 0; k < p.steps.size(); ++k) {
+    const auto& s = p.steps[k];
+    std::vector<std::vector<double>> cov(4, std::vector<double>(4));
+    for (int r = 0; r < 4; ++r) for (int c = 0; c < 4; ++c) cov[r][c] = s.covariance(r, c);
+    steps.push_back({{"step", k + 1},
+                     {"command", model.command_labels.at(ids[k])},
+                     {"mean", {s.mean[0], s.mean[1], s.mean[2], s.mean[3]}},
+                     {"covariance", cov}});
+  }
+  return {{"model", args.model}, {"pose", {"x_m", "y_m", "z_m", "yaw_rad"}}, {"spatial", p.spatial},
+          {"start", args.start}, {"trajectories", args.trajectories}, {"seed", args.seed},
+          {"terrain", args.terrain}, {"steps", steps}};
+}
+
+void Run(const PredictArgs& args) {
+  const MotionModel model = ReadModel(args.model);
+  const std::vector<int> ids = ParseCommands(model, args.commands);
+  const Eigen::VectorXd z = ParseTerrain(model, args.terrain);
+  std::vector<predict::Step> steps;
+  for (int id : ids) steps.push_back({id, z});
+  predict::PredictOptions options;
+  options.trajectories = args.trajectories;
+  options.seed = args.seed;
+  options.pose_dims = SplitOn(args.pose_dims, ',');
+  const auto p = predict::Predict(model, Eigen::Vector3d(args.start[0], args.start[1], args.start[2]), steps, options);
+  if (!args.output.empty()) {
+    AtomicFile file(args.output);
+    std::ofstream(file.temp_path()) << ToJson(model, ids, p, args).dump(2) << "\n";
+    file.Commit();
+  }
+  std::printf("%s trajectories, seed %llu%s\n", std::to_string(args.trajectories).c_str(),
+              static_cast<unsigned long long>(args.seed), z.size() ? "" : ", terrain marginalised");
+  std::printf("step  command            mean x (m)  mean y (m)  yaw (deg)   sd x (m)  sd y (m)  sd yaw (deg)\n");
+  for (std::size_t k = 0; k < p.steps.size(); ++k) {
+    const auto& s = p.steps[k];
+    std::printf("%4zu  %-17s %11.3f %11.3f %10.1f %10.3f %9.3f %13.1f\n", k + 1, model.command_labels.at(ids[k]).c_str(),
+                s.mean[0], s.mean[1], s.mean[3] * 180 / M_PI, std::sqrt(s.covariance(0, 0)),
+                std::sqrt(s.covariance(1, 1)), std::sqrt(s.covariance(3, 3)) * 180 / M_PI);
+  }
+  if (!args.output.empty()) std::printf("wrote %s\n", args.output.c_str());
+}
+
+void Setup(CLI::App& root) {
+  auto args = std::make_shared<PredictArgs>();
+  CLI::App* cmd = root.add_subcommand(
+      "predict",
+      "Where a sequence of commands takes the robot: draws pose changes from p(x | c, z) for each "
+      "command in turn and composes them in the robot's frame (SE(2), or SE(3) when the model has "
+      "dz, droll and dpitch), giving the mean and covariance of x, y, z and yaw after every command. "
+      "Seeded and repeatable.");
+  cmd->add_option("model", args->model, "model file (.h5)")->required();
+  cmd->add_option("--commands", args->commands,
+                  "command labels separated by ';', each optionally repeated as label*N, e.g. "
+                  "\"+0.5,0,0*3;0,0,+0.5\"")
+      ->required();
+  cmd->add_option("--terrain", args->terrain, "terrain to condition on, e.g. pitch=0.1,roll=0 (default: marginalised)");
+  cmd->add_option("--start", args->start, "start pose x,y,yaw (m, m, rad)")->delimiter(',')->expected(3);
+  cmd->add_option("--trajectories", args->trajectories, "Monte Carlo trajectories")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
+  cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();
+  cmd->add_option("--pose-dims", args->pose_dims,
+                  "the model's pose-change names for dx,dy,dyaw[,dz,droll,dpitch] (default: those names)");
+  cmd->add_option("-o,--output", args->output, "JSON file with every step's mean and covariance");
+  cmd->callback([args] { Run(*args); });
+}
+
+}  // namespace
+DGMM_REGISTER_COMMAND("predict", Setup);
+}  // namespace dgmm::app

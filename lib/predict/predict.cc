@@ -1,0 +1,115 @@
+#include "predict/predict.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <random>
+
+#include "util/error.h"
+
+namespace dgmm::predict {
+namespace {
+
+// Index of each wanted pose dimension in the model (dx, dy, dyaw[, dz, droll, dpitch]).
+std::vector<int> PoseIndices(const MotionModel& model, const PredictOptions& options, bool* spatial) {
+  std::vector<std::string> names = options.pose_dims;
+  auto has = [&](const std::string& n) {
+    for (const auto& p : model.pose_names) if (p == n) return true;
+    return false;
+  };
+  if (names.empty()) {
+    names = {"dx", "dy", "dyaw"};
+    if (has("dz") && has("droll") && has("dpitch")) names = {"dx", "dy", "dyaw", "dz", "droll", "dpitch"};
+  }
+  if (names.size() != 3 && names.size() != 6) {
+    throw MakeInputError("predict", "pose dims", "expected 3 names (dx, dy, dyaw) or 6 (dx, dy, dyaw, dz, droll, dpitch)");
+  }
+  std::vector<int> index;
+  for (const auto& n : names) {
+    int found = -1;
+    for (int i = 0; i < model.pose_dim; ++i) {
+      if (model.pose_names[i] == n) found = i;
+    }
+    if (found < 0) {
+      throw MakeInputError("model", "pose", "has no pose dimension \"" + n + "\" (name the planar ones with --pose-dims)");
+    }
+    index.push_back(found);
+  }
+  *spatial = names.size() == 6;
+  return index;
+}
+
+std::vector<int> Range(int begin, int end) {
+  std::vector<int> r;
+  for (int i = begin; i < end; ++i) r.push_back(i);
+  return r;
+}
+
+Eigen::Matrix3d Zyx(double yaw, double pitch, double roll) {
+  return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
+          Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
+      .toRotationMatrix();
+}
+
+// Mean and covariance of the poses, yaw unwrapped about its circular mean.
+void Summarise(StepPrediction* s) {
+  Eigen::MatrixXd& p = s->poses;
+  const double c = p.col(3).array().cos().mean(), sn = p.col(3).array().sin().mean();
+  const double centre = std::atan2(sn, c);
+  for (int i = 0; i < p.rows(); ++i) p(i, 3) = centre + std::remainder(p(i, 3) - centre, 2 * M_PI);
+  s->mean = p.colwise().mean().transpose();
+  const Eigen::MatrixXd d = p.rowwise() - s->mean.transpose();
+  s->covariance = d.transpose() * d / std::max<Eigen::Index>(1, p.rows() - 1);
+}
+
+}  // namespace
+
+bool PredictOptions::IsValid(std::string* error) const {
+  if (trajectories < 1 || trajectories > 10000000) {
+    if (error) *error = "trajectories: expected 1 to 10^7";
+    return false;
+  }
+  return true;
+}
+
+Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const std::vector<Step>& steps,
+                   const PredictOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("predict", "", error);
+  Prediction out;
+  const std::vector<int> idx = PoseIndices(model, options, &out.spatial);
+  const int n = options.trajectories;
+  std::vector<Eigen::Matrix3d> rotation(n, Zyx(start.z(), 0, 0));
+  Eigen::MatrixXd position(n, 3);
+  position.col(0).setConstant(start.x());
+  position.col(1).setConstant(start.y());
+  position.col(2).setZero();
+  std::mt19937_64 rng(options.seed);
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    const Step& step = steps[k];
+    if (!model.HasCommand(step.command)) {
+      throw MakeInputError("model", "command", "step " + std::to_string(k + 1) + ": the model has no such command");
+    }
+    if (step.terrain.size() > 0 && step.terrain.size() != model.terrain_dim) {
+      throw MakeInputError("predict", "terrain", "step " + std::to_string(k + 1) + ": expected " +
+                                                     std::to_string(model.terrain_dim) + " terrain values");
+    }
+    const Mixture mixture = step.terrain.size() > 0 ? model.Conditional(step.command, step.terrain)
+                            : model.terrain_dim > 0 ? model.MixtureFor(step.command).Marginal(Range(0, model.pose_dim))
+                                                    : model.MixtureFor(step.command);
+    const Eigen::MatrixXd dx = mixture.Sample(n, rng);  // pose_dim x n
+    StepPrediction s;
+    s.poses.resize(n, 4);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector3d t(dx(idx[0], i), dx(idx[1], i), out.spatial ? dx(idx[3], i) : 0.0);
+      const Eigen::Matrix3d r = out.spatial ? Zyx(dx(idx[2], i), dx(idx[5], i), dx(idx[4], i)) : Zyx(dx(idx[2], i), 0, 0);
+      position.row(i) += (rotation[i] * t).transpose();
+      rotation[i] = rotation[i] * r;
+      s.poses.row(i) << position(i, 0), position(i, 1), position(i, 2), std::atan2(rotation[i](1, 0), rotation[i](0, 0));
+    }
+    Summarise(&s);
+    out.steps.push_back(std::move(s));
+  }
+  return out;
+}
+
+}  // namespace dgmm::predict

@@ -1,0 +1,50 @@
+#pragma once
+// Where a command sequence takes the robot: the pose distribution after each command, by Monte
+// Carlo composition of pose changes drawn from the model's p(x | c, z) in the robot's frame
+// (SE(2) for a planar pose change (dx, dy, dyaw), SE(3) for (dx, dy, dz, droll, dpitch, dyaw),
+// ZYX Euler angles of the change relative to the start of the command).
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/motion_model.h"
+
+namespace dgmm::predict {
+
+struct PredictOptions {
+  int trajectories = 1000;
+  std::uint64_t seed = 1;
+  // Names of the pose-change dimensions, in the model's pose_names; empty: "dx,dy,dyaw" plus
+  // "dz,droll,dpitch" when the model has them all (SE(3)).
+  std::vector<std::string> pose_dims;
+  bool IsValid(std::string* error) const;
+};
+
+// One step of the sequence: the command's id in the model and the terrain to condition on (empty:
+// p(x | c), the terrain marginalised).
+struct Step {
+  int command = -1;
+  Eigen::VectorXd terrain;
+};
+
+struct StepPrediction {
+  // World pose of every trajectory after the step: x, y, z (m), yaw (rad, unwrapped about the
+  // mean); z is 0 for planar models.
+  Eigen::MatrixXd poses;      // trajectories x 4
+  Eigen::Vector4d mean = Eigen::Vector4d::Zero();
+  Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+};
+
+struct Prediction {
+  bool spatial = false;  // SE(3) composition
+  std::vector<StepPrediction> steps;
+};
+
+// Start pose: x, y (m), yaw (rad) in the world; z, roll and pitch start at zero. Throws
+// InputError naming the part (options, a pose dimension the model lacks, a command it does not
+// know, a terrain of the wrong size).
+Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const std::vector<Step>& steps,
+                   const PredictOptions& options);
+
+}  // namespace dgmm::predict

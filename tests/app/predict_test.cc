@@ -1,0 +1,43 @@
+// `dgmm predict` end to end on a model fitted from a shipped set.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "tests/app/run_dgmm.h"
+
+namespace dgmm::test {
+namespace {
+
+TEST(PredictCommand, PredictsASequenceAndWritesJson) {
+  const auto dir = MakeTempDir("predict_cmd");
+  const std::string model = (dir / "m.h5").string(), out = (dir / "p.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", SourcePath("datasets/scorpion_sim_390.h5").string(), "-o", model, "--k", "0.7",
+                     "--seed", "1"}).exit_code, 0);
+  const RunResult r = RunDgmm({"predict", model, "--commands", "+0.5,0,0*3;0,0,+0.5", "--terrain", "pitch=0.1,roll=0",
+                               "--trajectories", "300", "-o", out});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(out);
+  const auto j = nlohmann::json::parse(in);
+  ASSERT_EQ(j["steps"].size(), 4u);
+  const double x3 = j["steps"][2]["mean"][0], x1 = j["steps"][0]["mean"][0];
+  EXPECT_GT(x1, 0.1);                  // forward commands move forward
+  EXPECT_NEAR(x3, 3 * x1, 0.3 * x1);   // three of them, about three times as far
+  EXPECT_GT(double(j["steps"][3]["mean"][3]), double(j["steps"][2]["mean"][3]) + 0.1);  // then a left turn
+  EXPECT_EQ(RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--trajectories", "300", "-o", out}).exit_code, 0);
+}
+
+TEST(PredictCommand, AnUnknownCommandIsOneLineAndWritesNothing) {
+  const auto dir = MakeTempDir("predict_bad");
+  const std::string model = (dir / "m.h5").string(), out = (dir / "p.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", SourcePath("datasets/scorpion_sim_390.h5").string(), "-o", model}).exit_code, 0);
+  const RunResult r = RunDgmm({"predict", model, "--commands", "fly", "-o", out});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find("fly"), std::string::npos) << r.err;
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_NE(RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--terrain", "slope=3"}).exit_code, 0);
+}
+
+}  // namespace
+}  // namespace dgmm::test
