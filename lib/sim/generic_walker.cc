@@ -100,14 +100,18 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   const double ramp = 0.1 * period;
   const double envelope = std::clamp(std::min(t, duration - t) / ramp, 0.0, 1.0);
   const double duty = robot_.timing.duty;
+  std::vector<Eigen::Vector3d> targets(robot_.legs.size());
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
     const LegChain& leg = robot_.legs[i];
     const Eigen::Vector2d p = leg.stance_m.head<2>();
-    const Eigen::Vector2d d =
-        duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) + config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
+    const Eigen::Vector2d d = duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) +
+                                      config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
     const double u = t / period - robot_.timing.phase[i];
-    const Eigen::Vector3d foot = leg.stance_m + envelope * FootOffset(u, duty, d, robot_.step_height_m);
-    SolveLegIk(model_.get(), scratch_.get(), leg, robot_.robot_in_torso * foot, &q_[i], 8);
+    targets[i] = robot_.robot_in_torso * (leg.stance_m + envelope * FootOffset(u, duty, d, robot_.step_height_m));
+  }
+  SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);
+  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+    const LegChain& leg = robot_.legs[i];
     for (std::size_t k = 0; k < leg.actuators.size(); ++k) data_->ctrl[leg.actuators[k]] = q_[i][k];
   }
 }

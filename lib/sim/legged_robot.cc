@@ -237,36 +237,55 @@ Eigen::Vector3d FootPoint(const mjModel* m, const mjData* d, const LegChain& leg
   return Vec(d->xpos + 3 * leg.foot_body) + Mat(d->xmat + 9 * leg.foot_body) * leg.foot_offset_m;
 }
 
+double SolveLegsIk(const mjModel* m, mjData* d, const std::vector<LegChain>& legs,
+                   const std::vector<Eigen::Vector3d>& targets, std::vector<Eigen::VectorXd>* q, int iterations) {
+  std::vector<mjtNum> jacp(3 * m->nv);
+  std::vector<bool> done(legs.size(), false);
+  double worst = 0;
+  for (int it = 0; it <= iterations; ++it) {
+    for (std::size_t l = 0; l < legs.size(); ++l) {
+      for (std::size_t k = 0; k < legs[l].qpos.size(); ++k) d->qpos[legs[l].qpos[k]] = (*q)[l][k];
+    }
+    mj_kinematics(m, d);  // one pass for every leg: the chains are independent
+    mj_comPos(m, d);
+    worst = 0;
+    bool all_done = true;
+    for (std::size_t l = 0; l < legs.size(); ++l) {
+      const LegChain& leg = legs[l];
+      const Eigen::Vector3d foot = FootPoint(m, d, leg);
+      const Eigen::Vector3d e = targets[l] - foot;
+      worst = std::max(worst, e.norm());
+      done[l] = e.norm() < 1e-5 * leg.reach_m;
+      if (done[l] || it == iterations) continue;
+      all_done = false;
+      const int n = static_cast<int>(leg.qpos.size());
+      mj_jac(m, d, jacp.data(), nullptr, foot.data(), leg.foot_body);
+      Eigen::MatrixXd j(3, n);
+      for (int k = 0; k < n; ++k) {
+        for (int r = 0; r < 3; ++r) j(r, k) = jacp[r * m->nv + leg.dofs[k]];
+      }
+      const double lambda = 0.02 * std::max(leg.reach_m, 1e-3);
+      const Eigen::Matrix3d a = j * j.transpose() + lambda * lambda * Eigen::Matrix3d::Identity();
+      Eigen::VectorXd dq = j.transpose() * a.ldlt().solve(e);
+      const double max_step = 0.3;  // rad (or m for slides) per iteration
+      if (dq.cwiseAbs().maxCoeff() > max_step) dq *= max_step / dq.cwiseAbs().maxCoeff();
+      for (int k = 0; k < n; ++k) {
+        double v = (*q)[l][k] + dq[k];
+        const int jn = leg.joints[k];
+        if (m->jnt_limited[jn]) v = std::clamp(v, m->jnt_range[2 * jn], m->jnt_range[2 * jn + 1]);
+        (*q)[l][k] = v;
+      }
+    }
+    if (all_done) break;
+  }
+  return worst;
+}
+
 double SolveLegIk(const mjModel* m, mjData* d, const LegChain& leg, const Eigen::Vector3d& target,
                   Eigen::VectorXd* q, int iterations) {
-  const int n = static_cast<int>(leg.qpos.size());
-  std::vector<mjtNum> jacp(3 * m->nv);
-  const double lambda = 0.02 * std::max(leg.reach_m, 1e-3);
-  double residual = 0;
-  for (int it = 0; it <= iterations; ++it) {
-    for (int k = 0; k < n; ++k) d->qpos[leg.qpos[k]] = (*q)[k];
-    mj_kinematics(m, d);
-    mj_comPos(m, d);
-    const Eigen::Vector3d foot = FootPoint(m, d, leg);
-    const Eigen::Vector3d e = target - foot;
-    residual = e.norm();
-    if (it == iterations || residual < 1e-5 * leg.reach_m) break;
-    mj_jac(m, d, jacp.data(), nullptr, foot.data(), leg.foot_body);
-    Eigen::MatrixXd j(3, n);
-    for (int k = 0; k < n; ++k) {
-      for (int r = 0; r < 3; ++r) j(r, k) = jacp[r * m->nv + leg.dofs[k]];
-    }
-    const Eigen::Matrix3d a = j * j.transpose() + lambda * lambda * Eigen::Matrix3d::Identity();
-    Eigen::VectorXd dq = j.transpose() * a.ldlt().solve(e);
-    const double max_step = 0.3;  // rad (or m for slides) per iteration
-    if (dq.cwiseAbs().maxCoeff() > max_step) dq *= max_step / dq.cwiseAbs().maxCoeff();
-    for (int k = 0; k < n; ++k) {
-      double v = (*q)[k] + dq[k];
-      const int jn = leg.joints[k];
-      if (m->jnt_limited[jn]) v = std::clamp(v, m->jnt_range[2 * jn], m->jnt_range[2 * jn + 1]);
-      (*q)[k] = v;
-    }
-  }
+  std::vector<Eigen::VectorXd> qs = {*q};
+  const double residual = SolveLegsIk(m, d, {leg}, {target}, &qs, iterations);
+  *q = qs[0];
   return residual;
 }
 

@@ -60,6 +60,11 @@ void AddPayload(mjModel* model, int torso, const Eigen::Vector3d& p_m, double ma
 double SolveLegIk(const mjModel* model, mjData* scratch, const LegChain& leg, const Eigen::Vector3d& target_m,
                   Eigen::VectorXd* q, int iterations);
 
+// The same for every leg at once (one forward-kinematics pass per iteration: the legs' chains are
+// independent); returns the largest residual.
+double SolveLegsIk(const mjModel* model, mjData* scratch, const std::vector<LegChain>& legs,
+                   const std::vector<Eigen::Vector3d>& targets_m, std::vector<Eigen::VectorXd>* q, int iterations);
+
 // Foot point of a leg in the world frame of `data`.
 Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegChain& leg);
 
