@@ -20,21 +20,6 @@ int TorsoChildOf(const mjModel* m, int body, int torso) {
   return body > 0 ? body : -1;
 }
 
-Knob MakeKnob(KnobKind kind, int index, std::string name, std::string family, std::string unit,
-              double nominal, double lo, double hi, std::vector<double> probes) {
-  Knob k;
-  k.kind = kind;
-  k.index = index;
-  k.name = std::move(name);
-  k.family = std::move(family);
-  k.unit = std::move(unit);
-  k.nominal = nominal;
-  k.lo = lo;
-  k.hi = hi;
-  k.probes = std::move(probes);
-  return k;
-}
-
 // Largest |x| and |y| of the leg roots (the torso's children carrying the leg actuators) in the
 // torso frame; one falls back on the other when it is under 1 cm (legs in one line).
 Eigen::Vector2d LegRootSpan(const mjModel* m, const RobotParts& parts) {
@@ -51,6 +36,21 @@ Eigen::Vector2d LegRootSpan(const mjModel* m, const RobotParts& parts) {
 }
 
 }  // namespace
+
+Knob MakeKnob(KnobKind kind, int index, std::string name, std::string family, std::string unit,
+              double nominal, double lo, double hi, std::vector<double> probes) {
+  Knob k;
+  k.kind = kind;
+  k.index = index;
+  k.name = std::move(name);
+  k.family = std::move(family);
+  k.unit = std::move(unit);
+  k.nominal = nominal;
+  k.lo = lo;
+  k.hi = hi;
+  k.probes = std::move(probes);
+  return k;
+}
 
 std::string RobotMjcfText(const SimConfig& config) {
   if (config.mjcf_path.empty()) return kBuiltinRobotMjcf;

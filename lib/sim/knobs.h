@@ -59,6 +59,10 @@ struct KnobValue {
   double value = 0;
 };
 
+// A knob from its fields (probes: the values simulated for its signature).
+Knob MakeKnob(KnobKind kind, int index, std::string name, std::string family, std::string unit,
+              double nominal, double lo, double hi, std::vector<double> probes);
+
 // Knobs of the robot of `config` (loads its MJCF). Throws InputError when it cannot be loaded.
 std::vector<Knob> EnumerateKnobs(const SimConfig& config);
 

@@ -13,41 +13,26 @@
 namespace dgmm::sim {
 namespace {
 
-Knob Make(KnobKind kind, int index, std::string name, std::string family, std::string unit, double nominal,
-          double lo, double hi, std::vector<double> probes) {
-  Knob k;
-  k.kind = kind;
-  k.index = index;
-  k.name = std::move(name);
-  k.family = std::move(family);
-  k.unit = std::move(unit);
-  k.nominal = nominal;
-  k.lo = lo;
-  k.hi = hi;
-  k.probes = std::move(probes);
-  return k;
-}
-
 void AddContactKnobs(const mjModel* m, int floor, std::vector<Knob>* knobs) {
   const double tc = m->geom_solref[mjNREF * floor + 0];
   const double dr = m->geom_solref[mjNREF * floor + 1];
   if (tc > 0) {
-    knobs->push_back(Make(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s", tc,
+    knobs->push_back(MakeKnob(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s", tc,
                           std::max(2.5 * m->opt.timestep, 0.25 * tc), 8 * tc, {3 * tc}));
-    knobs->push_back(Make(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "", dr, 0.1 * dr,
+    knobs->push_back(MakeKnob(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "", dr, 0.1 * dr,
                           4 * dr, {0.3 * dr}));
   }
 }
 
 void AddLegKnobs(const SimConfig& config, const LeggedRobot& bound, std::vector<Knob>* knobs) {
-  Knob side[2] = {Make(KnobKind::kSideGain, 0, "actuators.left_side.gain", "actuator_gain", "", 1.0, 0.05, 1.5, {0.6}),
-                  Make(KnobKind::kSideGain, 1, "actuators.right_side.gain", "actuator_gain", "", 1.0, 0.05, 1.5,
+  Knob side[2] = {MakeKnob(KnobKind::kSideGain, 0, "actuators.left_side.gain", "actuator_gain", "", 1.0, 0.05, 1.5, {0.6}),
+                  MakeKnob(KnobKind::kSideGain, 1, "actuators.right_side.gain", "actuator_gain", "", 1.0, 0.05, 1.5,
                        {0.6})};
   for (int i = 0; i < static_cast<int>(bound.legs.size()); ++i) {
     const std::string& name = bound.legs[i].name;
     const auto it = config.robot->leg_gain.find(name);
     const double g = it == config.robot->leg_gain.end() ? 1.0 : it->second;
-    knobs->push_back(Make(KnobKind::kLegGain, i, "actuators." + name + ".gain", "actuator_gain", "", g, 0.05 * g,
+    knobs->push_back(MakeKnob(KnobKind::kLegGain, i, "actuators." + name + ".gain", "actuator_gain", "", g, 0.05 * g,
                           1.5 * g, {0.5 * g}));
     knobs->back().leg = name;
     side[bound.legs[i].side > 0 ? 0 : 1].members.push_back(name);
@@ -104,25 +89,25 @@ std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
   for (int b = 1; b < m->nbody; ++b) total_kg += m->body_mass[b];
   const double reach = bound.reach_m;
   std::vector<Knob> knobs;
-  knobs.push_back(Make(KnobKind::kFrictionScale, -1, "geoms.friction_scale", "friction", "", 1.0, 0.2, 2.0, {0.6, 1.5}));
+  knobs.push_back(MakeKnob(KnobKind::kFrictionScale, -1, "geoms.friction_scale", "friction", "", 1.0, 0.2, 2.0, {0.6, 1.5}));
   AddContactKnobs(m, bound.floor_geom, &knobs);
-  knobs.push_back(Make(KnobKind::kMassScale, -1, "bodies.mass_scale", "mass", "", 1.0, 0.4, 2.5, {0.7, 1.4}));
+  knobs.push_back(MakeKnob(KnobKind::kMassScale, -1, "bodies.mass_scale", "mass", "", 1.0, 0.4, 2.5, {0.7, 1.4}));
   const double probe_kg = 0.15 * total_kg;
   const auto& p = config.payload;
-  knobs.push_back(Make(KnobKind::kPayloadMass, -1, "payload.mass_kg", "payload", "kg", p.mass_kg, 0.0, 4 * probe_kg,
+  knobs.push_back(MakeKnob(KnobKind::kPayloadMass, -1, "payload.mass_kg", "payload", "kg", p.mass_kg, 0.0, 4 * probe_kg,
                        {p.mass_kg + probe_kg}));
-  knobs.push_back(Make(KnobKind::kPayloadX, -1, "payload.position_x_m", "payload", "m", p.position_body_m.x(), -0.6 * reach,
+  knobs.push_back(MakeKnob(KnobKind::kPayloadX, -1, "payload.position_x_m", "payload", "m", p.position_body_m.x(), -0.6 * reach,
                        0.6 * reach, {0.2 * reach}));
-  knobs.push_back(Make(KnobKind::kPayloadY, -1, "payload.position_y_m", "payload", "m", p.position_body_m.y(), -0.4 * reach,
+  knobs.push_back(MakeKnob(KnobKind::kPayloadY, -1, "payload.position_y_m", "payload", "m", p.position_body_m.y(), -0.4 * reach,
                        0.4 * reach, {0.15 * reach}));
   AddLegKnobs(config, bound, &knobs);
-  knobs.push_back(Make(KnobKind::kKpScale, -1, "actuators.kp_scale", "actuator_gain", "", 1.0, 0.2, 2.5, {0.6, 1.5}));
-  knobs.push_back(Make(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0, 0.05, 10.0,
+  knobs.push_back(MakeKnob(KnobKind::kKpScale, -1, "actuators.kp_scale", "actuator_gain", "", 1.0, 0.2, 2.5, {0.6, 1.5}));
+  knobs.push_back(MakeKnob(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0, 0.05, 10.0,
                        {0.25, 4.0}));
   const auto& n = config.noise;
   if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
       n.tracker_pitch_sd_rad > 0) {
-    knobs.push_back(Make(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0, 0.5, 5.0,
+    knobs.push_back(MakeKnob(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0, 0.5, 5.0,
                          {2.0}));
   }
   return knobs;
