@@ -52,7 +52,10 @@ def main():
     a = ap.parse_args()
     dgmm = os.path.join(a.build, "app", "dgmm")
     base = json.load(open(a.config))
-    base["mjcf_path"] = os.path.abspath(os.path.join(os.path.dirname(a.config), base["mjcf_path"]))
+    here = os.path.dirname(a.config)
+    base["mjcf_path"] = os.path.abspath(os.path.join(here, base["mjcf_path"]))
+    for rec in base["robot"].get("controller", {}).get("recordings", []):  # a replayed controller's files
+        rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
     tmp = tempfile.mkdtemp()
     print(f"Robot: {a.config}; paper protocol, seed {a.seed}; ratio = measured / commanded, cross = off-axis share\n")
     header = None
@@ -76,7 +79,8 @@ def main():
                 header = sorted(rows)
                 print("| slope | gait | " + " | ".join(header) + " | worst cross-talk |")
                 print("|---|---|" + "---|" * (len(header) + 1))
-            cells = " | ".join(f"{rows[k][0]:.2f}" for k in header)
+            # A command with no kept execution (every placement fell) shows as "fell".
+            cells = " | ".join(f"{rows[k][0]:.2f}" if k in rows else "fell" for k in header)
             print(f"| {slope:g} deg | {pattern} | {cells} | {max(r[1] for r in rows.values()):.2f} |")
     return 0
 

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "sim/compiled_model.h"
+#include "sim/replay.h"
 #include "sim/protocol.h"
 #include "sim/simulator.h"
 #include "sim2real/simulation_cache.h"
@@ -55,8 +56,11 @@ MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_
   // height fields with it) and the config without its path, so moving the robot's folder hits.
   sim::SimConfig keyed = config_;
   keyed.mjcf_path.clear();
+  if (keyed.robot) {
+    for (auto& rec : keyed.robot->controller.recordings) rec.file.clear();  // their bytes are keyed instead
+  }
   fingerprint_ = sim2real::HashHex(std::string(kSimulatorCodeVersion) + "\n" + sim::CompiledModelBytes(config_) +
-                                   "\n" + sim::SimConfigToJson(keyed));
+                                   "\n" + sim::ReplayBytes(config_) + "\n" + sim::SimConfigToJson(keyed));
   const sim::Simulator robot(config_);
   total_mass_kg_ = robot.total_mass_kg();
   leg_reach_m_ = robot.leg_reach_m();

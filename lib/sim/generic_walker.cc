@@ -5,11 +5,12 @@
 #include <cmath>
 
 #include "sim/simulator.h"
+#include "util/error.h"
 
 namespace dgmm::sim {
 
 GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const std::string& source)
-    : config_(config), model_(std::move(model)) {
+    : config_(config), model_(std::move(model)), source_(source) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
   ApplyExperiment(config, robot_, model_.get());
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
@@ -21,9 +22,19 @@ void GenericWalker::Start() {
   scratch_.reset(mj_makeData(model_.get()));
   for (int k = 0; k < 7; ++k) scratch_->qpos[robot_.torso_qpos + k] = k == 3 ? 1 : 0;  // torso frame = world
   mj_setConst(model_.get(), data_.get());
+  q_.resize(robot_.legs.size());
+  std::vector<int> actuators = robot_.leg_actuators;
+  if (!robot_.replay.empty()) {
+    actuators.clear();
+    for (int a = 0; a < model_->nu; ++a) actuators.push_back(a);
+  }
+  const int latency_steps = static_cast<int>(std::lround(config_.actuators.latency_s / model_->opt.timestep));
+  line_ = ActuationLine(model_.get(), actuators, latency_steps, config_.actuators.backlash_rad);
 }
 
 bool GenericWalker::Step() {
+  line_.Send(u_);
+  line_.Write(data_.get());
   time_s_ += model_->opt.timestep;
   return StepChecked(model_.get(), data_.get());
 }
@@ -45,11 +56,28 @@ bool GenericWalker::Fallen() const {
 }
 
 void GenericWalker::HoldStance() {
-  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
-    const LegChain& leg = robot_.legs[i];
-    q_[i] = leg.stance_q;
-    for (std::size_t k = 0; k < leg.actuators.size(); ++k) data_->ctrl[leg.actuators[k]] = q_[i][k];
+  if (!robot_.replay.empty()) {
+    u_ = robot_.replay[robot_.stand_recording].At(0);
+  } else {
+    u_.resize(static_cast<int>(robot_.leg_actuators.size()));
+    int k = 0;
+    for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+      q_[i] = robot_.legs[i].stance_q;
+      for (int j = 0; j < q_[i].size(); ++j) u_[k++] = q_[i][j];
+    }
   }
+  line_.Reset(u_);
+  line_.Write(data_.get());
+}
+
+const ReplayTrack& GenericWalker::Recording(const Eigen::Vector3d& c) const {
+  const int i = FindRecording(config_.robot->controller, c);
+  if (i < 0) {
+    char what[160];
+    std::snprintf(what, sizeof what, "no recording of command [%g, %g, %g]", c.x(), c.y(), c.z());
+    throw MakeInputError(source_, "robot.controller.recordings", what);
+  }
+  return robot_.replay[i];
 }
 
 RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
@@ -57,7 +85,6 @@ RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
   mjData* d = data_.get();
   mj_resetData(m, d);
   if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
-  q_.resize(robot_.legs.size());
   double extent = 0;
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
     const LegChain& leg = robot_.legs[i];
@@ -83,8 +110,10 @@ RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
 
 RunOutcome GenericWalker::Stand(double seconds) {
   HoldStance();
-  const int steps = static_cast<int>(std::lround(seconds / model_->opt.timestep));
+  const double dt = model_->opt.timestep;
+  const int steps = static_cast<int>(std::lround(seconds / dt));
   for (int s = 0; s < steps; ++s) {
+    if (!robot_.replay.empty()) u_ = robot_.replay[robot_.stand_recording].At((s + 1) * dt);
     if (!Step()) return RunOutcome::kUnstable;
     if (Fallen()) return RunOutcome::kFell;
   }
@@ -110,9 +139,9 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
     targets[i] = robot_.robot_in_torso * (leg.stance_m + envelope * FootOffset(u, duty, d, robot_.step_height_m));
   }
   SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);
+  int k = 0;
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
-    const LegChain& leg = robot_.legs[i];
-    for (std::size_t k = 0; k < leg.actuators.size(); ++k) data_->ctrl[leg.actuators[k]] = q_[i][k];
+    for (int j = 0; j < q_[i].size(); ++j) u_[k++] = q_[i][j];
   }
 }
 
@@ -121,8 +150,13 @@ RunOutcome GenericWalker::Run(const Eigen::Vector3d& command, const std::functio
   const double duration = config_.command_duration_s;
   const int steps = static_cast<int>(std::lround(duration / dt));
   const Eigen::Vector3d c = command.cwiseMax(-1.0).cwiseMin(1.0);
+  const ReplayTrack* track = robot_.replay.empty() ? nullptr : &Recording(command);
   for (int s = 0; s < steps; ++s) {
-    if (s % control_every_ == 0) Control(c, (s + 1) * dt, duration);
+    if (track) {
+      u_ = track->At((s + 1) * dt);
+    } else if (s % control_every_ == 0) {
+      Control(c, (s + 1) * dt, duration);
+    }
     if (!Step()) return RunOutcome::kUnstable;
     if (observe) observe(s);
     if (Fallen()) return RunOutcome::kFell;

@@ -5,6 +5,7 @@
 #include <functional>
 #include <vector>
 
+#include "sim/actuation_line.h"
 #include "sim/legged_robot.h"
 #include "sim/pose.h"
 #include "sim/sim_config.h"
@@ -37,14 +38,19 @@ class GenericWalker {
  private:
   bool Step();
   bool Fallen() const;
+  // The generic gait's joint targets at time t of a command (in u_).
   void Control(const Eigen::Vector3d& command, double t, double duration);
   void HoldStance();
+  const ReplayTrack& Recording(const Eigen::Vector3d& command) const;
 
   SimConfig config_;
   MjModelPtr model_;
   MjDataPtr data_, scratch_;
   LeggedRobot robot_;
   std::vector<Eigen::VectorXd> q_;  // each leg's joint targets
+  Eigen::VectorXd u_;               // the signal sent now: leg targets (gait) or every actuator's (replay)
+  ActuationLine line_;
+  std::string source_;
   double time_s_ = 0;
   int control_every_ = 1;
 };

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <set>
 
+#include "sim/replay.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -74,6 +75,36 @@ void BindFoot(const mjModel* m, const FootDescription& foot, const std::string& 
   }
 }
 
+// The actuator driving joint k (`j`) of a leg: the one named in the description or the one on
+// the joint. The generic gait needs a position servo on every leg joint; a replay does not (-1:
+// the joint is driven otherwise, e.g. through a tendon).
+int LegActuator(const mjModel* m, const RobotDescription& r, const LegDescription& desc, std::size_t k, int j,
+                const std::string& part, const std::string& source) {
+  int a = -1;
+  if (desc.actuators.empty()) {
+    a = ActuatorOf(m, j);
+    if (a < 0 && !r.controller.replay()) {
+      throw MakeInputError(source, part + ".joints",
+                           "no actuator drives joint \"" + desc.joints[k] +
+                               "\" (add one, or model the leg without it and list the joint in robot.passive_joints)");
+    }
+  } else {
+    a = Find(m, mjOBJ_ACTUATOR, desc.actuators[k], "actuator", part + ".actuators", source);
+    if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_trnid[2 * a] != j) {
+      throw MakeInputError(source, part + ".actuators",
+                           "actuator \"" + desc.actuators[k] + "\" does not drive joint \"" + desc.joints[k] + "\"");
+    }
+  }
+  if (a >= 0 && !r.controller.replay() && !IsPositionServo(m, a)) {
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+    throw MakeInputError(source, part + ".actuators",
+                         std::string("actuator \"") + (name ? name : "?") +
+                             "\" is not a position servo: the generic gait sends joint angles; drive a robot with "
+                             "motor or tendon actuation by a replay (robot.controller type replay)");
+  }
+  return a;
+}
+
 // Joints, actuators and foot of leg i, checked to lie on one torso-to-foot chain.
 LegChain BindChain(const mjModel* m, const RobotDescription& r, int i, int torso, const std::string& source) {
   const LegDescription& desc = r.legs[i];
@@ -93,32 +124,11 @@ LegChain BindChain(const mjModel* m, const RobotDescription& r, int i, int torso
                            "joint \"" + desc.joints[k] + "\" is not on the chain from the torso to the foot (in order)");
     }
     parent_body = body;
-    int a = -1;
-    if (desc.actuators.empty()) {
-      a = ActuatorOf(m, j);
-      if (a < 0) {
-        throw MakeInputError(source, part + ".joints",
-                             "no actuator drives joint \"" + desc.joints[k] +
-                                 "\" (add one, or model the leg without it and list the joint in robot.passive_joints)");
-      }
-    } else {
-      a = Find(m, mjOBJ_ACTUATOR, desc.actuators[k], "actuator", part + ".actuators", source);
-      if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_trnid[2 * a] != j) {
-        throw MakeInputError(source, part + ".actuators",
-                             "actuator \"" + desc.actuators[k] + "\" does not drive joint \"" + desc.joints[k] + "\"");
-      }
-    }
-    if (!IsPositionServo(m, a)) {
-      const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
-      throw MakeInputError(source, part + ".actuators",
-                           std::string("actuator \"") + (name ? name : "?") +
-                               "\" is not a position servo (motor or other actuation): the generic gait sends joint "
-                               "angles; a replay controller for torques is not available yet");
-    }
     leg.joints.push_back(j);
     leg.qpos.push_back(m->jnt_qposadr[j]);
     leg.dofs.push_back(m->jnt_dofadr[j]);
-    leg.actuators.push_back(a);
+    const int a = LegActuator(m, r, desc, k, j, part, source);
+    if (a >= 0) leg.actuators.push_back(a);
   }
   return leg;
 }
@@ -142,7 +152,7 @@ void CheckEverythingAccounted(const mjModel* m, const RobotDescription& r, const
                          std::string("joint \"") + (name ? name : "(unnamed)") +
                              "\" belongs to no leg and is not declared in robot.passive_joints");
   }
-  for (int a = 0; a < m->nu; ++a) {
+  for (int a = 0; a < m->nu && !r.controller.replay(); ++a) {  // a replay drives every actuator
     if (leg_actuators.count(a)) continue;
     const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
     throw MakeInputError(source, "robot.legs",
@@ -229,6 +239,31 @@ void SolveStance(const mjModel* m, const RobotDescription& r, const std::string&
   }
 }
 
+// A replay's signals fit its actuators (position targets for servos, forces for the rest), it has
+// a standing recording (command [0, 0, 0]) and every recording has a column per actuator.
+void BindReplay(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* b) {
+  const ControllerDescription& c = r.controller;
+  if (!c.replay()) return;
+  std::vector<std::string> names;
+  for (int a = 0; a < m->nu; ++a) {
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+    if (!name) throw MakeInputError(source, "robot.controller", "actuator " + std::to_string(a) + " has no name (a replay's columns name them)");
+    names.emplace_back(name);
+    if (IsPositionServo(m, a) != (c.signal == "position")) {
+      throw MakeInputError(source, "robot.controller.signal",
+                           c.signal + " signals, but actuator \"" + name + "\" is " +
+                               (IsPositionServo(m, a) ? "a position servo" : "not a position servo"));
+    }
+  }
+  if (m->nu == 0) throw MakeInputError(source, "robot.controller", "the model has no actuators to replay");
+  b->stand_recording = FindRecording(c, Eigen::Vector3d::Zero());
+  if (b->stand_recording < 0) {
+    throw MakeInputError(source, "robot.controller.recordings",
+                         "expected a recording of command [0, 0, 0]: the robot stands with it while placed");
+  }
+  for (const auto& rec : c.recordings) b->replay.push_back(LoadReplayTrack(rec.file, names));
+}
+
 }  // namespace
 
 Eigen::Vector3d FootPoint(const mjModel* m, const mjData* d, const LegChain& leg) {
@@ -305,6 +340,7 @@ LeggedRobot BindRobot(const mjModel* m, const RobotDescription& r, const std::st
     b.leg_actuators.insert(b.leg_actuators.end(), b.legs.back().actuators.begin(), b.legs.back().actuators.end());
   }
   CheckEverythingAccounted(m, r, b, source);
+  BindReplay(m, r, source, &b);
   MeasureRest(m, r, source, &b);
   std::vector<LegPlace> places;
   for (const auto& leg : b.legs) places.push_back({leg.side, leg.stance_m.x()});

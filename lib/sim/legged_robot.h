@@ -10,6 +10,7 @@
 
 #include "sim/gait_table.h"
 #include "sim/mujoco_model.h"
+#include "sim/replay.h"
 #include "sim/robot_description.h"
 #include "sim/sim_config.h"
 
@@ -34,6 +35,10 @@ struct LeggedRobot {
   std::vector<int> leg_actuators;  // every actuator a leg drives
   GaitTiming timing;
   double reach_m = 0, stance_height_m = 0, stride_m = 0, step_height_m = 0;
+  // A replay controller's tracks (one per robot.controller.recordings entry, columns in actuator
+  // id order) and the standing one; empty with the generic gait.
+  std::vector<ReplayTrack> replay;
+  int stand_recording = -1;
 };
 
 // Binds and validates (one-line InputError "<source>: robot.<part>: <problem>"): parts exist and

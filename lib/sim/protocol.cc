@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "sim/pose.h"
+#include "sim/replay.h"
 #include "sim/simulator.h"
 #include "util/error.h"
 
@@ -153,6 +154,9 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   const auto wall_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   Simulator sim(config, edit);
+  Eigen::MatrixXd used(static_cast<int>(plan.size()), 3);
+  for (int p = 0; p < used.rows(); ++p) used.row(p) = out->commands.row(plan[p].command);
+  CheckRecordingsCover(config, used);
   SampleSet& set = *out;
   const int reps = options.executions_per_placement;
 

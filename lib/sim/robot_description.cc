@@ -151,6 +151,40 @@ GaitDescription ReadGait(const json& j, const std::string& source) {
   return g;
 }
 
+ControllerDescription ReadController(const json& j, const std::string& source) {
+  Fields f(j, "robot.controller", source);
+  ControllerDescription c;
+  f.String("type", &c.type);
+  f.String("signal", &c.signal);
+  const json* recordings = f.Find("recordings");
+  f.Done();
+  if (c.type != "gait" && c.type != "replay") f.Fail("robot.controller.type", "expected gait or replay");
+  if (c.signal != "position" && c.signal != "torque") f.Fail("robot.controller.signal", "expected position or torque");
+  if (!c.replay()) {
+    if (recordings) f.Fail("robot.controller.recordings", "only with type replay");
+    return c;
+  }
+  if (!recordings || !recordings->is_array() || recordings->empty()) {
+    f.Fail("robot.controller.recordings", "expected an array of {\"command\": [long, lat, turn], \"file\": CSV}");
+  }
+  for (std::size_t i = 0; i < recordings->size(); ++i) {
+    const std::string path = "robot.controller.recordings[" + std::to_string(i) + "]";
+    Fields r((*recordings)[i], path, source);
+    ReplayRecording rec;
+    rec.command = Eigen::Vector3d::Constant(std::nan(""));
+    r.Vector3("command", &rec.command);
+    r.String("file", &rec.file);
+    r.Done();
+    if (!rec.command.allFinite()) r.Fail(path + ".command", "expected [long, lat, turn]");
+    if (rec.file.empty()) r.Fail(path + ".file", "expected the recording's CSV file");
+    for (const auto& other : c.recordings) {
+      if ((other.command - rec.command).norm() < 1e-9) r.Fail(path + ".command", "a second recording of this command");
+    }
+    c.recordings.push_back(rec);
+  }
+  return c;
+}
+
 }  // namespace
 
 RobotDescription RobotDescriptionFromJson(const std::string& json_text, const std::string& source) {
@@ -170,6 +204,7 @@ RobotDescription RobotDescriptionFromJson(const std::string& json_text, const st
   const json* legs = f.Find("legs");
   const json* gait = f.Find("gait");
   const json* gains = f.Find("leg_gain");
+  const json* controller = f.Find("controller");
   f.Done();
   if (r.forward_axis.norm() < 1e-9 || std::abs(r.forward_axis.z()) > 1e-9) {
     f.Fail("robot.forward_axis", "expected a non-zero horizontal direction in the torso frame (z = 0)");
@@ -184,6 +219,7 @@ RobotDescription RobotDescriptionFromJson(const std::string& json_text, const st
     }
   }
   if (gait) r.gait = ReadGait(*gait, source);
+  if (controller) r.controller = ReadController(*controller, source);
   if (gains) {
     Fields g(*gains, "robot.leg_gain", source);
     for (const auto& [leg, value] : gains->items()) {
@@ -226,6 +262,13 @@ std::string RobotDescriptionToJson(const RobotDescription& r) {
             {"gait", gait},
             {"overwrite_physics", r.overwrite_physics}};
   if (!r.leg_gain.empty()) j["leg_gain"] = r.leg_gain;
+  if (r.controller.replay()) {
+    json recordings = json::array();
+    for (const auto& rec : r.controller.recordings) {
+      recordings.push_back({{"command", {rec.command.x(), rec.command.y(), rec.command.z()}}, {"file", rec.file}});
+    }
+    j["controller"] = {{"type", r.controller.type}, {"signal", r.controller.signal}, {"recordings", recordings}};
+  }
   return j.dump();
 }
 

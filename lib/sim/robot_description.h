@@ -44,6 +44,23 @@ struct GaitDescription {
   double turn_rad = 0.3;           // yaw per cycle at |turn| = 1
 };
 
+// What drives the legs: the generic gait (foot placement through inverse kinematics), or a
+// replay of recorded actuator signals, one CSV per command: a column `t` (s, increasing from 0)
+// and one column per actuator of the model (by name), linearly interpolated and repeated with the
+// recording's length as period. `signal` says what the values are: position targets (servos)
+// or forces/torques (motors, tendons). Either way they pass the config's latency and backlash.
+struct ReplayRecording {
+  Eigen::Vector3d command = Eigen::Vector3d::Zero();  // (long, lat, turn)
+  std::string file;                                   // relative to the config file's folder
+};
+
+struct ControllerDescription {
+  std::string type = "gait";        // gait | replay
+  std::string signal = "position";  // replay: position | torque
+  std::vector<ReplayRecording> recordings;
+  bool replay() const { return type == "replay"; }
+};
+
 struct RobotDescription {
   std::string torso_body = "torso";
   std::string floor_geom = "floor";
@@ -52,6 +69,7 @@ struct RobotDescription {
   std::vector<std::string> passive_joints;  // joints deliberately left undriven
   GaitDescription gait;
   std::map<std::string, double> leg_gain;   // by leg name: scales the leg's actuator gains
+  ControllerDescription controller;
   // The model's physics is the nominal; true applies the config's friction, masses, gains and
   // damping over it (the built-in robot's behaviour).
   bool overwrite_physics = false;

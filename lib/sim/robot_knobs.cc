@@ -42,6 +42,23 @@ void AddLegKnobs(const SimConfig& config, const LeggedRobot& bound, std::vector<
   }
 }
 
+// Latency of every actuator signal (probe: 7% of the gait cycle), and backlash of the joint
+// servos when the robot has any (a torque replay has none).
+void AddActuationKnobs(const SimConfig& config, const mjModel* m, std::vector<Knob>* knobs) {
+  const double lat = config.actuators.latency_s;
+  const double probe = std::min(0.2, lat + 0.07 * config.robot->gait.period_s);
+  knobs->push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, 0.2, {probe}));
+  bool servos = false;
+  for (int a = 0; a < m->nu; ++a) {
+    servos |= m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_biastype[a] == mjBIAS_AFFINE &&
+              m->actuator_biasprm[mjNBIAS * a + 1] < 0;
+  }
+  if (!servos) return;
+  const double bl = config.actuators.backlash_rad;
+  knobs->push_back(MakeKnob(KnobKind::kBacklash, -1, "actuators.backlash_rad", "backlash", "rad", bl, 0.0, 0.2,
+                            {bl + 0.03 <= 0.2 ? bl + 0.03 : bl - 0.03}));
+}
+
 // What ApplyRobotKnobs collects from the values before building the model edit.
 struct RobotEdit {
   double friction = 1, mass = 1, kp = 1, damping = 1;
@@ -104,6 +121,7 @@ std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
   knobs.push_back(MakeKnob(KnobKind::kKpScale, -1, "actuators.kp_scale", "actuator_gain", "", 1.0, 0.2, 2.5, {0.6, 1.5}));
   knobs.push_back(MakeKnob(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0, 0.05, 10.0,
                        {0.25, 4.0}));
+  AddActuationKnobs(config, m, &knobs);
   const auto& n = config.noise;
   if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
       n.tracker_pitch_sd_rad > 0) {
@@ -133,6 +151,8 @@ SimConfig ApplyRobotKnobs(const SimConfig& config, const std::vector<Knob>& knob
       case KnobKind::kPayloadX: payload = true; c.payload.position_body_m.x() = v.value; break;
       case KnobKind::kPayloadY: payload = true; c.payload.position_body_m.y() = v.value; break;
       case KnobKind::kLegGain: c.robot->leg_gain[k.leg] = v.value; break;
+      case KnobKind::kLatency: c.actuators.latency_s = v.value; break;
+      case KnobKind::kBacklash: c.actuators.backlash_rad = v.value; break;
       case KnobKind::kSideGain:
         for (const auto& leg : k.members) {
           const auto it = config.robot->leg_gain.find(leg);

@@ -243,8 +243,14 @@ SimConfig LoadSimConfig(const std::string& path) {
   std::stringstream text;
   text << in.rdbuf();
   SimConfig c = SimConfigFromJson(text.str(), path);
-  if (!c.mjcf_path.empty() && std::filesystem::path(c.mjcf_path).is_relative()) {
-    c.mjcf_path = (std::filesystem::path(path).parent_path() / c.mjcf_path).lexically_normal();
+  const auto beside_config = [&](std::string* file) {
+    if (!file->empty() && std::filesystem::path(*file).is_relative()) {
+      *file = (std::filesystem::path(path).parent_path() / *file).lexically_normal();
+    }
+  };
+  beside_config(&c.mjcf_path);
+  if (c.robot) {
+    for (auto& rec : c.robot->controller.recordings) beside_config(&rec.file);
   }
   return c;
 }

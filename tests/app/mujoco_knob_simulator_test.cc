@@ -94,6 +94,23 @@ TEST(MujocoKnobSimulator, FingerprintFollowsIncludedFilesAndNotTheRobotsFolder) 
   EXPECT_NE(sim2real::RecordingKey(a, rec, {}), sim2real::RecordingKey(edited, rec, {}));
 }
 
+TEST(MujocoKnobSimulator, FingerprintFollowsAReplaysRecordingsNotTheirFolder) {
+  const fs::path src = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots" / "mammal_quadruped";
+  const fs::path root = fs::temp_directory_path() / ("dgmm_knob_sim_replay_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  fs::create_directories(root / "moved");
+  fs::copy(src, root / "a", fs::copy_options::recursive);
+  fs::copy(src, root / "moved" / "b", fs::copy_options::recursive);
+  const std::string a = MujocoKnobSimulator(sim::LoadSimConfig((root / "a" / "mammal_quadruped.json").string())).Fingerprint();
+  const std::string moved =
+      MujocoKnobSimulator(sim::LoadSimConfig((root / "moved" / "b" / "mammal_quadruped.json").string())).Fingerprint();
+  std::ofstream(root / "a" / "replay" / "p05_p00_p00.csv", std::ios::app) << "9.000,0,0,0,0,0,0,0,0,0,0,0,0\n";
+  const std::string edited = MujocoKnobSimulator(sim::LoadSimConfig((root / "a" / "mammal_quadruped.json").string())).Fingerprint();
+  fs::remove_all(root);
+  EXPECT_EQ(a, moved);
+  EXPECT_NE(a, edited);
+}
+
 TEST(MujocoKnobSimulator, RecordCellRepeatsACommandAtOnePlacementAndKnobsChangeIt) {
   const MujocoKnobSimulator sim{sim::SimConfig{}};
   sim2real::Cell cell;

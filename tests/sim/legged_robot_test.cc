@@ -173,5 +173,20 @@ TEST(LeggedRobot, BadRobotsAreRefusedNamingThePart) {
   expect(ErrorOf("", "", [](RobotDescription* r) { r->gait.pattern = "trot"; }), "needs 4 legs");
 }
 
+TEST(LeggedRobot, TheSprawledQuadrupedTrotsOnItsPassiveAnkles) {
+  Simulator sim(LoadSimConfig((kRobots / "sprawled_quadruped.json").string()));
+  const RobotDescription& r = *sim.config().robot;
+  ASSERT_EQ(sim.leg_count(), 4);
+  EXPECT_EQ(r.passive_joints.size(), 4u);
+  const double cycles = sim.config().command_duration_s / r.gait.period_s;
+  const double stride = r.gait.stride_reach * sim.leg_reach_m() * cycles;
+  ASSERT_EQ(sim.Place(0, 0, 0), RunOutcome::kCompleted);
+  const Pose start = sim.TorsoPose();
+  ASSERT_EQ(sim.RunCommand(Eigen::Vector3d(0.5, 0, 0)), RunOutcome::kCompleted);
+  const Eigen::Vector3d moved = start.rotation.transpose() * (sim.TorsoPose().position_m - start.position_m);
+  EXPECT_NEAR(moved.x() / (0.5 * stride), 1.0, 0.25);
+  EXPECT_LT(std::abs(moved.y()) / (0.5 * stride), 0.15);
+}
+
 }  // namespace
 }  // namespace dgmm::sim

@@ -31,7 +31,25 @@ TEST(RobotKnobs, PerLegKnobsAreNamedByLegNameAndSidesByTheSideRule) {
   ASSERT_GE(left, 0);
   EXPECT_EQ(knobs[left].members, (std::vector<std::string>{"front_left", "middle_left", "rear_left"}));
   EXPECT_LT(IndexOf(knobs, "actuators.leg0.gain"), 0) << "no built-in leg names";
-  EXPECT_LT(IndexOf(knobs, "actuators.latency_s"), 0) << "not on the generic path";
+}
+
+TEST(RobotKnobs, LatencyAndBacklashChangeTheWalkAndATorqueReplayHasNoBacklash) {
+  const SimConfig c = Hexapod();
+  const auto knobs = EnumerateKnobs(c);
+  const int latency = IndexOf(knobs, "actuators.latency_s");
+  const int backlash = IndexOf(knobs, "actuators.backlash_rad");
+  ASSERT_GE(latency, 0);
+  ASSERT_GE(backlash, 0);
+  EXPECT_NEAR(knobs[latency].probes.at(0), 0.07 * c.robot->gait.period_s, 1e-12) << "relative to the gait cycle";
+  ProtocolOptions options;
+  options.seed = 4;
+  options.placements = 1;
+  const SampleSet nominal = SimulateWithKnobs(c, options, knobs, {});
+  for (const auto& [knob, value] : {std::pair{latency, 0.06}, std::pair{backlash, 0.1}}) {
+    const SampleSet changed = SimulateWithKnobs(c, options, knobs, {{knob, value}});
+    ASSERT_EQ(changed.x.rows(), nominal.x.rows()) << knobs[knob].name;
+    EXPECT_GT((changed.x - nominal.x).norm(), 1e-3 * nominal.x.norm()) << knobs[knob].name;
+  }
 }
 
 TEST(RobotKnobs, PayloadAndOffsetsScaleWithTheModel) {
