@@ -1,4 +1,4 @@
-// `dgmm simulate`: records a sample set with the simulated eight-legged robot following the
+// `dgmm simulate`: records a sample set with the simulated robot (built-in or a robot block) following the
 // paper's protocol (lib/sim/protocol.h, docs/simulation.md) and writes it as HDF5.
 #include <cstdio>
 #include <filesystem>
@@ -85,7 +85,7 @@ void SetupSimulate(CLI::App& root) {
   auto args = std::make_shared<SimulateArgs>();
   CLI::App* cmd = root.add_subcommand(
       "simulate",
-      "Record a sample set with the simulated eight-legged robot on the slope (paper protocol)");
+      "Record a sample set with the simulated robot (the built-in octopod or a config's robot block) on the slope (paper protocol)");
   cmd->add_option("--config", args->config_path,
                   "Simulation config (JSON; missing fields keep their defaults, see "
                   "docs/simulation.md and --print-config)");
