@@ -12,6 +12,7 @@
 
 #include "app/command.h"
 #include "em/em.h"
+#include "em/em_model.h"
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "io/streaming.h"
@@ -48,50 +49,22 @@ void Run(const EmArgs& args) {
   { AtomicFile probe(args.output); }  // fail before the work when the output is unwritable
   const SampleSet set = ReadSampleSet(args.set);
   WarnIfUnderdetermined(set, !args.without_terrain, "em", false);
-  MotionModel model = ModelHeaderFor(set, !args.without_terrain);
-  model.kind = "em";
-  model.seed = args.em.seed;
-  const int dim = model.dim();
-  const bool terrain = model.terrain_dim > 0;
-
-  // Rows of each command, in set order.
-  std::map<int, std::vector<int>> rows;
-  for (int i = 0; i < set.size(); ++i) rows[set.command(i)].push_back(i);
-  if (rows.empty()) throw MakeInputError(args.set, "samples", "the set has no samples");
-
   const auto start = std::chrono::steady_clock::now();
+  EmModelResult fitted = FitEmMotionModel(set, args.em, !args.without_terrain, args.set,
+                                          [](long long done, long long total) { ReportProgress("em", done, total); });
+  MotionModel& model = fitted.model;
+  const int dim = model.dim();
   nlohmann::json commands = nlohmann::json::array();
   double total = 0;
-  long long samples = 0, done = 0;
-  for (const auto& [id, members] : rows) {
-    const std::string label =
-        id < static_cast<int>(set.command_labels.size()) ? set.command_labels[id] : "";
-    const int n = static_cast<int>(members.size());
-    const std::string where = "command " + std::to_string(id) + " '" + label + "'";
-    if (n < args.em.components) {
-      throw MakeInputError(args.set, where,
-                           std::to_string(n) + " samples are fewer than --components " +
-                               std::to_string(args.em.components));
-    }
-    Eigen::MatrixXd Y(n, dim);
-    for (int r = 0; r < n; ++r) {
-      Y.row(r).head(set.pose_dim()) = set.x.row(members[r]);
-      if (terrain) Y.row(r).tail(set.terrain_dim()) = set.z.row(members[r]);
-    }
-    const EmResult fit = FitEm(Y, args.em);
-    const EmSummary& s = fit.summary;
-    if (s.failed) {
-      throw MakeInputError(args.set, where,
-                           "EM failed: every restart lost a positive definite covariance "
-                           "(duplicate or collinear samples?); increase --reg-covar");
-    }
-    model.mixtures[id] = fit.mixture;
+  long long samples = 0;
+  for (const auto& [id, s] : fitted.summaries) {
+    const std::string label = id < static_cast<int>(set.command_labels.size()) ? set.command_labels[id] : "";
     total += s.log_likelihood;
-    samples += n;
+    samples += s.samples;
     commands.push_back({{"command", id},
                         {"label", label},
-                        {"samples", n},
-                        {"components", fit.mixture.size()},
+                        {"samples", s.samples},
+                        {"components", model.mixtures.at(id).size()},
                         {"total_log_likelihood", s.log_likelihood},
                         {"mean_log_likelihood", s.mean_log_likelihood},
                         {"iterations", s.iterations},
@@ -100,7 +73,6 @@ void Run(const EmArgs& args) {
                         {"failed_restarts", s.failed_restarts},
                         {"bic", s.bic},
                         {"report", s.BriefReport()}});
-    ReportProgress("em", done += n, set.size());
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -36,18 +36,6 @@ struct FitArgs {
   bool json = false;
 };
 
-// Default cap on components per mixture (docs/reliability.md, "Bounded work"): the square-root
-// rule ceil(sqrt(N)); at most N / (d + 1) (a component's covariance needs d + 1 samples); at most
-// kWorkBudget / (N d^2), since each sample costs about K d^2 once the cap is reached (choosing
-// the component); never below 50 so that small sets are not capped by default.
-long long DefaultMaxComponents(long long n, int dim) {
-  constexpr double kWorkBudget = 2e9;  // N K d^2 multiply-adds: a few seconds of one core
-  const double nd = static_cast<double>(n), d = dim;
-  const double cap = std::min({std::ceil(std::sqrt(nd)), std::floor(nd / (d + 1)),
-                               std::floor(kWorkBudget / (std::max(nd, 1.0) * d * d))});
-  return std::max<long long>(50, static_cast<long long>(cap));
-}
-
 // DGMM options from the flags, checked against the set's dimension.
 MotionModelOptions Options(const FitArgs& args) {
   if (!std::isfinite(args.k) || args.k <= 0) {

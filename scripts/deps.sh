@@ -6,7 +6,7 @@ packages=(
   libeigen3-dev libceres-dev libhdf5-dev libvtk9-dev libmujoco-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  xvfb xauth python3 python3-numpy python3-h5py python3-sklearn
+  xvfb xauth python3 python3-dev python3-numpy python3-h5py python3-sklearn python3-pytest pybind11-dev
   clang-14 libclang-rt-14-dev
 )
 missing=()

@@ -1,5 +1,6 @@
 #include "core/dgmm_options.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dgmm {
@@ -116,6 +117,14 @@ std::optional<DgmmOptions::InitialCovarianceRule> ParseInitialCovarianceRule(
   if (name == "data") return DgmmOptions::InitialCovarianceRule::kData;
   if (name == "user") return DgmmOptions::InitialCovarianceRule::kUser;
   return std::nullopt;
+}
+
+long long DefaultMaxComponents(long long n, int dim) {
+  constexpr double kWorkBudget = 2e9;  // N K d^2 multiply-adds: a few seconds of one core
+  const double nd = static_cast<double>(n), d = dim;
+  const double cap = std::min({std::ceil(std::sqrt(nd)), std::floor(nd / (d + 1)),
+                               std::floor(kWorkBudget / (std::max(nd, 1.0) * d * d))});
+  return std::max<long long>(50, static_cast<long long>(cap));
 }
 
 }  // namespace dgmm

@@ -51,6 +51,12 @@ struct DgmmOptions {
   Eigen::VectorXd ResolvedInitialDiagonal(int dim) const;
 };
 
+// Default cap on components per mixture for `samples` samples of `dim` dimensions
+// (docs/reliability.md, "Bounded work"): the square-root rule ceil(sqrt(N)); at most N / (d + 1)
+// (a component's covariance needs d + 1 samples); at most 2e9 / (N d^2), since each sample costs
+// about K d^2 once the cap is reached; never below 50 so that small sets are not capped.
+long long DefaultMaxComponents(long long samples, int dim);
+
 // Names as in model files and flags: "faithful"/"improved", "literal"/"blend"/"prior",
 // "identity"/"data"/"user".
 const char* VariantName(DgmmOptions::Variant v);

@@ -193,7 +193,7 @@ MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& opt
   return learner.Finish();
 }
 
-ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set) {
+Eigen::VectorXd ScoreSamples(const MotionModel& model, const SampleSet& set) {
   if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
   CheckSize("x", set.pose_dim(), model.pose_dim);
   const bool terrain = model.terrain_dim > 0;
@@ -240,7 +240,7 @@ ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set) {
     Mixture marginal;  // over x (no terrain in use) or over z (terrain)
   };
   std::map<int, Prepared> prepared;
-  ScoreSummary summary;
+  Eigen::VectorXd scores(set.size());
   Eigen::VectorXd y(dy);
   for (int i = 0; i < set.size(); ++i) {
     const int id = resolve(set.command[i]);
@@ -260,8 +260,15 @@ ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set) {
     const double ll = terrain ? it->second.joint->LogDensity(y) -
                                     it->second.marginal.LogDensity(y.tail(model.terrain_dim))
                               : it->second.marginal.LogDensity(y);
-    summary.total_log_likelihood += ll - log_jacobian;
+    scores[i] = ll - log_jacobian;
   }
+  return scores;
+}
+
+ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set) {
+  const Eigen::VectorXd scores = ScoreSamples(model, set);
+  ScoreSummary summary;
+  for (Eigen::Index i = 0; i < scores.size(); ++i) summary.total_log_likelihood += scores[i];
   summary.samples = set.size();
   summary.mean_log_likelihood = summary.total_log_likelihood / summary.samples;
   return summary;

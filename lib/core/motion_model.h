@@ -97,5 +97,7 @@ struct ScoreSummary {
   int samples = 0;
 };
 ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set);
+// log p(x_i | c_i [, z_i]) of every sample, in the raw units of x, with the checks above.
+Eigen::VectorXd ScoreSamples(const MotionModel& model, const SampleSet& set);
 
 }  // namespace dgmm
