@@ -52,7 +52,7 @@ std::vector<int> ParseCommands(const MotionModel& model, const std::string& text
 }
 
 // "pitch=0.1,roll=0" by the model's terrain names.
-Eigen::VectorXd ParseTerrain(const MotionModel& model, const std::string& text) {
+Eigen::VectorXd ParseOneTerrain(const MotionModel& model, const std::string& text) {
   if (text.empty()) return {};
   if (model.terrain_dim == 0) throw MakeInputError("--terrain", "", "the model was fitted without terrain");
   Eigen::VectorXd z = Eigen::VectorXd::Constant(model.terrain_dim, NAN);
@@ -66,9 +66,24 @@ Eigen::VectorXd ParseTerrain(const MotionModel& model, const std::string& text) 
     if (eq == std::string::npos || d < 0) {
       throw MakeInputError("--terrain", item, "expected name=value with a terrain name of the model");
     }
-    z[d] = std::atof(item.c_str() + eq + 1);
+    char* end = nullptr;
+    z[d] = std::strtod(item.c_str() + eq + 1, &end);
+    if (end == item.c_str() + eq + 1 || *end != '\0') throw MakeInputError("--terrain", item, "expected a number after '='");
   }
   if (!z.allFinite()) throw MakeInputError("--terrain", text, "expected a value for every terrain dimension");
+  return z;
+}
+
+// The terrain of every step: one entry for all, or one per step (after label*N expansion),
+// separated by ';'. Empty entries: the terrain marginalised.
+std::vector<Eigen::VectorXd> ParseTerrain(const MotionModel& model, const std::string& text, std::size_t steps) {
+  const std::vector<std::string> items = SplitOn(text, ';');
+  if (items.size() > 1 && items.size() != steps) {
+    throw MakeInputError("--terrain", "", std::to_string(items.size()) + " terrains for " + std::to_string(steps) +
+                                              " commands: expected one for all or one per command");
+  }
+  std::vector<Eigen::VectorXd> z(steps);
+  for (std::size_t k = 0; k < steps && !items.empty(); ++k) z[k] = ParseOneTerrain(model, items[items.size() == 1 ? 0 : k]);
   return z;
 }
 
@@ -92,9 +107,9 @@ nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, con
 void Run(const PredictArgs& args) {
   const MotionModel model = ReadModel(args.model);
   const std::vector<int> ids = ParseCommands(model, args.commands);
-  const Eigen::VectorXd z = ParseTerrain(model, args.terrain);
+  const std::vector<Eigen::VectorXd> z = ParseTerrain(model, args.terrain, ids.size());
   std::vector<predict::Step> steps;
-  for (int id : ids) steps.push_back({id, z});
+  for (std::size_t k = 0; k < ids.size(); ++k) steps.push_back({ids[k], z[k]});
   predict::PredictOptions options;
   options.trajectories = args.trajectories;
   options.seed = args.seed;
@@ -106,7 +121,7 @@ void Run(const PredictArgs& args) {
     file.Commit();
   }
   std::printf("%s trajectories, seed %llu%s\n", std::to_string(args.trajectories).c_str(),
-              static_cast<unsigned long long>(args.seed), z.size() ? "" : ", terrain marginalised");
+              static_cast<unsigned long long>(args.seed), args.terrain.empty() ? ", terrain marginalised" : "");
   std::printf("step  command            mean x (m)  mean y (m)  yaw (deg)   sd x (m)  sd y (m)  sd yaw (deg)\n");
   for (std::size_t k = 0; k < p.steps.size(); ++k) {
     const auto& s = p.steps[k];
@@ -130,7 +145,8 @@ void Setup(CLI::App& root) {
                   "command labels separated by ';', each optionally repeated as label*N, e.g. "
                   "\"+0.5,0,0*3;0,0,+0.5\"")
       ->required();
-  cmd->add_option("--terrain", args->terrain, "terrain to condition on, e.g. pitch=0.1,roll=0 (default: marginalised)");
+  cmd->add_option("--terrain", args->terrain, "terrain to condition on, e.g. pitch=0.1,roll=0 for every command, or one per command separated by ';' "
+                  "(default: marginalised)");
   cmd->add_option("--start", args->start, "start pose x,y,yaw (m, m, rad)")->delimiter(',')->expected(3);
   cmd->add_option("--trajectories", args->trajectories, "Monte Carlo trajectories")
       ->capture_default_str()

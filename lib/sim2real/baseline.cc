@@ -76,12 +76,15 @@ void TerrainRegions(const AnalysisInputs& in, const BaselineOptions& options, st
   b->sim_terrain = NearestCentre(in.sim.z, b->terrain_centres);
 }
 
+// Deficit per command x terrain region: the "cell" regions; with a single terrain region (a set
+// without terrain) Locate makes no cells, and the one column is each command's own deficit.
 Eigen::MatrixXd HeatMap(const std::vector<Region>& regions, const std::vector<int>& commands, int terrains) {
   Eigen::MatrixXd h = Eigen::MatrixXd::Constant(commands.size(), std::max(1, terrains), NAN);
+  const bool one_column = terrains <= 1;
   for (const auto& r : regions) {
-    if (r.family != "cell") continue;
+    if (r.family != (one_column ? "command" : "cell")) continue;
     auto it = std::find(commands.begin(), commands.end(), r.command);
-    if (it != commands.end()) h(it - commands.begin(), r.terrain) = r.deficit;
+    if (it != commands.end()) h(it - commands.begin(), one_column ? 0 : r.terrain) = r.deficit;
   }
   return h;
 }

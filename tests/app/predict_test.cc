@@ -37,6 +37,26 @@ TEST(PredictCommand, AnUnknownCommandIsOneLineAndWritesNothing) {
   EXPECT_EQ(CountLines(r.err), 1) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_NE(RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--terrain", "slope=3"}).exit_code, 0);
+  EXPECT_NE(RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--terrain", "pitch=0.1x,roll=0"}).exit_code, 0);
+  const RunResult miscount =
+      RunDgmm({"predict", model, "--commands", "+0.5,0,0*3", "--terrain", "pitch=0,roll=0;pitch=0.1,roll=0"});
+  EXPECT_NE(miscount.exit_code, 0);
+  EXPECT_NE(miscount.err.find("2 terrains for 3 commands"), std::string::npos) << miscount.err;
+}
+
+TEST(PredictCommand, TerrainPerStepConditionsEachStepOnItsOwn) {
+  const auto dir = MakeTempDir("predict_steps");
+  const std::string model = (dir / "m.h5").string(), a = (dir / "a.json").string(), b = (dir / "b.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", SourcePath("datasets/scorpion_sim_390.h5").string(), "-o", model}).exit_code, 0);
+  // Steps 1 and 2 on the same terrain as the constant run, step 2 of the other on steep ground.
+  ASSERT_EQ(RunDgmm({"--quiet", "predict", model, "--commands", "+0.5,0,0*2", "--terrain", "pitch=0,roll=0",
+                     "--trajectories", "500", "-o", a}).exit_code, 0);
+  ASSERT_EQ(RunDgmm({"--quiet", "predict", model, "--commands", "+0.5,0,0*2", "--terrain",
+                     "pitch=0,roll=0;pitch=0.3,roll=0", "--trajectories", "500", "-o", b}).exit_code, 0);
+  std::ifstream ia(a), ib(b);
+  const auto ja = nlohmann::json::parse(ia), jb = nlohmann::json::parse(ib);
+  EXPECT_EQ(ja["steps"][0]["mean"], jb["steps"][0]["mean"]);  // the same first step (same seed and terrain)
+  EXPECT_NE(ja["steps"][1]["mean"], jb["steps"][1]["mean"]);
 }
 
 }  // namespace

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "tests/sim2real/stage_fixture.h"
 
 namespace dgmm::sim2real {
@@ -28,6 +30,29 @@ TEST(Baseline, LocateModelOfTheSimModelIsTheBaselinesOwn) {
                                           s.options.locate.locate, rng);
   ASSERT_EQ(again.regions.size(), s.base.before.regions.size());
   EXPECT_EQ(again.heat, s.base.before.heat);  // deficits do not depend on the permutations
+}
+
+TEST(Baseline, WithoutTerrainTheHeatMapsColumnIsEachCommandsDeficit) {
+  test::FakePair pair = test::MakeFakePair(test::SharedFake(), {{test::kFriction, 0.5}});
+  for (SampleSet* set : {&pair.sim, &pair.real}) {
+    set->z.resize(set->size(), 0);
+    set->z_names.clear();
+    set->z_units.clear();
+  }
+  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, 1);
+  const Baseline base = LocateMismatch(in, test::FastOptions().locate);
+  const Eigen::MatrixXd& heat = base.before.heat;
+  ASSERT_EQ(heat.cols(), 1);
+  ASSERT_EQ(heat.rows(), static_cast<int>(in.real_commands.size()));
+  int filled = 0;
+  for (const auto& r : base.before.regions) {
+    if (r.family != "command") continue;
+    const auto row = std::find(in.real_commands.begin(), in.real_commands.end(), r.command) - in.real_commands.begin();
+    EXPECT_EQ(heat(row, 0), r.deficit) << r.label;
+    ++filled;
+  }
+  EXPECT_EQ(filled, heat.rows());
+  EXPECT_GT(heat.cwiseAbs().maxCoeff(), 0) << "not an empty column";
 }
 
 }  // namespace
