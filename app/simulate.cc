@@ -90,8 +90,9 @@ void SetupSimulate(CLI::App& root) {
                   "Simulation config (JSON; missing fields keep their defaults, see "
                   "docs/simulation.md and --print-config)");
   cmd->add_option("--protocol", args->protocol,
-                  "paper (26 commands x 3 headings x 5 = 390 samples) or paper-830 (166 random "
-                  "placements x 5 = 830)")
+                  "paper (26 commands x 3 headings x 5 = 390 samples), paper-830 (166 random "
+                  "placements x 5 = 830) or trajectories (100 random placements, each a sequence of "
+                  "--executions random commands: for checking predictions)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Random seed: same seed, same file")->capture_default_str();
   cmd->add_option("-o,--output", args->output, "Sample set to write (.h5)");

@@ -127,6 +127,10 @@ void BindSampleSet(py::module_& m) {
                              py::return_value_policy::reference_internal)
       .def_property_readonly("command", [](const SampleSet& s) -> const Eigen::VectorXi& { return s.command; },
                              py::return_value_policy::reference_internal)
+      .def_property_readonly("episode", [](const SampleSet& s) -> const Eigen::VectorXi& { return s.episode; },
+                             py::return_value_policy::reference_internal)
+      .def_property_readonly("step", [](const SampleSet& s) -> const Eigen::VectorXi& { return s.step; },
+                             py::return_value_policy::reference_internal)
       .def_readonly("command_labels", &SampleSet::command_labels)
       .def_readonly("x_names", &SampleSet::x_names)
       .def_readonly("z_names", &SampleSet::z_names)
@@ -197,7 +201,7 @@ void BindFitAndPredict(py::module_& m) {
         "The EM reference: one full-covariance mixture per command (as `dgmm em`).");
   m.def("predict",
         [](const MotionModel& model, const std::vector<int>& commands, const std::optional<Eigen::MatrixXd>& terrain,
-           const Eigen::Vector3d& start, int trajectories, std::uint64_t seed) {
+           const Eigen::Vector3d& start, int trajectories, std::uint64_t seed, const std::vector<std::string>& pose_dims) {
           std::vector<predict::Step> steps;
           for (std::size_t k = 0; k < commands.size(); ++k) {
             predict::Step s{commands[k], {}};
@@ -211,6 +215,7 @@ void BindFitAndPredict(py::module_& m) {
           predict::PredictOptions o;
           o.trajectories = trajectories;
           o.seed = seed;
+          o.pose_dims = pose_dims;
           const predict::Prediction p = predict::Predict(model, start, steps, o);
           const int n = static_cast<int>(p.steps.size());
           py::array_t<double> poses({n, trajectories, 4}), mean({n, 4}), cov({n, 4, 4});
@@ -234,8 +239,10 @@ void BindFitAndPredict(py::module_& m) {
         },
         py::arg("model"), py::arg("commands"), py::arg("terrain") = std::nullopt,
         py::arg("start") = Eigen::Vector3d::Zero(), py::arg("trajectories") = 1000, py::arg("seed") = 1,
+        py::arg("pose_dims") = std::vector<std::string>{},
         "Where a command sequence takes the robot (as `dgmm predict`): poses (steps x trajectories x "
-        "[x, y, z, yaw]), their mean and covariance per step.");
+        "[x, y, z, yaw]), their mean and covariance per step. pose_dims: the model's names for dx, dy, dyaw "
+        "(planar composition) or dx, dy, dyaw, dz, droll, dpitch; default: SE(3) when the model has them all.");
 }
 
 }  // namespace

@@ -21,6 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 // One placement: where the robot stands, which command it repeats.
 struct Placement {
   int command = 0;
+  std::vector<int> sequence;  // kTrajectories: the command of each execution (else `command` repeats)
   double heading_rad = 0;  // slope frame, 0 = facing uphill
   double x_m = 0, y_m = 0;
 };
@@ -71,6 +72,19 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
       p.y_m = position(rng);
       plan.push_back(p);
     }
+  } else if (options.protocol == Protocol::kTrajectories) {
+    const int total = options.placements > 0 ? options.placements : 100;
+    std::uniform_real_distribution<double> heading(-kPi, kPi);
+    std::uniform_int_distribution<int> any(0, num_commands - 1);
+    for (int i = 0; i < total; ++i) {
+      Placement p;
+      for (int r = 0; r < options.executions_per_placement; ++r) p.sequence.push_back(any(rng));
+      p.command = p.sequence[0];
+      p.heading_rad = heading(rng);
+      p.x_m = position(rng);
+      p.y_m = position(rng);
+      plan.push_back(p);
+    }
   } else {
     const int total = options.placements > 0 ? options.placements : 166;
     std::uniform_real_distribution<double> heading(-kPi, kPi);
@@ -105,13 +119,14 @@ Pose TrackerReading(const Pose& truth, const NoiseConfig& noise, std::mt19937_64
 }  // namespace
 
 std::string ProtocolName(Protocol protocol) {
-  return protocol == Protocol::kPaper ? "paper" : "paper-830";
+  return protocol == Protocol::kPaper ? "paper" : protocol == Protocol::kPaper830 ? "paper-830" : "trajectories";
 }
 
 Protocol ParseProtocol(const std::string& name) {
   if (name == "paper") return Protocol::kPaper;
   if (name == "paper-830") return Protocol::kPaper830;
-  throw MakeInputError("", "--protocol", "expected paper or paper-830, got \"" + name + "\"");
+  if (name == "trajectories") return Protocol::kTrajectories;
+  throw MakeInputError("", "--protocol", "expected paper, paper-830 or trajectories, got \"" + name + "\"");
 }
 
 bool ProtocolOptions::IsValid(std::string* error) const {
@@ -154,8 +169,13 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   const auto wall_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   Simulator sim(config, edit);
-  Eigen::MatrixXd used(static_cast<int>(plan.size()), 3);
-  for (int p = 0; p < used.rows(); ++p) used.row(p) = out->commands.row(plan[p].command);
+  std::vector<int> ids;
+  for (const Placement& p : plan) {
+    if (p.sequence.empty()) ids.push_back(p.command);
+    ids.insert(ids.end(), p.sequence.begin(), p.sequence.end());
+  }
+  Eigen::MatrixXd used(static_cast<int>(ids.size()), 3);
+  for (int k = 0; k < used.rows(); ++k) used.row(k) = out->commands.row(ids[k]);
   CheckRecordingsCover(config, used);
   SampleSet& set = *out;
   const int reps = options.executions_per_placement;
@@ -177,8 +197,9 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       bool fell = sim.Place(where.x_m, where.y_m, where.heading_rad) != RunOutcome::kCompleted;
       std::vector<Eigen::Matrix<double, 6, 1>> px;
       std::vector<Eigen::Vector2d> pz;
-      const Eigen::Vector3d c = set.commands.row(where.command).transpose();
       for (int r = 0; r < reps && !fell; ++r) {
+        const int id = where.sequence.empty() ? where.command : where.sequence[r];
+        const Eigen::Vector3d c = set.commands.row(id).transpose();
         const Eigen::Vector2d z_true = sim.TruePitchRoll();
         pz.emplace_back(z_true[0] + config.noise.imu_pitch_sd_rad * unit(rng),
                         z_true[1] + config.noise.imu_roll_sd_rad * unit(rng));
@@ -193,7 +214,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       }
       kept = true;
       for (int r = 0; r < reps; ++r) {
-        command.push_back(where.command);
+        command.push_back(where.sequence.empty() ? where.command : where.sequence[r]);
         episode.push_back(p);
         step.push_back(r);
         xs.push_back(px[r]);

@@ -19,9 +19,13 @@ enum class Protocol {
   // 166 placements at uniformly random heading and position on the slope, commands cycling
   // through seeded shuffles of the 26, 5 executions: 830 samples.
   kPaper830,
+  // Multi-command trajectories, for checking predictions (docs/prediction.md): 100 placements at
+  // uniformly random heading and position, each running a sequence of executions_per_placement
+  // commands drawn uniformly (with replacement) from the 26; episode = placement, step = its index.
+  kTrajectories,
 };
 
-// "paper" / "paper-830"; ParseProtocol throws InputError for anything else.
+// "paper" / "paper-830" / "trajectories"; ParseProtocol throws InputError for anything else.
 std::string ProtocolName(Protocol protocol);
 Protocol ParseProtocol(const std::string& name);
 

@@ -62,7 +62,7 @@ void CheckRecordingsCover(const SimConfig& config, const Eigen::MatrixXd& comman
   }
   if (missing == 0) return;
   char what[200];
-  std::snprintf(what, sizeof what, "no recording of command [%g, %g, %g] (%d of the %d placements run a command without one)",
+  std::snprintf(what, sizeof what, "no recording of command [%g, %g, %g] (%d of the %d planned commands have none)",
                 commands(first, 0), commands(first, 1), commands(first, 2), missing, static_cast<int>(commands.rows()));
   throw MakeInputError(config.mjcf_path, "robot.controller.recordings", what);
 }

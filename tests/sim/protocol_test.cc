@@ -102,6 +102,26 @@ TEST(ProtocolTest, FallsAreCountedNotRecorded) {
   EXPECT_EQ(set.metadata.at("falls"), std::to_string(summary.falls));
 }
 
+TEST(ProtocolTest, TrajectoriesRunASequenceOfCommandsPerPlacement) {
+  ProtocolOptions o;
+  o.protocol = ParseProtocol("trajectories");
+  EXPECT_EQ(ProtocolName(o.protocol), "trajectories");
+  o.seed = 4;
+  o.placements = 3;
+  o.executions_per_placement = 6;
+  const SampleSet set = SimulateProtocol(SimConfig{}, o);
+  ASSERT_EQ(set.Validate(), "");
+  ASSERT_EQ(set.size(), 18);
+  std::set<int> commands_of_first;
+  for (int i = 0; i < set.size(); ++i) {
+    EXPECT_EQ(set.step[i], i % 6);
+    EXPECT_EQ(set.episode[i], i / 6);
+    if (set.episode[i] == 0) commands_of_first.insert(set.command[i]);
+  }
+  EXPECT_GT(commands_of_first.size(), 1u) << "a sequence of commands, not one repeated";
+  EXPECT_EQ(set.metadata.at("protocol"), "trajectories");
+}
+
 TEST(ProtocolTest, ParsesNamesAndRejectsBadOptions) {
   EXPECT_EQ(ParseProtocol("paper"), Protocol::kPaper);
   EXPECT_EQ(ParseProtocol("paper-830"), Protocol::kPaper830);
