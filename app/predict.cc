@@ -10,6 +10,8 @@
 #include "app/command.h"
 #include "io/model_io.h"
 #include "predict/predict.h"
+#include "render/display.h"
+#include "render/trajectory_fan.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
@@ -17,7 +19,7 @@ namespace dgmm::app {
 namespace {
 
 struct PredictArgs {
-  std::string model, commands, terrain, output, pose_dims;
+  std::string model, commands, terrain, output, pose_dims, figure;
   std::vector<double> start{0, 0, 0};
   int trajectories = 1000;
   std::uint64_t seed = 1;
@@ -104,7 +106,20 @@ nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, con
           {"terrain", args.terrain}, {"steps", steps}};
 }
 
+// The trajectory fan (render/trajectory_fan.h) of the prediction, written to args.figure.
+void WriteFigure(const predict::Prediction& p, const PredictArgs& args) {
+  std::vector<Eigen::MatrixX2d> steps;
+  for (const auto& s : p.steps) steps.push_back(s.poses.leftCols(2));
+  const std::string title = "Where " + std::to_string(p.steps.size()) + " commands take the robot (" +
+                            std::to_string(args.trajectories) + " trajectories): 50% (white) and 90% (orange) regions";
+  RenderHeatMap(TrajectoryFan(steps, Eigen::Vector2d(args.start[0], args.start[1]), title), args.figure);
+}
+
 void Run(const PredictArgs& args) {
+  if (!args.figure.empty()) RequireDisplay();  // before any work or output
+  for (const std::string& out : {args.output, args.figure}) {
+    if (!out.empty()) AtomicFile probe(out);  // fail before the work when an output is unwritable
+  }
   const MotionModel model = ReadModel(args.model);
   const std::vector<int> ids = ParseCommands(model, args.commands);
   const std::vector<Eigen::VectorXd> z = ParseTerrain(model, args.terrain, ids.size());
@@ -115,6 +130,7 @@ void Run(const PredictArgs& args) {
   options.seed = args.seed;
   options.pose_dims = SplitOn(args.pose_dims, ',');
   const auto p = predict::Predict(model, Eigen::Vector3d(args.start[0], args.start[1], args.start[2]), steps, options);
+  if (!args.figure.empty()) WriteFigure(p, args);
   if (!args.output.empty()) {
     AtomicFile file(args.output);
     std::ofstream(file.temp_path()) << ToJson(model, ids, p, args).dump(2) << "\n";
@@ -130,6 +146,7 @@ void Run(const PredictArgs& args) {
                 std::sqrt(s.covariance(1, 1)), std::sqrt(s.covariance(3, 3)) * 180 / M_PI);
   }
   if (!args.output.empty()) std::printf("wrote %s\n", args.output.c_str());
+  if (!args.figure.empty()) std::printf("wrote %s\n", args.figure.c_str());
 }
 
 void Setup(CLI::App& root) {
@@ -147,6 +164,9 @@ void Setup(CLI::App& root) {
       ->required();
   cmd->add_option("--terrain", args->terrain, "terrain to condition on, e.g. pitch=0.1,roll=0 for every command, or one per command separated by ';' "
                   "(default: marginalised)");
+  cmd->add_option("--figure", args->figure,
+                  "trajectory fan (PNG): where the trajectories are after each command, each step's 50% and 90% "
+                  "regions and the mean path (needs an X display, e.g. xvfb-run -a)");
   cmd->add_option("--start", args->start, "start pose x,y,yaw (m, m, rad)")->delimiter(',')->expected(3);
   cmd->add_option("--trajectories", args->trajectories, "Monte Carlo trajectories")
       ->capture_default_str()

@@ -66,7 +66,10 @@ def main():
     lo, hi = (int(v) for v in a.seeds.split("-"))
     out = a.out or tempfile.mkdtemp()
     base = json.load(open(a.config))
-    base["mjcf_path"] = os.path.abspath(os.path.join(os.path.dirname(a.config), base["mjcf_path"]))
+    here = os.path.dirname(a.config)
+    base["mjcf_path"] = os.path.abspath(os.path.join(here, base["mjcf_path"]))
+    for rec in base["robot"].get("controller", {}).get("recordings", []):  # a replayed controller's files
+        rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
     print(f"Robot {a.config}, seeds {lo}-{hi}, sim2real with --threads {a.threads}\n")
     print("| seed | planted | truth | named | value | within 25% | status | wall s |")
     print("|---|---|---|---|---|---|---|---|")

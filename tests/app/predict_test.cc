@@ -59,5 +59,23 @@ TEST(PredictCommand, TerrainPerStepConditionsEachStepOnItsOwn) {
   EXPECT_NE(ja["steps"][1]["mean"], jb["steps"][1]["mean"]);
 }
 
+TEST(PredictCommand, TheFigureIsATrajectoryFanOrACleanErrorWithoutADisplay) {
+  const auto dir = MakeTempDir("predict_fig");
+  const std::string model = (dir / "m.h5").string(), png = (dir / "fan.png").string(), out = (dir / "p.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", SourcePath("datasets/scorpion_sim_390.h5").string(), "-o", model}).exit_code, 0);
+  const std::vector<std::string> args = {"predict", model, "--commands", "+0.5,0,0*2;0,0,+0.5", "--trajectories", "200",
+                                         "--figure", png, "-o", out};
+  const RunResult none = RunDgmm(args, {"DISPLAY=:4711"});
+  EXPECT_EQ(none.exit_code, 1) << none.err;
+  EXPECT_NE(none.err.find("cannot open an X display"), std::string::npos) << none.err;
+  EXPECT_EQ(CountLines(none.err), 1) << none.err;
+  EXPECT_FALSE(std::filesystem::exists(png));
+  EXPECT_FALSE(std::filesystem::exists(out)) << "no partial output";
+  const RunResult r = RunUnderXvfb(args, dir);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_GT(std::filesystem::file_size(png), 5000u);
+  EXPECT_TRUE(std::filesystem::exists(out));
+}
+
 }  // namespace
 }  // namespace dgmm::test
