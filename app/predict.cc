@@ -11,6 +11,7 @@
 #include "io/model_io.h"
 #include "predict/predict.h"
 #include "render/display.h"
+#include "sim/sim_config.h"
 #include "render/trajectory_fan.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
@@ -19,7 +20,7 @@ namespace dgmm::app {
 namespace {
 
 struct PredictArgs {
-  std::string model, commands, terrain, output, pose_dims, figure;
+  std::string model, commands, terrain, output, pose_dims, figure, ground;
   std::vector<double> start{0, 0, 0};
   int trajectories = 1000;
   std::uint64_t seed = 1;
@@ -129,6 +130,11 @@ void Run(const PredictArgs& args) {
   options.trajectories = args.trajectories;
   options.seed = args.seed;
   options.pose_dims = SplitOn(args.pose_dims, ',');
+  if (!args.ground.empty()) {
+    if (!args.terrain.empty()) throw MakeInputError("--ground", "", "give either --terrain or --ground, not both");
+    const sim::SimConfig ground = sim::LoadSimConfig(args.ground);
+    options.ground = predict::PlaneTerrain(model, ground.slope_deg * M_PI / 180);
+  }
   const auto p = predict::Predict(model, Eigen::Vector3d(args.start[0], args.start[1], args.start[2]), steps, options);
   if (!args.figure.empty()) WriteFigure(p, args);
   if (!args.output.empty()) {
@@ -137,7 +143,9 @@ void Run(const PredictArgs& args) {
     file.Commit();
   }
   std::printf("%s trajectories, seed %llu%s\n", std::to_string(args.trajectories).c_str(),
-              static_cast<unsigned long long>(args.seed), args.terrain.empty() ? ", terrain marginalised" : "");
+              static_cast<unsigned long long>(args.seed),
+              !args.ground.empty() ? ", terrain from the ground under each trajectory"
+              : args.terrain.empty() ? ", terrain marginalised" : "");
   std::printf("step  command            mean x (m)  mean y (m)  yaw (deg)   sd x (m)  sd y (m)  sd yaw (deg)\n");
   for (std::size_t k = 0; k < p.steps.size(); ++k) {
     const auto& s = p.steps[k];
@@ -164,6 +172,9 @@ void Setup(CLI::App& root) {
       ->required();
   cmd->add_option("--terrain", args->terrain, "terrain to condition on, e.g. pitch=0.1,roll=0 for every command, or one per command separated by ';' "
                   "(default: marginalised)");
+  cmd->add_option("--ground", args->ground,
+                  "simulation config whose ground the robot walks on (its slope_deg): each trajectory is conditioned "
+                  "on the pitch and roll where it stands; --start's yaw is then the heading on the slope (0 = uphill)");
   cmd->add_option("--figure", args->figure,
                   "trajectory fan (PNG): where the trajectories are after each command, each step's 50% and 90% "
                   "regions and the mean path (needs an X display, e.g. xvfb-run -a)");

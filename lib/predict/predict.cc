@@ -1,6 +1,7 @@
 #include "predict/predict.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -71,10 +72,51 @@ bool PredictOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// p(x | c, z) (z in raw units; empty: marginalised) as a mixture over the model's pose dimensions,
+// in the model's own units.
+Mixture PoseMixture(const MotionModel& model, int command, const Eigen::VectorXd& z) {
+  if (z.size() == 0) {
+    return model.terrain_dim > 0 ? model.MixtureFor(command).Marginal(Range(0, model.pose_dim)) : model.MixtureFor(command);
+  }
+  if (model.transform.empty()) return model.Conditional(command, z);
+  const auto& t = model.transform;
+  return model.Conditional(command, (z - t.offset.segment(model.pose_dim, model.terrain_dim))
+                                        .cwiseQuotient(t.scale.segment(model.pose_dim, model.terrain_dim)));
+}
+
+// n pose changes (pose_dim x n) of step `k`, in raw units: from the step's terrain (or none), or
+// with options.ground from the terrain under each trajectory's pose before the step.
+Eigen::MatrixXd DrawStep(const MotionModel& model, const Step& step, const PredictOptions& options,
+                         const Eigen::MatrixXd& poses, std::mt19937_64& rng) {
+  const int n = static_cast<int>(poses.rows());
+  Eigen::MatrixXd dx;
+  if (step.terrain.size() > 0 || !options.ground) {
+    dx = PoseMixture(model, step.command, step.terrain).Sample(n, rng);
+  } else {
+    dx.resize(model.pose_dim, n);
+    for (int i = 0; i < n; ++i) {
+      const Eigen::Vector4d pose = poses.row(i).transpose();
+      dx.col(i) = PoseMixture(model, step.command, options.ground(pose)).Sample(1, rng);
+    }
+  }
+  if (!model.transform.empty()) {  // back to raw units: x = x_std * scale + offset
+    const auto& t = model.transform;
+    dx = (dx.array().colwise() * t.scale.head(model.pose_dim).array()).colwise() + t.offset.head(model.pose_dim).array();
+  }
+  return dx;
+}
+
+}  // namespace
+
 Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const std::vector<Step>& steps,
                    const PredictOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("predict", "", error);
+  if (options.ground && model.terrain_dim == 0) {
+    throw MakeInputError("predict", "ground", "the model was fitted without terrain: it cannot be conditioned on the ground");
+  }
   Prediction out;
   const std::vector<int> idx = PoseIndices(model, options, &out.spatial);
   const int n = options.trajectories;
@@ -83,6 +125,9 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
   position.col(0).setConstant(start.x());
   position.col(1).setConstant(start.y());
   position.col(2).setZero();
+  Eigen::MatrixXd before(n, 4);  // every trajectory's pose before the step: x, y, z, yaw
+  before.leftCols(3) = position;
+  before.col(3).setConstant(start.z());
   std::mt19937_64 rng(options.seed);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const Step& step = steps[k];
@@ -93,10 +138,7 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
       throw MakeInputError("predict", "terrain", "step " + std::to_string(k + 1) + ": expected " +
                                                      std::to_string(model.terrain_dim) + " terrain values");
     }
-    const Mixture mixture = step.terrain.size() > 0 ? model.Conditional(step.command, step.terrain)
-                            : model.terrain_dim > 0 ? model.MixtureFor(step.command).Marginal(Range(0, model.pose_dim))
-                                                    : model.MixtureFor(step.command);
-    const Eigen::MatrixXd dx = mixture.Sample(n, rng);  // pose_dim x n
+    const Eigen::MatrixXd dx = DrawStep(model, step, options, before, rng);  // pose_dim x n
     StepPrediction s;
     s.poses.resize(n, 4);
     for (int i = 0; i < n; ++i) {
@@ -106,10 +148,30 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
       rotation[i] = rotation[i] * r;
       s.poses.row(i) << position(i, 0), position(i, 1), position(i, 2), std::atan2(rotation[i](1, 0), rotation[i](0, 0));
     }
+    before = s.poses;
     Summarise(&s);
     out.steps.push_back(std::move(s));
   }
   return out;
+}
+
+std::function<Eigen::VectorXd(const Eigen::Vector4d&)> PlaneTerrain(const MotionModel& model, double slope_rad) {
+  int pitch = -1, roll = -1;
+  for (int i = 0; i < model.terrain_dim; ++i) {
+    if (model.terrain_names[i] == "pitch") pitch = i;
+    if (model.terrain_names[i] == "roll") roll = i;
+  }
+  if (model.terrain_dim != 2 || pitch < 0 || roll < 0) {
+    throw MakeInputError("model", "terrain", "a ground of its own needs a model whose terrain is (pitch, roll)");
+  }
+  return [=](const Eigen::Vector4d& pose) {
+    const double p = std::asin(-std::sin(slope_rad) * std::cos(pose[3]));
+    const double r = std::asin(std::clamp(-std::sin(slope_rad) * std::sin(pose[3]) / std::cos(p), -1.0, 1.0));
+    Eigen::VectorXd z(2);
+    z[pitch] = p;
+    z[roll] = r;
+    return z;
+  };
 }
 
 }  // namespace dgmm::predict

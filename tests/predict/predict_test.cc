@@ -63,6 +63,51 @@ TEST(Predict, ConditionsOnTheTerrainOfEachStep) {
   EXPECT_GT(marginal.steps[0].covariance(0, 0), 0.1);  // the terrain's spread, marginalised
 }
 
+TEST(Predict, TheGroundConditionsEachTrajectoryWhereItStands) {
+  // dx = 0.1 + 0.5 pitch: walking "uphill" (pitch < 0) is slower. On a plane tilted by 0.2 rad a
+  // robot facing uphill (yaw 0) has pitch -0.2, facing downhill +0.2; after the quarter turn it
+  // faces across the slope (pitch 0).
+  MotionModel m = Planar(true);
+  m.terrain_dim = 2;
+  m.terrain_names = {"roll", "pitch"};  // by name, not by position
+  for (auto& [c, mix] : m.mixtures) {
+    Mixture grown(5);
+    Eigen::MatrixXd cov = Eigen::MatrixXd::Identity(5, 5);
+    cov.topLeftCorner(4, 4) = mix.component(0).covariance();
+    Eigen::VectorXd mean = Eigen::VectorXd::Zero(5);
+    mean.head(4) = mix.component(0).mean();
+    // Terrain order (roll, pitch): the pitch column moves from 3 to 4.
+    std::swap(cov(0, 3), cov(0, 4));
+    std::swap(cov(3, 0), cov(4, 0));
+    grown.Add(1.0, Gaussian(mean, cov));
+    mix = grown;
+  }
+  PredictOptions o;
+  o.trajectories = 100;
+  o.ground = PlaneTerrain(m, 0.2);
+  const double pitch = std::asin(std::sin(0.2));
+  const Prediction up = Predict(m, Eigen::Vector3d::Zero(), {{0, {}}, {1, {}}, {0, {}}}, o);
+  EXPECT_NEAR(up.steps[0].mean[0], 0.1 - 0.5 * pitch, 1e-3);
+  EXPECT_NEAR(up.steps[2].mean[1], 0.1, 1e-3);  // across the slope: pitch 0
+  const Prediction down = Predict(m, Eigen::Vector3d(0, 0, M_PI), {{0, {}}}, o);
+  EXPECT_NEAR(down.steps[0].mean[0], -(0.1 + 0.5 * pitch), 1e-3);
+  const Eigen::VectorXd z = o.ground(Eigen::Vector4d(0, 0, 0, M_PI / 2));
+  EXPECT_NEAR(z[1], 0, 1e-12);      // pitch facing across
+  EXPECT_NEAR(z[0], -0.2, 1e-12);   // left side (downhill) down
+  EXPECT_THROW(PlaneTerrain(Planar(true), 0.2), InputError);  // terrain is not (pitch, roll)
+}
+
+TEST(Predict, AStandardisedModelIsReportedInRawUnits) {
+  MotionModel m = Planar(true);
+  m.transform.offset = Eigen::Vector4d(1.0, 0, 0, 0.5);
+  m.transform.scale = Eigen::Vector4d(2.0, 1, 1, 4.0);
+  PredictOptions o;
+  o.trajectories = 100;
+  // Raw pitch 0.5 is standardised 0: dx_std = 0.1, raw dx = 0.1 * 2 + 1.
+  const Prediction p = Predict(m, Eigen::Vector3d::Zero(), {{0, Eigen::VectorXd::Constant(1, 0.5)}}, o);
+  EXPECT_NEAR(p.steps[0].mean[0], 1.2, 1e-3);
+}
+
 TEST(Predict, SeededAndRepeatable) {
   const MotionModel m = Planar(true);
   PredictOptions o;
