@@ -201,7 +201,8 @@ void BindFitAndPredict(py::module_& m) {
         "The EM reference: one full-covariance mixture per command (as `dgmm em`).");
   m.def("predict",
         [](const MotionModel& model, const std::vector<int>& commands, const std::optional<Eigen::MatrixXd>& terrain,
-           const Eigen::Vector3d& start, int trajectories, std::uint64_t seed, const std::vector<std::string>& pose_dims) {
+           const Eigen::Vector3d& start, int trajectories, std::uint64_t seed, const std::vector<std::string>& pose_dims,
+           std::optional<double> ground_slope_deg) {
           std::vector<predict::Step> steps;
           for (std::size_t k = 0; k < commands.size(); ++k) {
             predict::Step s{commands[k], {}};
@@ -216,6 +217,7 @@ void BindFitAndPredict(py::module_& m) {
           o.trajectories = trajectories;
           o.seed = seed;
           o.pose_dims = pose_dims;
+          if (ground_slope_deg) o.ground = predict::PlaneTerrain(model, *ground_slope_deg * M_PI / 180);
           const predict::Prediction p = predict::Predict(model, start, steps, o);
           const int n = static_cast<int>(p.steps.size());
           py::array_t<double> poses({n, trajectories, 4}), mean({n, 4}), cov({n, 4, 4});
@@ -239,10 +241,11 @@ void BindFitAndPredict(py::module_& m) {
         },
         py::arg("model"), py::arg("commands"), py::arg("terrain") = std::nullopt,
         py::arg("start") = Eigen::Vector3d::Zero(), py::arg("trajectories") = 1000, py::arg("seed") = 1,
-        py::arg("pose_dims") = std::vector<std::string>{},
+        py::arg("pose_dims") = std::vector<std::string>{}, py::arg("ground_slope_deg") = std::nullopt,
         "Where a command sequence takes the robot (as `dgmm predict`): poses (steps x trajectories x "
         "[x, y, z, yaw]), their mean and covariance per step. pose_dims: the model's names for dx, dy, dyaw "
-        "(planar composition) or dx, dy, dyaw, dz, droll, dpitch; default: SE(3) when the model has them all.");
+        "(planar composition) or dx, dy, dyaw, dz, droll, dpitch; default: SE(3) when the model has them all. "
+        "ground_slope_deg: condition each trajectory on a plane's pitch and roll at its heading (as --ground).");
 }
 
 }  // namespace

@@ -79,6 +79,10 @@ def test_predict_follows_the_commands():
     assert out["mean"][2, 0] > out["mean"][0, 0] > 0  # further forward after every command
     again = dgmm.predict(est.model_, [forward] * 3, terrain=np.array([[0.0, 0.0]]), trajectories=400, seed=2)
     assert np.array_equal(out["poses"], again["poses"])
+    # On the 18 degree slope facing uphill the robot is slower than facing downhill.
+    up = dgmm.predict(est.model_, [forward] * 2, ground_slope_deg=18, trajectories=400)
+    down = dgmm.predict(est.model_, [forward] * 2, ground_slope_deg=18, start=[0, 0, np.pi], trajectories=400)
+    assert up["mean"][1, 0] < -down["mean"][1, 0]
 
 
 def test_estimator_conventions():
