@@ -245,7 +245,7 @@ SimConfig LoadSimConfig(const std::string& path) {
   SimConfig c = SimConfigFromJson(text.str(), path);
   const auto beside_config = [&](std::string* file) {
     if (!file->empty() && std::filesystem::path(*file).is_relative()) {
-      *file = (std::filesystem::path(path).parent_path() / *file).lexically_normal();
+      *file = std::filesystem::absolute(std::filesystem::path(path).parent_path() / *file).lexically_normal();
     }
   };
   beside_config(&c.mjcf_path);

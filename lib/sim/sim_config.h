@@ -103,7 +103,8 @@ struct SimConfig {
 // Parses a JSON object; unknown keys are errors (typos must not silently fall back to defaults).
 // Throws InputError "<source_name>: <field>: <problem>" for bad JSON, types or values.
 SimConfig SimConfigFromJson(const std::string& json_text, const std::string& source_name);
-// Reads a JSON config file; relative mjcf_path is resolved against the config file's folder.
+// Reads a JSON config file; a relative mjcf_path or replay recording is made absolute against the
+// config file's folder (so a set's recorded config finds them from any working directory).
 SimConfig LoadSimConfig(const std::string& path);
 // Pretty-printed JSON with every field (round-trips through SimConfigFromJson).
 std::string SimConfigToJson(const SimConfig& config);
