@@ -123,12 +123,21 @@ RunOutcome GenericWalker::Stand(double seconds) {
 // Foot targets of the generic gait at time t of a command, through inverse kinematics to joint
 // targets: each foot travels d_i = duty (stride (long, lat) + turn_rad turn z x p_i) per stance,
 // so the torso moves stride per cycle and turns turn_rad per cycle; a ramp of a tenth of a cycle at
-// either end of the command starts and ends the pattern at the stance.
+// either end of the command starts and ends the pattern at the stance; the stance leans with
+// gravity (robot.gait.lean).
 void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration) {
   const double period = config_.robot->gait.period_s;
   const double ramp = 0.1 * period;
   const double envelope = std::clamp(std::min(t, duration - t) / ramp, 0.0, 1.0);
   const double duty = robot_.timing.duty;
+  // Lean: every foot shifted by lean x (where the gravity line through the torso meets the foot
+  // plane), so that the support polygon stays under the centre of mass on a slope. From the
+  // ground's tilt at the robot's heading, not the torso's own wobble (no feedback loop).
+  Eigen::Vector3d lean = Eigen::Vector3d::Zero();
+  const Eigen::Matrix3d r = RobotPose().rotation;
+  const Eigen::Vector3d g = Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() *
+                            Eigen::Vector3d(model_->opt.gravity[0], model_->opt.gravity[1], model_->opt.gravity[2]).normalized();
+  if (g.z() < -0.5) lean.head<2>() = config_.robot->gait.lean * robot_.stance_height_m * g.head<2>() / -g.z();
   std::vector<Eigen::Vector3d> targets(robot_.legs.size());
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
     const LegChain& leg = robot_.legs[i];
@@ -136,7 +145,7 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
     const Eigen::Vector2d d = duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) +
                                       config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
     const double u = t / period - robot_.timing.phase[i];
-    targets[i] = robot_.robot_in_torso * (leg.stance_m + envelope * FootOffset(u, duty, d, robot_.step_height_m));
+    targets[i] = robot_.robot_in_torso * (leg.stance_m + lean + envelope * FootOffset(u, duty, d, robot_.step_height_m));
   }
   SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);
   int k = 0;

@@ -42,6 +42,10 @@ struct GaitDescription {
   double stance_height_reach = 0;  // torso above the feet; 0: the model's rest pose, 90% extended
   double stance_height_m = 0;
   double turn_rad = 0.3;           // yaw per cycle at |turn| = 1
+  // Share of the way the feet shift to keep the support polygon under the centre of mass on a
+  // slope: by lean x h tan(slope) along the ground's tilt at the robot's heading (h the stance
+  // height). 0: feet where the gait puts them, whatever the ground.
+  double lean = 1.0;
 };
 
 // What drives the legs: the generic gait (foot placement through inverse kinematics), or a
