@@ -161,6 +161,18 @@ std::string SimSummary::BriefReport() const {
 
 namespace {
 
+// The command (long, lat, turn) of every placement, or of every execution of a sequence.
+Eigen::MatrixXd CommandsPlanned(const std::vector<Placement>& plan, const Eigen::MatrixXd& table) {
+  std::vector<int> ids;
+  for (const Placement& p : plan) {
+    if (p.sequence.empty()) ids.push_back(p.command);
+    ids.insert(ids.end(), p.sequence.begin(), p.sequence.end());
+  }
+  Eigen::MatrixXd used(static_cast<int>(ids.size()), table.cols());
+  for (int k = 0; k < used.rows(); ++k) used.row(k) = table.row(ids[k]);
+  return used;
+}
+
 // Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
 // set (command table already filled), its metadata and the summary.
 void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std::vector<Placement>& plan,
@@ -169,14 +181,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   const auto wall_start = std::chrono::steady_clock::now();
   const std::clock_t cpu_start = std::clock();
   Simulator sim(config, edit);
-  std::vector<int> ids;
-  for (const Placement& p : plan) {
-    if (p.sequence.empty()) ids.push_back(p.command);
-    ids.insert(ids.end(), p.sequence.begin(), p.sequence.end());
-  }
-  Eigen::MatrixXd used(static_cast<int>(ids.size()), 3);
-  for (int k = 0; k < used.rows(); ++k) used.row(k) = out->commands.row(ids[k]);
-  CheckRecordingsCover(config, used);
+  CheckRecordingsCover(config, CommandsPlanned(plan, out->commands));
   SampleSet& set = *out;
   const int reps = options.executions_per_placement;
 
