@@ -64,9 +64,14 @@ Eigen::VectorXd Mixture::LogDensity(const Eigen::Ref<const Eigen::MatrixXd>& X) 
   for (int i = 0; i < size(); ++i) {
     terms.row(i) = (components_[i].LogDensity(X).array() + std::log(weights_[i])).transpose();
   }
+  // Log-sum-exp of every column at once (vectorised exp and log over the whole block); a column
+  // whose largest term is not finite (-inf: every component zero) keeps that term.
+  const Eigen::RowVectorXd top = terms.colwise().maxCoeff();
+  const Eigen::RowVectorXd finite_top = top.unaryExpr([](double m) { return std::isfinite(m) ? m : 0.0; });
+  const Eigen::ArrayXd lse = (finite_top.array() + (terms.rowwise() - finite_top).array().exp().colwise().sum().log()).transpose();
   const double log_total = std::log(total_weight());
   Eigen::VectorXd out(n);
-  for (int j = 0; j < n; ++j) out[j] = LogSumExp(terms.col(j)) - log_total;
+  for (int j = 0; j < n; ++j) out[j] = (std::isfinite(top[j]) ? lse[j] : top[j]) - log_total;
   return out;
 }
 
