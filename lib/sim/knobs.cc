@@ -61,6 +61,23 @@ std::string RobotMjcfText(const SimConfig& config) {
   return text.str();
 }
 
+void AddTrackerNoiseKnob(const SimConfig& config, std::vector<Knob>* knobs) {
+  const auto& n = config.noise;
+  if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
+      n.tracker_pitch_sd_rad > 0) {
+    knobs->push_back(MakeKnob(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0,
+                              0.5, 5.0, {2.0}));
+  }
+}
+
+void ScaleTrackerNoise(const SimConfig& config, double factor, SimConfig* out) {
+  const auto& n = config.noise;
+  out->noise.tracker_position_sd_m = n.tracker_position_sd_m * factor;
+  out->noise.tracker_yaw_sd_rad = n.tracker_yaw_sd_rad * factor;
+  out->noise.tracker_roll_sd_rad = n.tracker_roll_sd_rad * factor;
+  out->noise.tracker_pitch_sd_rad = n.tracker_pitch_sd_rad * factor;
+}
+
 double PayloadProbeMass(const SimConfig& config) {
   if (config.robot) return 0.15 * Simulator(config).total_mass_kg();
   const auto& m = config.masses;
@@ -145,12 +162,7 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
   knobs.push_back(MakeKnob(KnobKind::kBacklash, -1, "actuators.backlash_rad", "backlash", "rad", bl, 0.0, 0.2,
                            {bl + 0.03 <= 0.2 ? bl + 0.03 : bl - 0.03}));
   // Last: a measurement-side knob of the simulator (the tracker's noise), config-level.
-  const auto& n = config.noise;
-  if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
-      n.tracker_pitch_sd_rad > 0) {
-    knobs.push_back(MakeKnob(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0,
-                             0.5, 5.0, {2.0}));
-  }
+  AddTrackerNoiseKnob(config, &knobs);
   return knobs;
 }
 
@@ -201,14 +213,7 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
       case KnobKind::kLatency: c.actuators.latency_s = v.value; break;
       case KnobKind::kBacklash: c.actuators.backlash_rad = v.value; break;
       case KnobKind::kFrictionScale: break;  // a robot block's knob only
-      case KnobKind::kTrackerNoiseScale: {
-        const auto& n = config.noise;
-        c.noise.tracker_position_sd_m = n.tracker_position_sd_m * v.value;
-        c.noise.tracker_yaw_sd_rad = n.tracker_yaw_sd_rad * v.value;
-        c.noise.tracker_roll_sd_rad = n.tracker_roll_sd_rad * v.value;
-        c.noise.tracker_pitch_sd_rad = n.tracker_pitch_sd_rad * v.value;
-        break;
-      }
+      case KnobKind::kTrackerNoiseScale: ScaleTrackerNoise(config, v.value, &c); break;
     }
   }
   if (payload) {

@@ -92,4 +92,10 @@ std::string RobotMjcfText(const SimConfig& config);
 // Mass of the payload probes [kg]: 15% of the robot's mass (the model's, with a robot block).
 double PayloadProbeMass(const SimConfig& config);
 
+// The measurement-side knob shared by every robot: appends tracker.noise_scale when config.noise
+// has any tracker noise, and applies a value of it (the four tracker sd's of `config` scaled into
+// out->noise; the IMU's untouched).
+void AddTrackerNoiseKnob(const SimConfig& config, std::vector<Knob>* knobs);
+void ScaleTrackerNoise(const SimConfig& config, double factor, SimConfig* out);
+
 }  // namespace dgmm::sim

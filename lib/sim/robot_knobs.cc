@@ -122,12 +122,7 @@ std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
   knobs.push_back(MakeKnob(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0, 0.05, 10.0,
                        {0.25, 4.0}));
   AddActuationKnobs(config, m, &knobs);
-  const auto& n = config.noise;
-  if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
-      n.tracker_pitch_sd_rad > 0) {
-    knobs.push_back(MakeKnob(KnobKind::kTrackerNoiseScale, -1, "tracker.noise_scale", "tracker_noise", "", 1.0, 0.5, 5.0,
-                         {2.0}));
-  }
+  AddTrackerNoiseKnob(config, &knobs);
   return knobs;
 }
 
@@ -159,14 +154,7 @@ SimConfig ApplyRobotKnobs(const SimConfig& config, const std::vector<Knob>& knob
           c.robot->leg_gain[leg] = (it == config.robot->leg_gain.end() ? 1.0 : it->second) * v.value;
         }
         break;
-      case KnobKind::kTrackerNoiseScale: {
-        const auto& n = config.noise;
-        c.noise.tracker_position_sd_m = n.tracker_position_sd_m * v.value;
-        c.noise.tracker_yaw_sd_rad = n.tracker_yaw_sd_rad * v.value;
-        c.noise.tracker_roll_sd_rad = n.tracker_roll_sd_rad * v.value;
-        c.noise.tracker_pitch_sd_rad = n.tracker_pitch_sd_rad * v.value;
-        break;
-      }
+      case KnobKind::kTrackerNoiseScale: ScaleTrackerNoise(config, v.value, &c); break;
       default:
         throw MakeInputError(config.mjcf_path, k.name, "not a knob of a robot block's robot");
     }
