@@ -49,29 +49,9 @@ SampleSet MakeSet(const Eigen::MatrixXd& x, const Eigen::VectorXi& command, cons
   return set;
 }
 
-// p(x | c) or p(x | c, z) in the raw units of x (z raw too), whatever the model's standardisation.
+// p(x | c) or p(x | c, z) in the raw units of x and z (MotionModel::RawPoseDistribution).
 Mixture PoseMixture(const MotionModel& model, int command, const std::optional<Eigen::VectorXd>& z) {
-  const int dx = model.pose_dim;
-  Mixture m;
-  if (z) {
-    if (model.terrain_dim == 0) throw InputError("model: fitted without terrain; give no z");
-    if (z->size() != model.terrain_dim) {
-      throw InputError("z: " + std::to_string(z->size()) + " values, expected " + std::to_string(model.terrain_dim));
-    }
-    Eigen::VectorXd zs = *z;
-    if (!model.transform.empty()) {
-      zs = (zs - model.transform.offset.segment(dx, model.terrain_dim))
-               .cwiseQuotient(model.transform.scale.segment(dx, model.terrain_dim));
-    }
-    m = model.Conditional(command, zs);
-  } else {
-    std::vector<int> dims(dx);
-    for (int d = 0; d < dx; ++d) dims[d] = d;
-    m = model.MixtureFor(command).Marginal(dims);
-  }
-  if (model.transform.empty()) return m;
-  const Eigen::VectorXd scale = model.transform.scale.head(dx), offset = model.transform.offset.head(dx);
-  return m.Affine(scale.asDiagonal(), offset);
+  return model.RawPoseDistribution(command, z ? *z : Eigen::VectorXd());
 }
 
 MotionModel FitDgmm(const SampleSet& set, double k, bool with_terrain, std::uint64_t seed, long long max_components,

@@ -89,6 +89,26 @@ Mixture MotionModel::Conditional(int command, const Eigen::Ref<const Eigen::Vect
   return MixtureFor(command).Conditional(Range(pose_dim, dim()), z);
 }
 
+Mixture MotionModel::RawPoseDistribution(int command, const Eigen::VectorXd& z) const {
+  std::vector<int> pose(pose_dim);
+  for (int d = 0; d < pose_dim; ++d) pose[d] = d;
+  Mixture m;
+  if (z.size() == 0) {
+    m = terrain_dim > 0 ? MixtureFor(command).Marginal(pose) : MixtureFor(command);
+  } else {
+    if (terrain_dim == 0) throw InputError("model: fitted without terrain; give no z");
+    if (z.size() != terrain_dim) {
+      throw InputError("z: " + std::to_string(z.size()) + " values, expected " + std::to_string(terrain_dim));
+    }
+    m = transform.empty() ? Conditional(command, z)
+                          : Conditional(command, (z - transform.offset.segment(pose_dim, terrain_dim))
+                                                     .cwiseQuotient(transform.scale.segment(pose_dim, terrain_dim)));
+  }
+  if (transform.empty()) return m;
+  const Eigen::VectorXd scale = transform.scale.head(pose_dim), offset = transform.offset.head(pose_dim);
+  return m.Affine(scale.asDiagonal(), offset);
+}
+
 MotionModelLearner::MotionModelLearner(MotionModel header, const MotionModelOptions& options)
     : header_(std::move(header)), options_(options), rng_(options.seed) {
   std::string error;

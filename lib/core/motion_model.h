@@ -40,6 +40,10 @@ struct MotionModel {
                        const Eigen::Ref<const Eigen::VectorXd>& z) const;
   // p(x | c, z) as a mixture over x.
   Mixture Conditional(int command, const Eigen::Ref<const Eigen::VectorXd>& z) const;
+  // p(x | c, z) (or p(x | c) for an empty z) in the raw units of x and z, whatever the model's
+  // standardisation: z standardised before conditioning, the mixture mapped back. InputError for
+  // a z given to a model without terrain or of the wrong size.
+  Mixture RawPoseDistribution(int command, const Eigen::VectorXd& z) const;
 };
 
 // Options for learning one DGMM per command from a sample set.

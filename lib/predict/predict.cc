@@ -39,12 +39,6 @@ std::vector<int> PoseIndices(const MotionModel& model, const PredictOptions& opt
   return index;
 }
 
-std::vector<int> Range(int begin, int end) {
-  std::vector<int> r;
-  for (int i = begin; i < end; ++i) r.push_back(i);
-  return r;
-}
-
 Eigen::Matrix3d Zyx(double yaw, double pitch, double roll) {
   return (Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
           Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX()))
@@ -74,36 +68,18 @@ bool PredictOptions::IsValid(std::string* error) const {
 
 namespace {
 
-// p(x | c, z) (z in raw units; empty: marginalised) as a mixture over the model's pose dimensions,
-// in the model's own units.
-Mixture PoseMixture(const MotionModel& model, int command, const Eigen::VectorXd& z) {
-  if (z.size() == 0) {
-    return model.terrain_dim > 0 ? model.MixtureFor(command).Marginal(Range(0, model.pose_dim)) : model.MixtureFor(command);
-  }
-  if (model.transform.empty()) return model.Conditional(command, z);
-  const auto& t = model.transform;
-  return model.Conditional(command, (z - t.offset.segment(model.pose_dim, model.terrain_dim))
-                                        .cwiseQuotient(t.scale.segment(model.pose_dim, model.terrain_dim)));
-}
-
 // n pose changes (pose_dim x n) of step `k`, in raw units: from the step's terrain (or none), or
 // with options.ground from the terrain under each trajectory's pose before the step.
 Eigen::MatrixXd DrawStep(const MotionModel& model, const Step& step, const PredictOptions& options,
                          const Eigen::MatrixXd& poses, std::mt19937_64& rng) {
   const int n = static_cast<int>(poses.rows());
-  Eigen::MatrixXd dx;
   if (step.terrain.size() > 0 || !options.ground) {
-    dx = PoseMixture(model, step.command, step.terrain).Sample(n, rng);
-  } else {
-    dx.resize(model.pose_dim, n);
-    for (int i = 0; i < n; ++i) {
-      const Eigen::Vector4d pose = poses.row(i).transpose();
-      dx.col(i) = PoseMixture(model, step.command, options.ground(pose)).Sample(1, rng);
-    }
+    return model.RawPoseDistribution(step.command, step.terrain).Sample(n, rng);
   }
-  if (!model.transform.empty()) {  // back to raw units: x = x_std * scale + offset
-    const auto& t = model.transform;
-    dx = (dx.array().colwise() * t.scale.head(model.pose_dim).array()).colwise() + t.offset.head(model.pose_dim).array();
+  Eigen::MatrixXd dx(model.pose_dim, n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector4d pose = poses.row(i).transpose();
+    dx.col(i) = model.RawPoseDistribution(step.command, options.ground(pose)).Sample(1, rng);
   }
   return dx;
 }
