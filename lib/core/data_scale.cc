@@ -14,9 +14,14 @@ void Welford(long long* n, Eigen::VectorXd* mean, Eigen::VectorXd* m2,
     *m2 = Eigen::VectorXd::Zero(y.size());
   }
   ++*n;
-  const Eigen::VectorXd delta = y - *mean;
-  *mean += delta / static_cast<double>(*n);
-  *m2 += delta.cwiseProduct(y - *mean);
+  const double count = static_cast<double>(*n);
+  double* mu = mean->data();
+  double* s = m2->data();
+  for (Eigen::Index j = 0; j < y.size(); ++j) {  // no temporaries: this runs once per sample
+    const double delta = y[j] - mu[j];
+    mu[j] += delta / count;
+    s[j] += delta * (y[j] - mu[j]);
+  }
 }
 
 std::string Num(double v) {

@@ -30,31 +30,38 @@ Eigen::MatrixXd Dgmm::FlooredCovariance(const DgmmComponentStats& stats) const {
   return cov;
 }
 
-void Dgmm::FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const {
-  const double n = static_cast<double>(stats.count);
-  double scatter_scale = 0.0, prior_weight = 0.0;  // cov = M2 * scatter_scale + prior_weight * S0
+void Dgmm::CovarianceCoefficients(std::int64_t count, double* scatter_scale,
+                                  double* prior_weight) const {
+  const double n = static_cast<double>(count);
+  *scatter_scale = 0.0;
+  *prior_weight = 0.0;
   using Rule = DgmmOptions::CovarianceRule;
   switch (options_.covariance_rule) {
     case Rule::kLiteral:  // eq. 13: M2 / (n - 1); S0 until a second sample arrives
-      if (stats.count < 2) {
-        prior_weight = 1.0;
+      if (count < 2) {
+        *prior_weight = 1.0;
       } else {
-        scatter_scale = 1.0 / (n - 1.0);
+        *scatter_scale = 1.0 / (n - 1.0);
       }
       break;
     case Rule::kBlend: {  // (M2 + nu S0) / (n - 1 + nu), nu = max(0, d + 1 - n)
       const double nu = std::max(0.0, dim_ + 1.0 - n);
-      scatter_scale = 1.0 / (n - 1.0 + nu);
-      prior_weight = nu * scatter_scale;
+      *scatter_scale = 1.0 / (n - 1.0 + nu);
+      *prior_weight = nu * *scatter_scale;
       break;
     }
     case Rule::kPrior: {  // (M2 + nu0 S0) / (n + nu0)
       const double nu0 = options_.prior_pseudo_count;
-      scatter_scale = 1.0 / (n + nu0);
-      prior_weight = nu0 * scatter_scale;
+      *scatter_scale = 1.0 / (n + nu0);
+      *prior_weight = nu0 * *scatter_scale;
       break;
     }
   }
+}
+
+void Dgmm::FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const {
+  double scatter_scale, prior_weight;  // cov = M2 * scatter_scale + prior_weight * S0 + floor I
+  CovarianceCoefficients(stats.count, &scatter_scale, &prior_weight);
   cov->resize(dim_, dim_);  // no reallocation when already dim x dim
   *cov = stats.scatter * scatter_scale;
   for (int i = 0; i < dim_; ++i) {
@@ -120,16 +127,20 @@ AddSampleResult Dgmm::AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std:
 AddSampleResult Dgmm::DecideMerge(const Eigen::Ref<const Eigen::VectorXd>& x,
                                   std::mt19937_64& rng) {
   AddSampleResult result;
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  const double r = uniform(rng);
-  const double decay = std::exp(-options_.k * static_cast<double>(num_samples_));
-  if (options_.max_components > 0 && mixture_.size() >= options_.max_components) {
-    // Bounded work: at the cap every sample merges (no density needed).
-    max_components_hit_ = true;
+  // exp(-k n) underflows to exactly 0 beyond k n = 745.2; skip the call there.
+  const double kn = options_.k * static_cast<double>(num_samples_);
+  const double decay = kn > 746.0 ? 0.0 : std::exp(-kn);
+  const bool at_cap = options_.max_components > 0 && mixture_.size() >= options_.max_components;
+  if (at_cap || (!mixture_.empty() && 1.0 - decay == 1.0)) {
+    // At the cap every sample merges (bounded work: no density needed); and once t = 1 in
+    // floating point, r < t holds for every r in [0, 1): the merge is certain, r is not drawn.
+    max_components_hit_ = max_components_hit_ || at_cap;
     result.threshold = 1.0;
     result.merged = true;
     return result;
   }
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  const double r = uniform(rng);
   if (mixture_.empty()) {
     // p(x) = 0 for an empty model: d = 0 and t = 1 - exp(0) = 0, so r < t never holds.
     result.threshold = 0.0;
@@ -187,6 +198,8 @@ int Dgmm::StartComponent(const Eigen::Ref<const Eigen::VectorXd>& x) {
   stats_.push_back(std::move(s));
   Eigen::MatrixXd cov = FlooredCovariance(stats_.back());
   mixture_.Add(1.0, Gaussian(x, std::move(cov)));
+  factor_floor_.push_back(options_.covariance_floor);
+  updates_since_factor_.push_back(0);
   max_valid_ = false;
   return mixture_.size() - 1;
 }
@@ -201,24 +214,55 @@ void Dgmm::MergeInto(int i, const Eigen::Ref<const Eigen::VectorXd>& x) {
   const double w_next = w + 1.0;
   delta_scratch_ = x - s.mean;
   s.mean.noalias() += delta_scratch_ / w_next;
-  // Lower triangle computed once and mirrored: the scatter stays bitwise symmetric.
+  // M2 += e e^T with e = sqrt(w / w') delta: each entry e_r e_c, so the scatter stays bitwise
+  // symmetric (the products commute).
   const double c = w / w_next;
+  update_scratch_ = std::sqrt(c) * delta_scratch_;
+  const double* e = update_scratch_.data();
+  double* m2 = s.scatter.data();
   for (int col = 0; col < dim_; ++col) {
-    const double dc = c * delta_scratch_[col];
-    for (int row = col; row < dim_; ++row) {
-      s.scatter(row, col) += dc * delta_scratch_[row];
-      s.scatter(col, row) = s.scatter(row, col);
-    }
+    for (int row = 0; row < dim_; ++row, ++m2) *m2 += e[row] * e[col];
   }
   s.count += 1;
   mixture_.SetWeight(i, static_cast<double>(s.count));
-  RefreshComponent(i);
+  if (!RankOneRefresh(i)) RefreshComponent(i);
+}
+
+bool Dgmm::RankOneRefresh(int i) {
+  // Every rule is cov(n) = a_n M2 + b_n S0 + f I. With alpha = a_{n+1} / a_n and
+  // b_{n+1} = alpha b_n (the prior rule always; literal and blend once n > d):
+  //   cov(n+1) = alpha cov(n) + a_{n+1} e e^T + (1 - alpha) f I   (e from MergeInto),
+  // a rank-one update of the cached factor (O(d^2) instead of O(d^3)) except for the last term.
+  // It is dropped while the floor g inside the factor stays above f / 1.01, so the floor sags
+  // by under 1% until the next factorisation, which restores g = f. Factorising again after
+  // kMaxUpdates updates bounds the round-off the updates accumulate.
+  constexpr int kMaxUpdates = 1024;
+  constexpr double kFloorSag = 1.01;
+  const DgmmComponentStats& s = stats_[i];
+  double a_old, b_old, a_new, b_new;
+  CovarianceCoefficients(s.count - 1, &a_old, &b_old);
+  CovarianceCoefficients(s.count, &a_new, &b_new);
+  if (!(a_old > 0.0) || updates_since_factor_[i] >= kMaxUpdates) return false;
+  const double alpha = a_new / a_old;
+  if (std::abs(b_new - alpha * b_old) > 1e-12 * std::max(b_new, alpha * b_old)) return false;
+  const double floor = alpha * factor_floor_[i];
+  if (floor * kFloorSag < options_.covariance_floor) return false;
+  update_scratch_ *= std::sqrt(a_new);  // sqrt(a_{n+1} c) delta
+  if (!mixture_.mutable_component(i).ScaleAndRankOneUpdate(s.mean, alpha, update_scratch_)) {
+    return false;
+  }
+  factor_floor_[i] = floor;
+  ++updates_since_factor_[i];
+  max_valid_ = false;
+  return true;
 }
 
 void Dgmm::RefreshComponent(int i) {
   FloorInto(stats_[i], &covariance_scratch_);
   Gaussian& g = mixture_.mutable_component(i);
   max_valid_ = false;
+  factor_floor_[i] = options_.covariance_floor;
+  updates_since_factor_[i] = 0;
   if (g.SetInPlace(stats_[i].mean, covariance_scratch_)) return;
   // Round-off (or floor = 0 with degenerate samples): add a growing multiple of S0's diagonal.
   for (double jitter = 1e-12; jitter <= 1.0; jitter *= 10) {
@@ -231,19 +275,21 @@ void Dgmm::RefreshComponent(int i) {
 }
 
 int Dgmm::ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng) {
-  // P(i) = w_i g_i(x) / sum_j w_j g_j(x), g_i = exp(-1/2 m_i^2) (max-normalised, Algorithm 2),
-  // in log space so that a sample far from every component still picks the nearest one.
+  // P(i) = w_i g_i(x) / sum_j w_j g_j(x), g_i = exp(-1/2 m_i^2) (max-normalised, Algorithm 2).
+  // g_i is scaled by exp(1/2 min_j m_j^2) so that a sample far from every component still picks
+  // the nearest one (the nearest gets g = 1; weights are counts >= 1, so nothing overflows).
   const int k = mixture_.size();
   log_choice_.resize(k);
   double m = kNegInf;
   for (int i = 0; i < k; ++i) {
-    log_choice_[i] =
-        std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).SquaredMahalanobis(x);
+    log_choice_[i] = -0.5 * mixture_.component(i).SquaredMahalanobis(x);
     m = std::max(m, log_choice_[i]);
   }
+  if (k == 1) return 0;  // nothing to draw
   double total = 0.0;
   for (int i = 0; i < k; ++i) {
-    log_choice_[i] = std::exp(log_choice_[i] - m);
+    const double a = log_choice_[i] - m;
+    log_choice_[i] = mixture_.weight(i) * (a == 0.0 ? 1.0 : std::exp(a));
     total += log_choice_[i];
   }
   std::uniform_real_distribution<double> uniform(0.0, 1.0);

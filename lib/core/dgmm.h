@@ -76,8 +76,15 @@ class Dgmm {
   // FlooredCovariance written into *cov (reusing its storage); for the improved variant M2 is
   // its weighted scatter (n - 1) C_w.
   void FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const;
-  // Rebuilds mixture_ component i from stats_[i] with the floor.
+  // Rebuilds mixture_ component i from stats_[i] with the floor (a new factorisation).
   void RefreshComponent(int i);
+  // After a merge into component i (count n -> n + 1, scatter += e e^T with e in
+  // update_scratch_): updates its factor by one rank-one step when the covariance rule allows it
+  // (core/dgmm.cc); false when component i needs RefreshComponent instead.
+  bool RankOneRefresh(int i);
+  // The covariance rule as cov = scatter_scale * M2 + prior_weight * S0 (+ floor) for `count`.
+  void CovarianceCoefficients(std::int64_t count, double* scatter_scale,
+                              double* prior_weight) const;
 
   int dim_;
   DgmmOptions options_;
@@ -96,6 +103,11 @@ class Dgmm {
   std::vector<double> log_choice_;      // scratch for ChooseComponent
   Eigen::MatrixXd covariance_scratch_;  // scratch for RefreshComponent
   Eigen::VectorXd delta_scratch_;       // scratch for MergeInto
+  Eigen::VectorXd update_scratch_;      // e = sqrt(w / w') delta from MergeInto
+  // Per component: the floor currently inside its factor (it shrinks with the rest of the
+  // covariance between factorisations) and rank-one updates since its last factorisation.
+  std::vector<double> factor_floor_;
+  std::vector<int> updates_since_factor_;
 };
 
 }  // namespace dgmm

@@ -30,6 +30,11 @@ class Gaussian {
   // used by the DGMM update on every merged sample.
   bool SetInPlace(const Eigen::Ref<const Eigen::VectorXd>& mean,
                   const Eigen::Ref<const Eigen::MatrixXd>& covariance);
+  // covariance <- alpha covariance + v v^T (alpha > 0) and the mean replaced, in O(d^2): the
+  // cached factor gets a rank-one update (L' L'^T = alpha L L^T + v v^T) instead of a new
+  // factorisation. Returns false (state unchanged) when the result would not be finite.
+  bool ScaleAndRankOneUpdate(const Eigen::Ref<const Eigen::VectorXd>& mean, double alpha,
+                             const Eigen::Ref<const Eigen::VectorXd>& v);
 
   // m^2 = (x - mean)^T covariance^-1 (x - mean); x has dim() entries.
   double SquaredMahalanobis(const Eigen::Ref<const Eigen::VectorXd>& x) const;
@@ -69,7 +74,9 @@ class Gaussian {
   Eigen::MatrixXd covariance_;
   Eigen::MatrixXd l_;
   double log_det_ = 0.0;
+  Eigen::VectorXd inv_diag_;  // 1 / L_ii, for the forward substitutions
   Eigen::MatrixXd scratch_;  // factor under construction in SetInPlace
+  Eigen::VectorXd inv_diag_scratch_;  // 1 / L'_ii under construction there
 };
 
 // Indices 0..dim-1 that are not in `dims`, ascending.

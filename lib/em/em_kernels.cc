@@ -1,7 +1,20 @@
 #include "em/em_kernels.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cstring>
+
+// On x86-64 with GCC or Clang the two entry points are compiled twice, for the baseline and for
+// x86-64-v3 (AVX2 + FMA), and the loader picks the clone the CPU supports (ifunc); the fixed-size
+// kernels are inlined into each. Results may differ in the last bits between the two clones
+// (fused multiply-adds), never between runs on one machine.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
+#define DGMM_EM_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
+#define DGMM_EM_INLINE __attribute__((always_inline)) inline
+#else
+#define DGMM_EM_KERNEL
+#define DGMM_EM_INLINE inline
+#endif
 
 namespace dgmm::em_internal {
 namespace {
@@ -10,7 +23,7 @@ namespace {
 // d x d upper triangular, column-major). D fixes d at compile time so that the loops over
 // dimensions unroll and the loop over samples vectorises.
 template <int D>
-void SquaredMahalanobisBlockFixed(const double* const* cols, Eigen::Index b, const double* U,
+DGMM_EM_INLINE void SquaredMahalanobisBlockFixed(const double* const* cols, Eigen::Index b, const double* U,
                                   const double* shift, double* __restrict m2) {
   const double* __restrict c[D];
   for (int a = 0; a < D; ++a) c[a] = cols[a];
@@ -42,44 +55,55 @@ void SquaredMahalanobisBlockFixed(const double* const* cols, Eigen::Index b, con
   }
 }
 
-// WeightedScatter for d = D: the d(d+1)/2 sums stay in registers, two samples per SSE2 lane pair.
+// WeightedScatter for d = D, in blocks of kScatterBlock samples: the block is centred once
+// (D columns in L1 cache), then each row a of the triangle accumulates its a + 1 sums over the
+// block in registers (4 lanes: one AVX or two SSE2 registers per sum), so no sum is spilled.
+constexpr Eigen::Index kScatterBlock = 256;
+
 template <int D>
-void WeightedScatterFixed(const double* const* cols, Eigen::Index n, const double* r,
-                          const double* mean, double* cov) {
-  typedef double Pair __attribute__((vector_size(2 * sizeof(double))));
-  constexpr int kSums = D * (D + 1) / 2;
-  Pair sums[kSums];
-  for (int q = 0; q < kSums; ++q) sums[q] = Pair{0, 0};
-  Eigen::Index i = 0;
-  for (; i + 2 <= n; i += 2) {
-    Pair weight, c[D];
-    std::memcpy(&weight, r + i, sizeof(Pair));
+DGMM_EM_INLINE void WeightedScatterFixed(const double* const* cols, Eigen::Index n,
+                                         const double* r, const double* mean, double* cov) {
+  typedef double Lanes __attribute__((vector_size(4 * sizeof(double))));
+  alignas(32) double centred[D][kScatterBlock];
+  double sums[D][D] = {};
+  for (Eigen::Index i0 = 0; i0 < n; i0 += kScatterBlock) {
+    const Eigen::Index b = std::min(kScatterBlock, n - i0);
+    const Eigen::Index b4 = b & ~Eigen::Index{3};
     for (int a = 0; a < D; ++a) {
-      std::memcpy(&c[a], cols[a] + i, sizeof(Pair));
-      c[a] -= mean[a];
+      for (Eigen::Index i = 0; i < b; ++i) centred[a][i] = cols[a][i0 + i] - mean[a];
     }
-    int q = 0;
+#pragma GCC unroll 8
     for (int a = 0; a < D; ++a) {
-      const Pair w = c[a] * weight;
-      for (int b = 0; b <= a; ++b) sums[q++] += w * c[b];
+      Lanes acc[D];
+#pragma GCC unroll 8
+      for (int c = 0; c <= a; ++c) acc[c] = Lanes{0, 0, 0, 0};
+      for (Eigen::Index i = 0; i < b4; i += 4) {
+        Lanes weight, w;
+        std::memcpy(&weight, r + i0 + i, sizeof(Lanes));
+        std::memcpy(&w, &centred[a][i], sizeof(Lanes));
+        w *= weight;
+#pragma GCC unroll 8
+        for (int c = 0; c <= a; ++c) {
+          Lanes x;
+          std::memcpy(&x, &centred[c][i], sizeof(Lanes));
+          acc[c] += w * x;
+        }
+      }
+      for (int c = 0; c <= a; ++c) {
+        double tail = 0;
+        for (Eigen::Index i = b4; i < b; ++i) tail += r[i0 + i] * centred[a][i] * centred[c][i];
+        sums[a][c] += (acc[c][0] + acc[c][1]) + (acc[c][2] + acc[c][3]) + tail;
+      }
     }
   }
-  double tail[kSums] = {};
-  for (; i < n; ++i) {
-    double c[D];
-    for (int a = 0; a < D; ++a) c[a] = cols[a][i] - mean[a];
-    int q = 0;
-    for (int a = 0; a < D; ++a)
-      for (int b = 0; b <= a; ++b) tail[q++] += r[i] * c[a] * c[b];
-  }
-  int q = 0;
   for (int a = 0; a < D; ++a)
-    for (int b = 0; b <= a; ++b, ++q) cov[a + b * D] += sums[q][0] + sums[q][1] + tail[q];
+    for (int c = 0; c <= a; ++c) cov[a + c * D] += sums[a][c];
 }
 
 }  // namespace
 
-void SquaredMahalanobisBlock(const double* const* cols, Eigen::Index b, int d, const double* U,
+DGMM_EM_KERNEL void SquaredMahalanobisBlock(const double* const* cols, Eigen::Index b, int d,
+                                            const double* U,
                              const double* shift, double* m2) {
   switch (d) {
     case 1: return SquaredMahalanobisBlockFixed<1>(cols, b, U, shift, m2);
@@ -94,7 +118,8 @@ void SquaredMahalanobisBlock(const double* const* cols, Eigen::Index b, int d, c
   }
 }
 
-void WeightedScatter(const double* const* cols, Eigen::Index n, int d, const double* r,
+DGMM_EM_KERNEL void WeightedScatter(const double* const* cols, Eigen::Index n, int d,
+                                    const double* r,
                      const double* mean, double* cov) {
   switch (d) {
     case 1: return WeightedScatterFixed<1>(cols, n, r, mean, cov);

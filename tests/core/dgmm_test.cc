@@ -138,7 +138,9 @@ TEST(DgmmTest, IncrementalUpdateEqualsBatchAndPaperRecursion) {
 }
 
 // Algorithm 2 without the shortcut, evaluated on a copy of the generator before each call:
-// the implementation (which skips d when r < 1 - exp(-k n)) must take the same decisions.
+// the implementation (which skips d when r < 1 - exp(-k n)) must take the same decisions. Draws
+// whose outcome is certain are not made: r once 1 - exp(-k n) rounds to 1 (every r in [0, 1)
+// merges), and the component draw when there is one component.
 TEST(DgmmTest, MatchesLiteralAlgorithm2) {
   for (double k : {0.01, 0.2, 0.7}) {
     std::mt19937_64 data_rng(7), rng(8);
@@ -149,9 +151,10 @@ TEST(DgmmTest, MatchesLiteralAlgorithm2) {
       const Eigen::VectorXd x = X.col(j);
       std::mt19937_64 ref_rng = rng;
       std::uniform_real_distribution<double> uniform(0.0, 1.0);
-      const double r = uniform(ref_rng);
       const Mixture& m = model.mixture();
       const double n = static_cast<double>(model.num_samples());
+      const bool certain = !m.empty() && 1.0 - std::exp(-k * n) == 1.0;
+      const double r = certain ? 0.0 : uniform(ref_rng);
       double d = 0;
       if (!m.empty()) d = std::exp(m.LogDensity(x) - m.MaxDensity().log_density);
       const double t = 1 - (1 - std::min(d, 1.0)) * std::exp(-k * n);
@@ -164,7 +167,7 @@ TEST(DgmmTest, MatchesLiteralAlgorithm2) {
           p[i] = m.weight(i) * m.component(i).ScaledDensity(x);
           total += p[i];
         }
-        const double u = uniform(ref_rng) * total;
+        const double u = m.size() == 1 ? 0.0 : uniform(ref_rng) * total;
         double c = 0;
         for (expect_component = 0; expect_component < m.size(); ++expect_component) {
           c += p[expect_component];
@@ -204,6 +207,37 @@ TEST(DgmmTest, InvariantsHoldOverManySeededStreams) {
     for (int j = 0; j < X.cols(); ++j) model.AddSample(X.col(j), rng);
     EXPECT_EQ(model.num_samples(), X.cols());
     ExpectDgmmInvariants(model);
+  }
+}
+
+// Merges update each component's factor by rank-one steps (O(d^2)); the covariance it holds
+// must stay the options' rule applied to the statistics, up to the floor's documented sag (under
+// 1% of the floor between factorisations), for every rule, and the factor must match it.
+TEST(DgmmTest, RankOneUpdatesTrackTheCovarianceRule) {
+  using Rule = DgmmOptions::CovarianceRule;
+  for (Rule rule : {Rule::kPrior, Rule::kLiteral, Rule::kBlend}) {
+    for (double floor : {1e-3, 0.0}) {
+      SCOPED_TRACE(std::string(CovarianceRuleName(rule)) + " floor " + std::to_string(floor));
+      std::mt19937_64 data_rng(3), rng(4);
+      const int d = 6;
+      const Eigen::MatrixXd X = Stream(d, 5000, data_rng);
+      DgmmOptions o = PaperOptions();
+      o.covariance_rule = rule;
+      o.covariance_floor = floor;
+      o.covariance_floor_relative = 0.0;
+      Dgmm model(d, o);
+      for (int j = 0; j < X.cols(); ++j) model.AddSample(X.col(j), rng);
+      ExpectDgmmInvariants(model);
+      for (int i = 0; i < model.mixture().size(); ++i) {
+        const Gaussian& g = model.mixture().component(i);
+        const Eigen::MatrixXd want = model.FlooredCovariance(model.stats()[i]);
+        const Eigen::MatrixXd diff = g.covariance() - want;
+        EXPECT_LE(diff.norm(), 0.01 * floor * std::sqrt(d) + 1e-10 * want.norm());
+        if (floor > 0) EXPECT_LE(diff.diagonal().maxCoeff(), 1e-10 * want.norm());
+        const Eigen::MatrixXd llt = g.cholesky_l() * g.cholesky_l().transpose();
+        EXPECT_LE((llt - g.covariance()).norm(), 1e-10 * want.norm());
+      }
+    }
   }
 }
 

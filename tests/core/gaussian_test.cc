@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "core_test_utils.h"
@@ -86,6 +87,55 @@ TEST(GaussianTest, SetInPlaceEqualsSet) {
   EXPECT_EQ(a.covariance(), b.covariance());
   EXPECT_EQ(a.cholesky_l(), b.cholesky_l());
   EXPECT_EQ(a.log_det(), b.log_det());
+}
+
+// The O(d^2) update equals a fresh factorisation of alpha S + v v^T, for the unrolled sizes
+// (d <= 12), the run-time-size loop and the refactorising path beyond the stack (d > 32); and
+// stays consistent over a long chain of updates.
+TEST(GaussianTest, ScaleAndRankOneUpdateEqualsRefactorisation) {
+  std::mt19937_64 rng(11);
+  for (int d : {1, 2, 5, 8, 12, 13, 20, 40}) {
+    SCOPED_TRACE("d = " + std::to_string(d));
+    const Eigen::MatrixXd s = RandomSpd(d, rng);
+    Gaussian g(RandomVector(d, rng), s);
+    const Eigen::VectorXd mean = RandomVector(d, rng), v = RandomVector(d, rng);
+    const double alpha = 0.93;
+    ASSERT_TRUE(g.ScaleAndRankOneUpdate(mean, alpha, v));
+    const Gaussian want(mean, alpha * s + v * v.transpose());
+    EXPECT_LE((g.cholesky_l() - want.cholesky_l()).norm(), kTol * want.cholesky_l().norm());
+    EXPECT_LE((g.covariance() - want.covariance()).norm(), kTol * want.covariance().norm());
+    EXPECT_EQ(g.covariance(), g.covariance().transpose());
+    EXPECT_NEAR(g.log_det(), want.log_det(), kTol * std::max(1.0, std::abs(want.log_det())));
+    const Eigen::VectorXd x = RandomVector(d, rng);
+    EXPECT_NEAR(g.LogDensity(x), want.LogDensity(x), kTol * std::abs(want.LogDensity(x)));
+  }
+  for (int d : {3, 8}) {  // 2000 updates with the weights of a growing sample count
+    Eigen::MatrixXd s = RandomSpd(d, rng);
+    Gaussian g(Eigen::VectorXd::Zero(d), s);
+    for (int n = 10; n < 2010; ++n) {
+      const double alpha = n / (n + 1.0);
+      const Eigen::VectorXd v = RandomVector(d, rng) / std::sqrt(n + 1.0);
+      ASSERT_TRUE(g.ScaleAndRankOneUpdate(Eigen::VectorXd::Zero(d), alpha, v));
+      s = alpha * s + v * v.transpose();
+    }
+    const Gaussian want(Eigen::VectorXd::Zero(d), s);
+    EXPECT_LE((g.cholesky_l() - want.cholesky_l()).norm(), 1e-9 * want.cholesky_l().norm());
+    EXPECT_NEAR(g.log_det(), want.log_det(), 1e-9 * std::max(1.0, std::abs(want.log_det())));
+  }
+}
+
+TEST(GaussianTest, ScaleAndRankOneUpdateRefusesBadInput) {
+  std::mt19937_64 rng(12);
+  Gaussian g(RandomVector(3, rng), RandomSpd(3, rng));
+  const Gaussian before = g;
+  const Eigen::VectorXd v = RandomVector(3, rng);
+  EXPECT_FALSE(g.ScaleAndRankOneUpdate(g.mean(), 0.0, v));
+  EXPECT_FALSE(g.ScaleAndRankOneUpdate(g.mean(), std::nan(""), v));
+  Eigen::VectorXd bad = v;
+  bad[1] = std::numeric_limits<double>::infinity();
+  EXPECT_FALSE(g.ScaleAndRankOneUpdate(g.mean(), 0.5, bad));
+  EXPECT_EQ(g.covariance(), before.covariance());
+  EXPECT_EQ(g.cholesky_l(), before.cholesky_l());
 }
 
 TEST(GaussianTest, MarginalTakesSubvectorAndSubmatrix) {

@@ -38,18 +38,24 @@ TEST(Streaming, FitFromFileEqualsInMemoryFit) {
       options.seed = 5;
       options.with_terrain = with_terrain;
       const MotionModel expected = LearnMotionModel(set, options);
-      for (int chunk_rows : {1, 999, 4096}) {
-        SCOPED_TRACE(testing::Message()
-                     << "dz " << dz << " terrain " << with_terrain << " chunk " << chunk_rows);
-        long long last_done = 0;
-        const MotionModel streamed = LearnMotionModelFromFile(dir / "s.h5", options, chunk_rows,
-                                                              [&](long long done, long long total) {
-                                                                EXPECT_GT(done, last_done);
-                                                                EXPECT_EQ(total, set.size());
-                                                                last_done = done;
-                                                              });
-        EXPECT_EQ(last_done, set.size());
-        test::ExpectSameModel(expected, streamed);
+      // keep_bytes: the samples kept from the first pass (default), none (read twice), or the
+      // first chunks kept and then dropped when the rest do not fit (read twice).
+      for (std::size_t keep_bytes : {kStreamKeepBytes, std::size_t{0}, std::size_t{40000}}) {
+        for (int chunk_rows : {1, 999, 4096}) {
+          SCOPED_TRACE(testing::Message() << "dz " << dz << " terrain " << with_terrain
+                                          << " chunk " << chunk_rows << " keep " << keep_bytes);
+          long long last_done = 0;
+          const MotionModel streamed = LearnMotionModelFromFile(
+              dir / "s.h5", options, chunk_rows,
+              [&](long long done, long long total) {
+                EXPECT_GT(done, last_done);
+                EXPECT_EQ(total, set.size());
+                last_done = done;
+              },
+              nullptr, keep_bytes);
+          EXPECT_EQ(last_done, set.size());
+          test::ExpectSameModel(expected, streamed);
+        }
       }
     }
   }
