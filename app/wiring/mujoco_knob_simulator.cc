@@ -16,7 +16,7 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v4";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v5";
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {
   switch (kind) {

@@ -36,7 +36,10 @@ Eigen::MatrixX2d RegionEllipse(const Eigen::MatrixX2d& points, double share, int
   const Eigen::RowVector2d mean = points.colwise().mean();
   const Eigen::MatrixX2d centred = points.rowwise() - mean;
   Eigen::Matrix2d cov = centred.transpose() * centred / std::max<double>(1, points.rows() - 1);
-  cov.diagonal().array() += 1e-12 * std::max(1.0, cov.trace());
+  // Relative jitter (all points equal: a unit-free tiny circle) so that a fan of one point or
+  // on a line still factors.
+  const double scale = cov.trace() > 0 ? cov.trace() : 1.0;
+  cov.diagonal().array() += 1e-12 * scale;
   const Eigen::LLT<Eigen::Matrix2d> llt(cov);
   const Eigen::Matrix2d l = llt.matrixL();
   const Eigen::MatrixX2d u = llt.matrixL().solve(centred.transpose()).transpose();

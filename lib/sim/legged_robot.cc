@@ -350,11 +350,13 @@ LeggedRobot BindRobot(const mjModel* m, const RobotDescription& r, const std::st
   return b;
 }
 
-void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass) {
+// The payload is a solid ball of radius 0.1 x the longest leg's reach (a compact block whatever the
+// robot's size) at p in the torso's frame, merged into the torso's mass, centre and inertia.
+void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass, double reach_m) {
   const double m0 = m->body_mass[torso];
   const Eigen::Vector3d c0(m->body_ipos[3 * torso], m->body_ipos[3 * torso + 1], m->body_ipos[3 * torso + 2]);
   const Eigen::Vector3d c = (m0 * c0 + mass * p) / (m0 + mass);
-  const double kRadius = 0.03;  // m: a compact block
+  const double kRadius = 0.1 * reach_m;
   auto perp = [](const Eigen::Vector3d& d, int k) { return d.squaredNorm() - d[k] * d[k]; };
   for (int k = 0; k < 3; ++k) {
     m->body_inertia[3 * torso + k] += m0 * perp(c0 - c, k) + mass * perp(p - c, k) + 0.4 * mass * kRadius * kRadius;
@@ -380,7 +382,8 @@ void ApplyExperiment(const SimConfig& config, const LeggedRobot& b, mjModel* m) 
     }
   }
   if (config.payload.mass_kg > 0) {
-    AddPayload(m, b.torso_body, b.robot_in_torso * config.payload.position_body_m, config.payload.mass_kg);
+    AddPayload(m, b.torso_body, b.robot_in_torso * config.payload.position_body_m, config.payload.mass_kg,
+               b.reach_m);
   }
   if (r.overwrite_physics) {
     for (int i = 0; i < m->ngeom; ++i) {

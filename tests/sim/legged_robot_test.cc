@@ -124,6 +124,35 @@ TEST(LeggedRobot, ALegGainScalesThatLegsServosOnly) {
   }
 }
 
+// A payload merges into the torso: total mass, centre of mass, and an inertia that adds the
+// parallel-axis terms plus the payload's own, a ball of radius 0.1 x the robot's reach (so the
+// block scales with the robot instead of being 3 cm for every robot).
+TEST(LeggedRobot, APayloadMergesIntoTheTorsoAtTheRobotsScale) {
+  SimConfig c = Hexapod();
+  c.payload.mass_kg = 0.8;
+  c.payload.position_body_m = Eigen::Vector3d(0.05, -0.02, 0.01);
+  MjModelPtr m = LoadRobotModel(c);
+  MjModelPtr original = LoadRobotModel(c);
+  const LeggedRobot bound = BindRobot(m.get(), *c.robot, "hexapod");
+  ApplyExperiment(c, bound, m.get());
+  const int t = bound.torso_body;
+  const double m0 = original->body_mass[t], mass = 0.8;
+  EXPECT_DOUBLE_EQ(m->body_mass[t], m0 + mass);
+  const Eigen::Vector3d c0(original->body_ipos + 3 * t), p = bound.robot_in_torso * c.payload.position_body_m;
+  const Eigen::Vector3d centre = (m0 * c0 + mass * p) / (m0 + mass);
+  const double radius = 0.1 * bound.reach_m;
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(m->body_ipos[3 * t + k], centre[k], 1e-12);
+    auto perp = [k](const Eigen::Vector3d& d) { return d.squaredNorm() - d[k] * d[k]; };
+    const double want = original->body_inertia[3 * t + k] + m0 * perp(c0 - centre) +
+                        mass * perp(p - centre) + 0.4 * mass * radius * radius;
+    EXPECT_NEAR(m->body_inertia[3 * t + k], want, 1e-12) << "axis " << k;
+  }
+  for (int b = 0; b < m->nbody; ++b) {
+    if (b != t) EXPECT_EQ(m->body_mass[b], original->body_mass[b]) << "body " << b;
+  }
+}
+
 TEST(LeggedRobot, FootExtentForCapsuleAndBoxFeet) {
   const SimConfig c = Hexapod();
   MjModelPtr m = LoadRobotModel(c);
