@@ -74,6 +74,10 @@ void Setup(CLI::App& root) {
   cmd->add_option("--terrain-cols", args->csv.terrain_columns,
                   "columns of the terrain z observed before the command (optional)")
       ->delimiter(',');
+  cmd->add_option("--continuous-cols", args->csv.continuous_command_columns,
+                  "continuous command columns (e.g. vx,wz): conditioning dimensions stored first "
+                  "in z, so models give p(x | command, z) for any value (optional)")
+      ->delimiter(',');
   cmd->add_option("--delimiter", args->delimiter, "field separator: , ; tab | space")
       ->capture_default_str();
   cmd->add_flag("--drop-invalid", args->csv.drop_invalid,

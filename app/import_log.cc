@@ -68,6 +68,18 @@ void ReportProblems(const LogImportSummary& summary, const std::string& commands
                summary.unmatched_commands.size(), commands_path.c_str(), list.c_str());
 }
 
+nlohmann::json ContinuousJson(const LogImportSummary& summary) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& c : summary.continuous) {
+    out.push_back({{"column", c.name},
+                   {"min", c.min},
+                   {"max", c.max},
+                   {"spread_of_window_averages", c.spread},
+                   {"median_variation_inside_window", c.median_within}});
+  }
+  return out;
+}
+
 nlohmann::json ImportJson(const SampleSet& set, const LogImportSummary& summary,
                           const std::string& output) {
   return {{"output", output},
@@ -95,6 +107,7 @@ nlohmann::json ImportJson(const SampleSet& set, const LogImportSummary& summary,
           {"min_duration_s", summary.min_duration_s},
           {"time_tolerance_s", summary.time_tolerance_s},
           {"warnings", summary.warnings},
+          {"continuous_commands", ContinuousJson(summary)},
           {"unmatched_commands", summary.unmatched_commands}};
 }
 
@@ -112,6 +125,7 @@ void Run(const ImportLogArgs& args) {
   }
   std::printf("imported %s\n", summary.BriefReport().c_str());
   std::printf("%s\n", summary.WindowReport().c_str());
+  if (const std::string c = summary.ContinuousReport(); !c.empty()) std::printf("%s\n", c.c_str());
   std::printf("%s:", Plural(set.num_commands(), "command").c_str());
   for (const auto& label : set.command_labels) std::printf(" [%s]", label.c_str());
   std::printf("\nwrote %s\n", args.output.c_str());
@@ -126,6 +140,12 @@ void AddStreamFlags(CLI::App* cmd, ImportLogArgs* args) {
       ->required();
   cmd->add_option("--command-cols", o.commands.columns,
                   "command columns (comma-separated; numbers, or text taken as labels)")
+      ->delimiter(',');
+  cmd->add_option("--continuous-cols", o.continuous_columns,
+                  "continuous command columns of the command stream (e.g. vx,vy,wz): not cut "
+                  "into commands; each window keeps their time average as leading conditioning "
+                  "dimensions of z, so models give p(x | command, z) for any value (needs "
+                  "--window)")
       ->delimiter(',');
   cmd->add_option("--pose", o.pose.path,
                   "pose stream in a fixed frame (e.g. map/odom): a CSV file, folder or glob; "

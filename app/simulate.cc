@@ -91,8 +91,10 @@ void SetupSimulate(CLI::App& root) {
                   "docs/simulation.md and --print-config)");
   cmd->add_option("--protocol", args->protocol,
                   "paper (26 commands x 3 headings x 5 = 390 samples), paper-830 (166 random "
-                  "placements x 5 = 830) or trajectories (100 random placements, each a sequence of "
-                  "--executions random commands: for checking predictions)")
+                  "placements x 5 = 830), trajectories (100 random placements, each a sequence of "
+                  "--executions random commands: for checking predictions) or continuous (166 "
+                  "random placements x 5 commands drawn uniformly from [-0.5, 0.5]^3, stored as "
+                  "the conditioning dimensions cmd_long, cmd_lat, cmd_turn of z)")
       ->capture_default_str();
   cmd->add_option("--seed", args->seed, "Random seed: same seed, same file")->capture_default_str();
   cmd->add_option("-o,--output", args->output, "Sample set to write (.h5)");

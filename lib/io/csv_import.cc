@@ -59,7 +59,10 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options,
   std::set<std::string> used;
   const auto command_idx = FindColumns(options.command_columns, table, &used);
   const auto pose_idx = FindColumns(options.pose_columns, table, &used);
-  const auto terrain_idx = FindColumns(options.terrain_columns, table, &used);
+  std::vector<std::string> conditioning = options.continuous_command_columns;
+  conditioning.insert(conditioning.end(), options.terrain_columns.begin(),
+                      options.terrain_columns.end());
+  const auto terrain_idx = FindColumns(conditioning, table, &used);
   std::vector<int> episode_idx;
   if (!options.episode_column.empty()) {
     episode_idx = FindColumns({options.episode_column}, table, &used);
@@ -163,7 +166,11 @@ SampleSet ImportCsv(const std::string& path, const CsvImportOptions& options,
   set.x_names = options.pose_columns;
   if (dz > 0) {
     set.z = Eigen::Map<RowMatrix>(zs.data(), n, dz);
-    set.z_names = options.terrain_columns;
+    set.z_names = conditioning;
+  }
+  if (!options.continuous_command_columns.empty()) {
+    set.metadata["continuous_command_columns"] =
+        std::to_string(options.continuous_command_columns.size());
   }
   if (!episodes.empty()) {
     set.episode = Eigen::Map<Eigen::VectorXi>(episodes.data(), n);

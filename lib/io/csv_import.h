@@ -12,6 +12,10 @@ struct CsvImportOptions {
   std::vector<std::string> command_columns;  // empty: a single command
   std::vector<std::string> pose_columns;     // required, >= 1
   std::vector<std::string> terrain_columns;  // optional
+  // Continuous command columns (e.g. vx, yaw rate): conditioning dimensions like the terrain,
+  // stored first in z (before terrain_columns) and counted in the set's metadata
+  // "continuous_command_columns", so models give p(x | command, z) for any value.
+  std::vector<std::string> continuous_command_columns;
   std::string episode_column;                // optional; step = order within the episode
   bool standardize = false;                  // store x||z standardised plus the transform
   std::string source = "csv";

@@ -85,6 +85,7 @@ struct CommandRows {
   std::vector<std::string> label;
   std::vector<int> episode;
   std::vector<std::vector<std::string>> text;  // per row, per column: the label text or ""
+  std::vector<std::vector<double>> continuous;  // per row, the continuous command columns (SI)
 };
 
 // What all trials share about the command columns: which are numeric (decided by the first file)
@@ -136,6 +137,14 @@ CommandRows ReadCommands(const std::string& path, const LogImportOptions& o, Com
                                    : "text labels here but numbers in an earlier file");
     }
   }
+  std::vector<int> continuous_cols;
+  for (const std::string& name : o.continuous_columns) {
+    continuous_cols.push_back(table.Column(name));
+    if (!table.IsNumericColumn(continuous_cols.back())) {
+      throw MakeInputError(path, "column '" + name + "'",
+                           "a continuous command column must hold numbers");
+    }
+  }
   CommandRows out;
   out.path = path;
   for (size_t i = 0; i < table.records.size(); ++i) {
@@ -145,6 +154,11 @@ CommandRows ReadCommands(const std::string& path, const LogImportOptions& o, Com
       const double t = RowTime(table, r, i, time_col, s, path, Unit(o, s.time_column), out.t);
       std::vector<std::string> text;
       std::vector<double> key = RowKey(table, r, cols, o, path, shared, &text);
+      std::vector<double> continuous;
+      for (size_t j = 0; j < continuous_cols.size(); ++j) {
+        continuous.push_back(table.Number(r, continuous_cols[j]) *
+                             Unit(o, o.continuous_columns[j]));
+      }
       int episode = 0;
       if (episode_col >= 0) {
         const double e = table.Number(r, episode_col);
@@ -158,6 +172,7 @@ CommandRows ReadCommands(const std::string& path, const LogImportOptions& o, Com
       out.t.push_back(t);
       out.key.push_back(std::move(key));
       out.text.push_back(std::move(text));
+      out.continuous.push_back(std::move(continuous));
       out.episode.push_back(episode);
     } catch (const InputError& e) {
       invalid->Handle(path, e.what());
@@ -192,8 +207,9 @@ void KeyCommands(const LogImportOptions& o, const CommandColumns& shared,
       warnings->push_back("command column '" + o.commands.columns[j] + "' has " +
                           std::to_string(distinct.size()) + " distinct values in " +
                           std::to_string(values.size()) +
-                          " rows: continuous values? bin them with --bins N (quantiles; zero is "
-                          "its own command) or --bin-edges");
+                          " rows: continuous values? keep them as they are with --continuous-cols "
+                          "and --window, or bin them with --bins N (quantiles; zero is its own "
+                          "command) or --bin-edges");
     }
   }
   for (CommandRows& c : *trials) {
@@ -236,11 +252,44 @@ struct SampleSink {
   std::vector<double> xs, zs, durations;
   std::vector<int> command, episode, step;
   std::set<std::string> used_labels;
+  // Per continuous command column: each window's time average and its variation inside.
+  std::vector<std::vector<double>> continuous_mean, continuous_within;
 
   // The pose change over [t0, t1] in the body frame at t0 (and the terrain at t0) for `row`.
   void Add(const CommandRows& c, size_t row, const TrialStreams& s, double t0, double t1,
            int episode_id, int step_in_episode, bool per_second);
+  // The continuous command columns' time averages over [t0, t1] (first conditioning dimensions
+  // of z) and their variation inside the window; the command row in force at t0 is `row` or
+  // later (rows hold until the next).
+  void AddContinuous(const CommandRows& c, size_t row, double t0, double t1);
 };
+
+void SampleSink::AddContinuous(const CommandRows& c, size_t row, double t0, double t1) {
+  const size_t dims = c.continuous.empty() ? 0 : c.continuous[0].size();
+  if (dims == 0) return;
+  continuous_mean.resize(dims);
+  continuous_within.resize(dims);
+  while (row + 1 < c.t.size() && c.t[row + 1] <= t0) ++row;
+  // sum w v and sum w v^2 over the rows in force, w the time each holds inside [t0, t1].
+  std::vector<double> sum(dims, 0.0), sum2(dims, 0.0);
+  double total = 0;
+  for (size_t i = row; i < c.t.size() && (i == row || c.t[i] < t1); ++i) {
+    const double hi = i + 1 < c.t.size() ? std::min(c.t[i + 1], t1) : t1;
+    const double w = std::max(0.0, hi - std::max(c.t[i], t0));
+    for (size_t j = 0; j < dims; ++j) {
+      sum[j] += w * c.continuous[i][j];
+      sum2[j] += w * c.continuous[i][j] * c.continuous[i][j];
+    }
+    total += w;
+  }
+  for (size_t j = 0; j < dims; ++j) {
+    const double mean = total > 0 ? sum[j] / total : c.continuous[row][j];
+    const double var = total > 0 ? std::max(0.0, sum2[j] / total - mean * mean) : 0.0;
+    zs.push_back(mean);
+    continuous_mean[j].push_back(mean);
+    continuous_within[j].push_back(std::sqrt(var));
+  }
+}
 
 void SampleSink::Add(const CommandRows& c, size_t row, const TrialStreams& s, double t0, double t1,
                      int episode_id, int step_in_episode, bool per_second) {
@@ -254,6 +303,7 @@ void SampleSink::Add(const CommandRows& c, size_t row, const TrialStreams& s, do
   if (per_second) {
     for (size_t i = first; i < xs.size(); ++i) xs[i] /= std::max(duration, 1e-12);
   }
+  AddContinuous(c, row, t0, t1);
   if (s.has_attitude) {
     const auto ba = Bracket(s.attitude.t, t0);
     for (const auto& column : s.attitude.values)
@@ -424,6 +474,7 @@ void CheckUnits(const LogImportOptions& o) {
   std::set<std::string> known = {o.commands.time_column, o.pose.time_column, o.episode_column};
   for (const auto* s : {&o.commands, &o.pose, &o.attitude})
     known.insert(s->columns.begin(), s->columns.end());
+  known.insert(o.continuous_columns.begin(), o.continuous_columns.end());
   if (!o.attitude.path.empty()) known.insert(o.attitude.time_column);
   for (const auto& [column, factor] : o.units) {
     if (!known.count(column)) {
@@ -453,8 +504,18 @@ SampleSet Assemble(SampleSink& sink, const LogImportOptions& o, const std::vecto
     set.x_names = {"dx", "dy", "dyaw"};
     set.x_units = {"m" + rate, "m" + rate, "rad" + rate};
   }
+  const int continuous_dims = static_cast<int>(o.continuous_columns.size());
+  for (const std::string& name : o.continuous_columns) {
+    set.z_names.push_back(name);
+    set.z_units.push_back(o.units.count(name) ? "SI" : "as logged");
+  }
+  if (continuous_dims > 0) {
+    set.metadata["continuous_command_columns"] = std::to_string(continuous_dims);
+  }
+  if (terrain_dims + continuous_dims > 0) {
+    set.z = Eigen::Map<RowMatrix>(sink.zs.data(), n, terrain_dims + continuous_dims);
+  }
   if (terrain_dims > 0) {
-    set.z = Eigen::Map<RowMatrix>(sink.zs.data(), n, terrain_dims);
     // "pitch_deg" converted to radians is stored as "pitch".
     for (const std::string& name : o.attitude.columns) {
       std::string stored = name;
@@ -466,7 +527,7 @@ SampleSet Assemble(SampleSink& sink, const LogImportOptions& o, const std::vecto
       }
       set.z_names.push_back(stored);
     }
-    set.z_units.assign(terrain_dims, "rad");
+    set.z_units.resize(continuous_dims + terrain_dims, "rad");
   }
   set.episode = Eigen::Map<Eigen::VectorXi>(sink.episode.data(), n);
   set.step = Eigen::Map<Eigen::VectorXi>(sink.step.data(), n);
@@ -514,6 +575,15 @@ bool LogImportOptions::IsValid(std::string* error) const {
   if (!(time_tolerance_s >= 0) || !std::isfinite(time_tolerance_s)) {
     return fail("--time-tolerance: expected seconds >= 0");
   }
+  if (!continuous_columns.empty() && window_s <= 0) {
+    return fail("--continuous-cols: needs --window S (each window keeps the commands' average)");
+  }
+  for (const std::string& name : continuous_columns) {
+    if (std::find(commands.columns.begin(), commands.columns.end(), name) !=
+        commands.columns.end()) {
+      return fail("--continuous-cols: '" + name + "' is also a --command-cols column");
+    }
+  }
   if (window_s > 0 && 2 * time_tolerance_s >= window_s) {
     return fail(
         "--time-tolerance: must be shorter than half the --window (it applies at each end)");
@@ -555,6 +625,33 @@ std::string LogImportSummary::WindowReport() const {
            FormatNumber(0.5 * largest_near_miss_s * 1.01) + ")";
   }
   return out;
+}
+
+std::string LogImportSummary::ContinuousReport() const {
+  std::string out;
+  for (const ContinuousColumn& c : continuous) {
+    out += (out.empty() ? "" : "\n") + std::string("continuous command ") + c.name + ": " +
+           FormatNumber(c.min) + " to " + FormatNumber(c.max) + ", window averages spread " +
+           FormatNumber(c.spread) + " (standard deviation), variation inside a window " +
+           FormatNumber(c.median_within) + " (median standard deviation)";
+  }
+  return out;
+}
+
+// Range and spread of each continuous column's window averages and the median variation inside.
+void SummariseContinuous(const LogImportOptions& o, const SampleSink& sink,
+                         LogImportSummary* summary) {
+  for (size_t j = 0; j < sink.continuous_mean.size(); ++j) {
+    const std::vector<double>& m = sink.continuous_mean[j];
+    LogImportSummary::ContinuousColumn c;
+    c.name = o.continuous_columns[j];
+    const auto [lo, hi] = std::minmax_element(m.begin(), m.end());
+    c.min = *lo, c.max = *hi;
+    const Eigen::Map<const Eigen::ArrayXd> a(m.data(), static_cast<Eigen::Index>(m.size()));
+    c.spread = m.size() > 1 ? std::sqrt((a - a.mean()).square().sum() / (a.size() - 1.0)) : 0.0;
+    c.median_within = Median(sink.continuous_within[j]);
+    summary->continuous.push_back(c);
+  }
 }
 
 SampleSet ImportLog(const LogImportOptions& o, LogImportSummary* summary_out) {
@@ -610,12 +707,14 @@ SampleSet ImportLog(const LogImportOptions& o, LogImportSummary* summary_out) {
     if (!sink.used_labels.count(label)) summary.unmatched_commands.push_back(label);
   }
   CheckDurations(sink.durations, o, ts, &summary);
+  if (summary.samples > 0) SummariseContinuous(o, sink, &summary);
   if (summary_out) *summary_out = summary;
   if (summary.samples == 0) {
     throw MakeInputError(trials[0].commands, "",
                          "no samples: every command segment was shorter than " +
                              FormatNumber(summary.min_duration_s) +
-                             " s (continuous commands need --bins) (" + summary.WindowReport() +
+                             " s (continuous commands: --continuous-cols with --window, or --bins) (" +
+                             summary.WindowReport() +
                              ")");
   }
   SampleSet set =

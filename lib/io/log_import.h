@@ -48,6 +48,11 @@ struct LogImportOptions {
   // Numeric command columns binned into a few commands (io/command_bins.h; a zero is its own
   // command). bins.bins == 0 and no edges: every distinct value is a command.
   CommandBinOptions bins;
+  // Continuous command columns of the command stream (e.g. vx, vy, yaw rate sent at 10-50 Hz):
+  // not cut into commands; each sample keeps their time average over its window (zero-order
+  // hold) as leading conditioning dimensions of z, before the attitude, so that models give
+  // p(x | command, z) for any command value (docs/log-import.md). Needs window_s > 0.
+  std::vector<std::string> continuous_columns;
   // Divide each pose change by its window's duration (rates, m/s and rad/s): for samples of
   // unequal duration (e.g. one sample per command segment).
   bool per_second = false;
@@ -83,9 +88,19 @@ struct LogImportSummary {
   double min_window_s = 0, median_window_s = 0, max_window_s = 0;
   std::vector<std::string> unmatched_commands;  // in the command stream but in no sample
   std::vector<std::string> warnings;  // e.g. continuous commands without --bins, unequal durations
+  // Per continuous command column: the spread (standard deviation) of the window averages, and
+  // the median over windows of the variation inside a window (time-weighted standard deviation).
+  struct ContinuousColumn {
+    std::string name;
+    double min = 0, max = 0, spread = 0, median_within = 0;
+  };
+  std::vector<ContinuousColumn> continuous;
   std::string BriefReport() const;
   // "windows: 187 kept; dropped: ..." by reason, one line.
   std::string WindowReport() const;
+  // One line per continuous command column: range, spread of the window averages and the
+  // variation inside windows; empty without continuous columns.
+  std::string ContinuousReport() const;
 };
 
 // Throws InputError naming file, line and column for bad input (unless drop_invalid for bad

@@ -22,6 +22,7 @@ constexpr double kPi = 3.14159265358979323846;
 struct Placement {
   int command = 0;
   std::vector<int> sequence;  // kTrajectories: the command of each execution (else `command` repeats)
+  std::vector<Eigen::Vector3d> values;  // kContinuous: the command of each execution
   double heading_rad = 0;  // slope frame, 0 = facing uphill
   double x_m = 0, y_m = 0;
 };
@@ -72,6 +73,19 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
       p.y_m = position(rng);
       plan.push_back(p);
     }
+  } else if (options.protocol == Protocol::kContinuous) {
+    const int total = options.placements > 0 ? options.placements : 166;
+    std::uniform_real_distribution<double> heading(-kPi, kPi), level(-0.5, 0.5);
+    for (int i = 0; i < total; ++i) {
+      Placement p;
+      p.heading_rad = heading(rng);
+      p.x_m = position(rng);
+      p.y_m = position(rng);
+      for (int r = 0; r < options.executions_per_placement; ++r) {
+        p.values.emplace_back(level(rng), level(rng), level(rng));
+      }
+      plan.push_back(p);
+    }
   } else if (options.protocol == Protocol::kTrajectories) {
     const int total = options.placements > 0 ? options.placements : 100;
     std::uniform_real_distribution<double> heading(-kPi, kPi);
@@ -119,13 +133,20 @@ Pose TrackerReading(const Pose& truth, const NoiseConfig& noise, std::mt19937_64
 }  // namespace
 
 std::string ProtocolName(Protocol protocol) {
-  return protocol == Protocol::kPaper ? "paper" : protocol == Protocol::kPaper830 ? "paper-830" : "trajectories";
+  switch (protocol) {
+    case Protocol::kPaper: return "paper";
+    case Protocol::kPaper830: return "paper-830";
+    case Protocol::kTrajectories: return "trajectories";
+    case Protocol::kContinuous: return "continuous";
+  }
+  return "paper";
 }
 
 Protocol ParseProtocol(const std::string& name) {
   if (name == "paper") return Protocol::kPaper;
   if (name == "paper-830") return Protocol::kPaper830;
   if (name == "trajectories") return Protocol::kTrajectories;
+  if (name == "continuous") return Protocol::kContinuous;
   throw MakeInputError("", "--protocol", "expected paper, paper-830 or trajectories, got \"" + name + "\"");
 }
 
@@ -163,14 +184,15 @@ namespace {
 
 // The command (long, lat, turn) of every placement, or of every execution of a sequence.
 Eigen::MatrixXd CommandsPlanned(const std::vector<Placement>& plan, const Eigen::MatrixXd& table) {
-  std::vector<int> ids;
+  std::vector<Eigen::Vector3d> used;
   for (const Placement& p : plan) {
-    if (p.sequence.empty()) ids.push_back(p.command);
-    ids.insert(ids.end(), p.sequence.begin(), p.sequence.end());
+    if (p.sequence.empty() && p.values.empty()) used.push_back(table.row(p.command).transpose());
+    for (int id : p.sequence) used.push_back(table.row(id).transpose());
+    used.insert(used.end(), p.values.begin(), p.values.end());
   }
-  Eigen::MatrixXd used(static_cast<int>(ids.size()), table.cols());
-  for (int k = 0; k < used.rows(); ++k) used.row(k) = table.row(ids[k]);
-  return used;
+  Eigen::MatrixXd out(static_cast<int>(used.size()), 3);
+  for (int k = 0; k < out.rows(); ++k) out.row(k) = used[k].transpose();
+  return out;
 }
 
 // Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
@@ -188,6 +210,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   std::vector<int> command, episode, step;
   std::vector<Eigen::Matrix<double, 6, 1>> xs;
   std::vector<Eigen::Vector2d> zs;
+  std::vector<Eigen::Vector3d> values;  // the command of each sample (continuous protocol)
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::normal_distribution<double> unit(0.0, 1.0);
   SimSummary sum;
@@ -204,7 +227,8 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       std::vector<Eigen::Vector2d> pz;
       for (int r = 0; r < reps && !fell; ++r) {
         const int id = where.sequence.empty() ? where.command : where.sequence[r];
-        const Eigen::Vector3d c = set.commands.row(id).transpose();
+        const Eigen::Vector3d c =
+            where.values.empty() ? Eigen::Vector3d(set.commands.row(id).transpose()) : where.values[r];
         const Eigen::Vector2d z_true = sim.TruePitchRoll();
         pz.emplace_back(z_true[0] + config.noise.imu_pitch_sd_rad * unit(rng),
                         z_true[1] + config.noise.imu_roll_sd_rad * unit(rng));
@@ -224,6 +248,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
         step.push_back(r);
         xs.push_back(px[r]);
         zs.push_back(pz[r]);
+        if (!where.values.empty()) values.push_back(where.values[r]);
       }
     }
     if (!kept) ++sum.abandoned_placements;
@@ -246,6 +271,14 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   set.x_units = {"m", "m", "m", "rad", "rad", "rad"};
   set.z_names = {"pitch", "roll"};
   set.z_units = {"rad", "rad"};
+  if (!values.empty()) {  // continuous commands: the first conditioning dimensions of z
+    Eigen::MatrixXd z(n, 5);
+    for (int i = 0; i < n; ++i) z.row(i) << values[i].transpose(), set.z.row(i);
+    set.z = z;
+    set.z_names = {"cmd_long", "cmd_lat", "cmd_turn", "pitch", "roll"};
+    set.z_units = {"command", "command", "command", "rad", "rad"};
+    set.metadata["continuous_command_columns"] = "3";
+  }
   set.source = "sim";
 
   sum.samples = n;
@@ -285,6 +318,10 @@ SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& optio
   SampleSet set;
   FillCommandTable(&set);
   const std::vector<Placement> plan = PlanPlacements(options, set.num_commands(), rng);
+  if (options.protocol == Protocol::kContinuous) {  // one command: the values are in z
+    set.commands = Eigen::MatrixXd::Zero(1, 3);
+    set.command_labels = {"velocity"};
+  }
   RunPlan(config, options, plan, rng, progress, summary, edit, &set);
   return set;
 }

@@ -23,9 +23,16 @@ enum class Protocol {
   // uniformly random heading and position, each running a sequence of executions_per_placement
   // commands drawn uniformly (with replacement) from the 26; episode = placement, step = its index.
   kTrajectories,
+  // Continuous commands (issue #25): 166 placements at uniformly random heading and position,
+  // each running executions_per_placement commands drawn uniformly from [-0.5, 0.5]^3 (long,
+  // lat, turn); one command-table row "velocity", and the command values stored as the first
+  // three conditioning dimensions of z (cmd_long, cmd_lat, cmd_turn, then pitch, roll), so that
+  // models give p(x | command, z) for any command in the range.
+  kContinuous,
 };
 
-// "paper" / "paper-830" / "trajectories"; ParseProtocol throws InputError for anything else.
+// "paper" / "paper-830" / "trajectories" / "continuous"; ParseProtocol throws InputError for
+// anything else.
 std::string ProtocolName(Protocol protocol);
 Protocol ParseProtocol(const std::string& name);
 

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <tuple>
 
 #include "core_test_utils.h"
 #include "util/error.h"
@@ -68,6 +69,54 @@ TEST(MotionModelTest, LikelihoodsFollowMarginalAndConditional) {
   // Eq. 15: p(x | c, z) = p(x, z | c) / p(z | c).
   EXPECT_NEAR(model.LogLikelihood(2, x, z), m.LogDensity(y) - m.Marginal({2}).LogDensity(z), kTol);
   EXPECT_EQ(model.Conditional(2, z).dim(), 2);
+}
+
+// Issue #25: a continuous command is a conditioning dimension like the terrain. A DGMM learnt
+// on x (1-D) given z = (command value, pitch), with x bimodal around 2 c + 0.5 pitch, gives
+// log p(x | c, pitch) equal to the brute-force conditional log p(x, c, pitch) -
+// log integral p(x', c, pitch) dx' (trapezoid rule on a fine grid, which converges exponentially
+// for Gaussian integrands) to 1e-9, at command values inside and between the ones seen.
+TEST(MotionModelTest, ConditioningOnAContinuousCommandEqualsTheNumericalConditional) {
+  std::mt19937_64 rng(25);
+  const int n = 600;
+  SampleSet set;
+  set.commands = Eigen::MatrixXd::Zero(1, 0);
+  set.command_labels = {"velocity"};
+  set.command = Eigen::VectorXi::Zero(n);
+  set.x.resize(n, 1);
+  set.z.resize(n, 2);
+  set.x_names = {"dx"};
+  set.z_names = {"cmd_v", "pitch"};
+  set.metadata["continuous_command_columns"] = "1";
+  std::uniform_real_distribution<double> command(-0.5, 0.5);
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < n; ++i) {
+    const double c = command(rng), pitch = 0.1 * normal(rng);
+    set.z.row(i) << c, pitch;
+    set.x(i, 0) = 2 * c + 0.5 * pitch + (i % 2 ? 0.3 : -0.3) + 0.05 * normal(rng);
+  }
+  ASSERT_EQ(set.Validate(), "");
+  MotionModelOptions options;
+  options.dgmm.k = 0.05;  // several components
+  const MotionModel model = LearnMotionModel(set, options);
+  const Mixture& joint = model.MixtureFor(0);
+  ASSERT_GE(joint.size(), 2);
+  for (const auto& [c, pitch, x] : std::vector<std::tuple<double, double, double>>{
+           {0.25, 0.0, 0.8}, {-0.4, 0.1, -1.1}, {0.013, -0.05, 0.3}, {0.5, 0.2, 0.7}}) {
+    const Eigen::Vector2d z(c, pitch);
+    const double analytic = model.LogLikelihood(0, Eigen::VectorXd::Constant(1, x), z);
+    // The integral of the joint over x' in [-6, 6] (the joint is negligible beyond), step 1e-3.
+    auto log_joint = [&](double xp) { return joint.LogDensity(Eigen::Vector3d(xp, c, pitch)); };
+    const double peak = log_joint(x);
+    double integral = 0;
+    const double h = 1e-3;
+    for (int k = 0; k <= 12000; ++k) {
+      const double w = (k == 0 || k == 12000) ? 0.5 : 1.0;
+      integral += w * std::exp(log_joint(-6 + k * h) - peak);
+    }
+    const double numeric = log_joint(x) - (peak + std::log(integral * h));
+    EXPECT_NEAR(analytic, numeric, 1e-9) << "c " << c << " pitch " << pitch << " x " << x;
+  }
 }
 
 TEST(MotionModelTest, UnknownOrEmptyCommandIsAClearError) {

@@ -202,6 +202,63 @@ TEST(LogImport, ContinuousCommandsBinned) {
   EXPECT_GT(s.commands(0, 0), s.commands(1, 0));  // the fast bin first (it came first)
 }
 
+// Continuous commands stay continuous: a speed ramp logged at 10 Hz (zero-order hold) next to
+// the mode labels. Each 0.5 s window keeps the speed's time average as the first conditioning
+// dimension of z (before pitch and roll), the modes still cut segments, and the summary reports
+// the spread of the window averages and the variation inside windows.
+TEST(LogImport, ContinuousCommandsKeptAsTimeAveragesInZ) {
+  const PlanarLog log = WritePlanarLog("continuous");
+  std::ostringstream out;
+  out << "time,mode,speed\n";
+  for (int i = 0; i < 40; ++i) {
+    const double t = 0.1 * i;
+    out << t << "," << (t < 2 - 1e-9 ? "fwd" : "turn") << "," << 0.05 * i << "\n";
+  }
+  test::WriteText(log.commands, out.str());
+  LogImportOptions o = PlanarOptions(log);
+  o.continuous_columns = {"speed"};
+  o.window_s = 0.5;
+  LogImportSummary summary;
+  const SampleSet s = ImportLog(o, &summary);
+  ASSERT_EQ(s.Validate(), "");
+  ASSERT_EQ(s.size(), 8);
+  EXPECT_EQ(s.num_commands(), 2);  // the modes; the speed is not a command
+  ASSERT_EQ(s.terrain_dim(), 3);
+  EXPECT_EQ(s.z_names, (std::vector<std::string>{"speed", "pitch", "roll"}));
+  EXPECT_EQ(s.metadata.at("continuous_command_columns"), "1");
+  // Window w covers [0.5 w, 0.5 (w + 1)): rows 5w .. 5w + 4 hold 0.1 s each, speed 0.05 i,
+  // so the average is 0.05 (5w + 2).
+  for (int w = 0; w < 8; ++w) {
+    EXPECT_NEAR(s.z(w, 0), 0.05 * (5 * w + 2), 1e-9) << "window " << w;
+    EXPECT_NEAR(s.z(w, 1), 10 * kDeg, kTol);
+  }
+  ASSERT_EQ(summary.continuous.size(), 1u);
+  const auto& c = summary.continuous[0];
+  EXPECT_NEAR(c.min, 0.1, 1e-9);
+  EXPECT_NEAR(c.max, 0.05 * 37, 1e-9);
+  // Inside a window: five equally held values 0.05 apart, standard deviation 0.05 sqrt(2).
+  EXPECT_NEAR(c.median_within, 0.05 * std::sqrt(2.0), 1e-9);
+  EXPECT_NE(summary.ContinuousReport().find("speed"), std::string::npos);
+
+  std::string error;
+  o.window_s = 0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("--window"), std::string::npos) << error;
+  o.window_s = 0.5;
+  o.continuous_columns = {"mode"};
+  o.commands.columns = {};
+  try {
+    ImportLog(o);
+    ADD_FAILURE() << "a text column taken as a continuous command";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'mode'"), std::string::npos) << e.what();
+  }
+  o.continuous_columns = {"speed"};
+  o.commands.columns = {"speed"};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("also a --command-cols"), std::string::npos) << error;
+}
+
 TEST(LogImport, InvalidRowsRefusedWithLineOrDroppedAndCounted) {
   const PlanarLog log = WritePlanarLog("invalid");
   std::string text;

@@ -122,6 +122,42 @@ TEST(ProtocolTest, TrajectoriesRunASequenceOfCommandsPerPlacement) {
   EXPECT_EQ(set.metadata.at("protocol"), "trajectories");
 }
 
+// Issue #25: continuous commands drawn uniformly from [-0.5, 0.5]^3, one "velocity" command, the
+// values stored as the first three conditioning dimensions of z; and the robot really follows
+// them (the turn command's sign is the yaw change's).
+TEST(ProtocolTest, ContinuousCommandsAreConditioningDimensions) {
+  ProtocolOptions o;
+  o.protocol = ParseProtocol("continuous");
+  EXPECT_EQ(ProtocolName(o.protocol), "continuous");
+  o.seed = 5;
+  o.placements = 4;
+  o.executions_per_placement = 3;
+  const SampleSet set = SimulateProtocol(SimConfig{}, o);
+  ASSERT_EQ(set.Validate(), "");
+  ASSERT_EQ(set.size(), 12);
+  EXPECT_EQ(set.command_labels, std::vector<std::string>{"velocity"});
+  ASSERT_EQ(set.terrain_dim(), 5);
+  EXPECT_EQ(set.z_names,
+            (std::vector<std::string>{"cmd_long", "cmd_lat", "cmd_turn", "pitch", "roll"}));
+  EXPECT_EQ(set.metadata.at("continuous_command_columns"), "3");
+  std::set<double> distinct;
+  int turns_followed = 0, strong_turns = 0;
+  for (int i = 0; i < set.size(); ++i) {
+    for (int j = 0; j < 3; ++j) {
+      EXPECT_GE(set.z(i, j), -0.5);
+      EXPECT_LE(set.z(i, j), 0.5);
+      distinct.insert(set.z(i, j));
+    }
+    if (std::abs(set.z(i, 2)) > 0.2) {
+      ++strong_turns;
+      turns_followed += (set.z(i, 2) > 0) == (set.x(i, 5) > 0);
+    }
+  }
+  EXPECT_EQ(distinct.size(), 36u);  // every value drawn anew
+  EXPECT_GT(strong_turns, 0);
+  EXPECT_EQ(turns_followed, strong_turns);
+}
+
 TEST(ProtocolTest, ParsesNamesAndRejectsBadOptions) {
   EXPECT_EQ(ParseProtocol("paper"), Protocol::kPaper);
   EXPECT_EQ(ParseProtocol("paper-830"), Protocol::kPaper830);
