@@ -2,6 +2,7 @@
 // pose distribution after each command (lib/predict/predict.h), as JSON and a table.
 #include <cmath>
 #include <cstdio>
+#include <fmt/format.h>
 #include <fstream>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -116,6 +117,29 @@ void WriteFigure(const predict::Prediction& p, const PredictArgs& args) {
   RenderHeatMap(TrajectoryFan(steps, Eigen::Vector2d(args.start[0], args.start[1]), title), args.figure);
 }
 
+// One warning line per step whose conditioning value (terrain, continuous commands) lies where
+// the training data are thin: fewer than 1% of the samples near it that lie near the densest
+// point of the data (MotionModel::SamplesNear): the prediction extrapolates there.
+void WarnWhereDataIsThin(const MotionModel& model, const std::vector<int>& ids,
+                         const std::vector<Eigen::VectorXd>& z) {
+  constexpr double kThin = 0.01;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (z[k].size() == 0) continue;
+    double at_data = 0;
+    const double near = model.SamplesNear(ids[k], z[k], &at_data);
+    if (near >= kThin * at_data) continue;
+    std::string at;
+    for (int j = 0; j < model.terrain_dim; ++j) {
+      at += fmt::format("{}{}={:g}", j ? "," : "", model.terrain_names[j], z[k][j]);
+    }
+    std::fprintf(stderr,
+                 "dgmm: warning: predict: step %zu: %s is outside what command '%s' was trained "
+                 "on (about %.2g training samples near it, %.2g near the densest data; kernel of "
+                 "0.1 standard deviation per dimension): the prediction extrapolates\n",
+                 k + 1, at.c_str(), model.command_labels.at(ids[k]).c_str(), near, at_data);
+  }
+}
+
 void Run(const PredictArgs& args) {
   if (!args.figure.empty()) RequireDisplay();  // before any work or output
   for (const std::string& out : {args.output, args.figure}) {
@@ -126,6 +150,7 @@ void Run(const PredictArgs& args) {
   const std::vector<Eigen::VectorXd> z = ParseTerrain(model, args.terrain, ids.size());
   std::vector<predict::Step> steps;
   for (std::size_t k = 0; k < ids.size(); ++k) steps.push_back({ids[k], z[k]});
+  WarnWhereDataIsThin(model, ids, z);
   predict::PredictOptions options;
   options.trajectories = args.trajectories;
   options.seed = args.seed;

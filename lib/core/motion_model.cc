@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <numbers>
 #include <numeric>
 
 #include "core/data_scale.h"
@@ -107,6 +108,58 @@ Mixture MotionModel::RawPoseDistribution(int command, const Eigen::VectorXd& z) 
   if (transform.empty()) return m;
   const Eigen::VectorXd scale = transform.scale.head(pose_dim), offset = transform.offset.head(pose_dim);
   return m.Affine(scale.asDiagonal(), offset);
+}
+
+double MotionModel::SamplesNear(int command, const Eigen::VectorXd& z, double* at_data) const {
+  if (terrain_dim == 0) throw InputError("model: fitted without terrain; no z to be near");
+  if (z.size() != terrain_dim) {
+    throw InputError("z: " + std::to_string(z.size()) + " values, expected " + std::to_string(terrain_dim));
+  }
+  std::vector<int> dims(terrain_dim);
+  for (int d = 0; d < terrain_dim; ++d) dims[d] = pose_dim + d;
+  const Mixture marginal = MixtureFor(command).Marginal(dims);
+  const Eigen::VectorXd q =
+      transform.empty() ? z
+                        : Eigen::VectorXd((z - transform.offset.segment(pose_dim, terrain_dim))
+                                              .cwiseQuotient(transform.scale.segment(pose_dim, terrain_dim)));
+  // The marginal's mean and covariance: sum_k p_k (S_k + mu_k mu_k^T) - mu mu^T.
+  const double total = marginal.total_weight();
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(terrain_dim);
+  Eigen::MatrixXd second = Eigen::MatrixXd::Zero(terrain_dim, terrain_dim);
+  for (int k = 0; k < marginal.size(); ++k) {
+    const Gaussian& g = marginal.component(k);
+    const double p = marginal.weight(k) / total;
+    mean += p * g.mean();
+    second += p * (g.covariance() + g.mean() * g.mean().transpose());
+  }
+  const Eigen::VectorXd sd = (second - mean * mean.transpose()).diagonal().cwiseMax(0).cwiseSqrt();
+  Eigen::VectorXd h2(terrain_dim);
+  double log_kernel_scale = 0.5 * terrain_dim * std::log(2 * std::numbers::pi);
+  for (int j = 0; j < terrain_dim; ++j) {
+    const double h = std::max(0.1 * sd[j], 1e-12 * std::max(1.0, std::abs(mean[j])));
+    h2[j] = h * h;
+    log_kernel_scale += std::log(h);
+  }
+  std::vector<Gaussian> widened;
+  for (int k = 0; k < marginal.size(); ++k) {
+    Eigen::MatrixXd c = marginal.component(k).covariance();
+    c.diagonal() += h2;
+    widened.emplace_back(marginal.component(k).mean(), c);
+  }
+  auto near = [&](const Eigen::VectorXd& at) {
+    double sum = 0;
+    for (int k = 0; k < marginal.size(); ++k) {
+      sum += marginal.weight(k) * std::exp(widened[k].LogDensity(at) + log_kernel_scale);
+    }
+    return sum;
+  };
+  if (at_data) {
+    *at_data = 0;
+    for (int k = 0; k < marginal.size(); ++k) {
+      *at_data = std::max(*at_data, near(marginal.component(k).mean()));
+    }
+  }
+  return near(q);
 }
 
 MotionModelLearner::MotionModelLearner(MotionModel header, const MotionModelOptions& options)

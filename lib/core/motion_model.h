@@ -44,6 +44,14 @@ struct MotionModel {
   // standardisation: z standardised before conditioning, the mixture mapped back. InputError for
   // a z given to a model without terrain or of the wrong size.
   Mixture RawPoseDistribution(int command, const Eigen::VectorXd& z) const;
+  // How much training data lies near a conditioning value z (raw units; continuous commands and
+  // terrain): sum_k w_k E_k[exp(-1/2 |H^-1 (z' - z)|^2)], the kernel-weighted count of training
+  // samples around z under the command's marginal over z (weights are sample counts), with
+  // H = diag(0.1 sd_j), sd_j the marginal's standard deviation of z_j. Closed form:
+  // w_k (2 pi)^(d/2) det(H) N(z; mu_k, S_k + H^2). Near 0 outside the range the model saw.
+  // *at_data (if given): the same count at the densest of the components' means, the scale to
+  // compare with (small sets have few samples near any point).
+  double SamplesNear(int command, const Eigen::VectorXd& z, double* at_data = nullptr) const;
 };
 
 // Options for learning one DGMM per command from a sample set.

@@ -59,6 +59,23 @@ TEST(PredictCommand, TerrainPerStepConditionsEachStepOnItsOwn) {
   EXPECT_NE(ja["steps"][1]["mean"], jb["steps"][1]["mean"]);
 }
 
+// A conditioning value far outside the training data (the 390 set's pitch stays within about
+// +-0.35 rad on its 18-degree slope) draws one warning line naming it; one inside does not.
+TEST(PredictCommand, WarnsWhenTheTerrainOrCommandIsOutsideTheTrainingData) {
+  const auto dir = MakeTempDir("predict_thin");
+  const std::string model = (dir / "m.h5").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", SourcePath("datasets/scorpion_sim_390.h5").string(), "-o", model}).exit_code, 0);
+  const RunResult inside = RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--terrain", "pitch=0.3,roll=0",
+                                    "--trajectories", "50"});
+  ASSERT_EQ(inside.exit_code, 0) << inside.err;
+  EXPECT_EQ(inside.err.find("extrapolates"), std::string::npos) << inside.err;
+  const RunResult outside = RunDgmm({"predict", model, "--commands", "+0.5,0,0*2", "--terrain",
+                                     "pitch=0.3,roll=0;pitch=1.2,roll=0", "--trajectories", "50"});
+  ASSERT_EQ(outside.exit_code, 0) << outside.err;
+  EXPECT_NE(outside.err.find("step 2: pitch=1.2,roll=0 is outside"), std::string::npos) << outside.err;
+  EXPECT_EQ(outside.err.find("step 1:"), std::string::npos) << outside.err;
+}
+
 TEST(PredictCommand, TheFigureIsATrajectoryFanOrACleanErrorWithoutADisplay) {
   const auto dir = MakeTempDir("predict_fig");
   const std::string model = (dir / "m.h5").string(), png = (dir / "fan.png").string(), out = (dir / "p.json").string();

@@ -119,6 +119,41 @@ TEST(MotionModelTest, ConditioningOnAContinuousCommandEqualsTheNumericalConditio
   }
 }
 
+// SamplesNear counts the training samples around a conditioning value: where the model's
+// marginal fits the data (Gaussian commands and pitch) it agrees with the kernel-weighted count
+// over the training set itself, up to the count's sampling noise; far outside it is near zero.
+TEST(MotionModelTest, SamplesNearCountsTrainingDataAroundAConditioningValue) {
+  std::mt19937_64 rng(26);
+  const int n = 8000;
+  SampleSet set;
+  set.commands = Eigen::MatrixXd::Zero(1, 0);
+  set.command_labels = {"velocity"};
+  set.command = Eigen::VectorXi::Zero(n);
+  set.x.resize(n, 1);
+  set.z.resize(n, 2);
+  set.x_names = {"dx"};
+  set.z_names = {"cmd_v", "pitch"};
+  std::normal_distribution<double> normal;
+  for (int i = 0; i < n; ++i) {
+    set.z.row(i) << 0.2 * normal(rng), 0.1 * normal(rng);
+    set.x(i, 0) = 2 * set.z(i, 0) + 0.05 * normal(rng);
+  }
+  MotionModelOptions options;
+  options.dgmm.k = 5;  // one Gaussian, as the data are
+  const MotionModel model = LearnMotionModel(set, options);
+  const Eigen::Vector2d h(0.1 * 0.2, 0.1 * 0.1);  // 0.1 x the marginal's standard deviations
+  for (const Eigen::Vector2d q : {Eigen::Vector2d(0.0, 0.0), Eigen::Vector2d(0.15, 0.05)}) {
+    double count = 0;
+    for (int i = 0; i < n; ++i) {
+      count += std::exp(-0.5 * (set.z.row(i).transpose() - q).cwiseQuotient(h).squaredNorm());
+    }
+    EXPECT_GT(count, 25) << q.transpose();
+    EXPECT_NEAR(model.SamplesNear(0, q), count, 3 * std::sqrt(count)) << q.transpose();
+  }
+  EXPECT_LT(model.SamplesNear(0, Eigen::Vector2d(1.5, 0.0)), 1e-3);
+  EXPECT_THROW(model.SamplesNear(0, Eigen::VectorXd::Zero(3)), InputError);
+}
+
 TEST(MotionModelTest, UnknownOrEmptyCommandIsAClearError) {
   const MotionModel model = HandMadeModel();
   try {
