@@ -132,6 +132,15 @@ void BindModel(py::module_& m) {
                                return ids;
                              })
       .def("components", [](const MotionModel& model, int c) { return model.MixtureFor(c).size(); }, py::arg("command"))
+      .def("samples_near",
+           [](const MotionModel& model, int c, const Eigen::VectorXd& z) {
+             double at_data = 0;
+             const double near = model.SamplesNear(c, z, &at_data);
+             return std::make_pair(near, at_data);
+           },
+           py::arg("command"), py::arg("z"),
+           "(training samples near z, the same at the densest data): kernel-weighted counts under "
+           "the model's marginal of z (continuous commands and terrain), raw units")
       .def("score_samples", &ScoreSamples, py::arg("set"), "log p(x_i | c_i [, z_i]) per sample, raw units of x")
       .def("score", [](const MotionModel& model, const SampleSet& set) { return ScoreSampleSet(model, set).mean_log_likelihood; },
            py::arg("set"), "mean log-likelihood per sample")

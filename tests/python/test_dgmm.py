@@ -70,6 +70,17 @@ def test_terrain_is_conditioned_on():
         assert draws.mean() == pytest.approx(2 * z, abs=0.1)
 
 
+def test_samples_near_falls_outside_the_training_range():
+    rng = np.random.default_rng(2)
+    Z = rng.normal(0, 0.3, (800, 1))  # e.g. a continuous command
+    X = 2.0 * Z + rng.normal(0, 0.05, (800, 1))
+    model = dgmm.DGMM(seed=2).fit(X, None, Z)._model()
+    inside, at_data = model.samples_near(0, [0.0])
+    outside, _ = model.samples_near(0, [3.0])
+    assert inside > 0.5 * at_data > 0
+    assert outside < 1e-6 * at_data
+
+
 def test_predict_follows_the_commands():
     est = dgmm.DGMM(seed=1).fit(dgmm.SampleSet.read(SHIPPED))
     labels = est.model_.command_labels
