@@ -4,17 +4,7 @@
 #include <cassert>
 #include <cstring>
 
-// On x86-64 with GCC or Clang the two entry points are compiled twice, for the baseline and for
-// x86-64-v3 (AVX2 + FMA), and the loader picks the clone the CPU supports (ifunc); the fixed-size
-// kernels are inlined into each. Results may differ in the last bits between the two clones
-// (fused multiply-adds), never between runs on one machine.
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__)) && !defined(__SANITIZE_ADDRESS__)
-#define DGMM_EM_KERNEL __attribute__((target_clones("arch=x86-64-v3", "default")))
-#define DGMM_EM_INLINE __attribute__((always_inline)) inline
-#else
-#define DGMM_EM_KERNEL
-#define DGMM_EM_INLINE inline
-#endif
+#include "util/target_clones.h"
 
 namespace dgmm::em_internal {
 namespace {
@@ -23,7 +13,7 @@ namespace {
 // d x d upper triangular, column-major). D fixes d at compile time so that the loops over
 // dimensions unroll and the loop over samples vectorises.
 template <int D>
-DGMM_EM_INLINE void SquaredMahalanobisBlockFixed(const double* const* cols, Eigen::Index b, const double* U,
+DGMM_ALWAYS_INLINE void SquaredMahalanobisBlockFixed(const double* const* cols, Eigen::Index b, const double* U,
                                   const double* shift, double* __restrict m2) {
   const double* __restrict c[D];
   for (int a = 0; a < D; ++a) c[a] = cols[a];
@@ -61,7 +51,7 @@ DGMM_EM_INLINE void SquaredMahalanobisBlockFixed(const double* const* cols, Eige
 constexpr Eigen::Index kScatterBlock = 256;
 
 template <int D>
-DGMM_EM_INLINE void WeightedScatterFixed(const double* const* cols, Eigen::Index n,
+DGMM_ALWAYS_INLINE void WeightedScatterFixed(const double* const* cols, Eigen::Index n,
                                          const double* r, const double* mean, double* cov) {
   typedef double Lanes __attribute__((vector_size(4 * sizeof(double))));
   alignas(32) double centred[D][kScatterBlock];
@@ -102,7 +92,7 @@ DGMM_EM_INLINE void WeightedScatterFixed(const double* const* cols, Eigen::Index
 
 }  // namespace
 
-DGMM_EM_KERNEL void SquaredMahalanobisBlock(const double* const* cols, Eigen::Index b, int d,
+DGMM_TARGET_CLONES void SquaredMahalanobisBlock(const double* const* cols, Eigen::Index b, int d,
                                             const double* U,
                              const double* shift, double* m2) {
   switch (d) {
@@ -118,7 +108,7 @@ DGMM_EM_KERNEL void SquaredMahalanobisBlock(const double* const* cols, Eigen::In
   }
 }
 
-DGMM_EM_KERNEL void WeightedScatter(const double* const* cols, Eigen::Index n, int d,
+DGMM_TARGET_CLONES void WeightedScatter(const double* const* cols, Eigen::Index n, int d,
                                     const double* r,
                      const double* mean, double* cov) {
   switch (d) {

@@ -195,6 +195,44 @@ Eigen::MatrixXd CommandsPlanned(const std::vector<Placement>& plan, const Eigen:
   return out;
 }
 
+// The samples a plan recorded, in order.
+struct Recorded {
+  std::vector<int> command, episode, step;
+  std::vector<Eigen::Matrix<double, 6, 1>> xs;
+  std::vector<Eigen::Vector2d> zs;
+  std::vector<Eigen::Vector3d> values;  // the command of each sample (continuous protocol)
+};
+
+// The recorded samples into the set: x, z (continuous commands first, then pitch and roll),
+// episodes, names and units.
+void FillSamples(const Recorded& r, SampleSet* set) {
+  const int n = static_cast<int>(r.xs.size());
+  set->command.resize(n);
+  set->episode.resize(n);
+  set->step.resize(n);
+  set->x.resize(n, 6);
+  const int dc = r.values.empty() ? 0 : 3;
+  set->z.resize(n, dc + 2);
+  for (int i = 0; i < n; ++i) {
+    set->command[i] = r.command[i];
+    set->episode[i] = r.episode[i];
+    set->step[i] = r.step[i];
+    set->x.row(i) = r.xs[i].transpose();
+    if (dc > 0) set->z.row(i).head(3) = r.values[i].transpose();
+    set->z.row(i).tail(2) = r.zs[i].transpose();
+  }
+  set->x_names = {"dx", "dy", "dz", "droll", "dpitch", "dyaw"};
+  set->x_units = {"m", "m", "m", "rad", "rad", "rad"};
+  set->z_names = {"pitch", "roll"};
+  set->z_units = {"rad", "rad"};
+  if (dc > 0) {  // continuous commands: the first conditioning dimensions of z
+    set->z_names.insert(set->z_names.begin(), {"cmd_long", "cmd_lat", "cmd_turn"});
+    set->z_units.insert(set->z_units.begin(), {"command", "command", "command"});
+    set->metadata["continuous_command_columns"] = "3";
+  }
+  set->source = "sim";
+}
+
 // Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
 // set (command table already filled), its metadata and the summary.
 void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std::vector<Placement>& plan,
@@ -207,10 +245,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   SampleSet& set = *out;
   const int reps = options.executions_per_placement;
 
-  std::vector<int> command, episode, step;
-  std::vector<Eigen::Matrix<double, 6, 1>> xs;
-  std::vector<Eigen::Vector2d> zs;
-  std::vector<Eigen::Vector3d> values;  // the command of each sample (continuous protocol)
+  Recorded rec;
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::normal_distribution<double> unit(0.0, 1.0);
   SimSummary sum;
@@ -243,43 +278,19 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       }
       kept = true;
       for (int r = 0; r < reps; ++r) {
-        command.push_back(where.sequence.empty() ? where.command : where.sequence[r]);
-        episode.push_back(p);
-        step.push_back(r);
-        xs.push_back(px[r]);
-        zs.push_back(pz[r]);
-        if (!where.values.empty()) values.push_back(where.values[r]);
+        rec.command.push_back(where.sequence.empty() ? where.command : where.sequence[r]);
+        rec.episode.push_back(p);
+        rec.step.push_back(r);
+        rec.xs.push_back(px[r]);
+        rec.zs.push_back(pz[r]);
+        if (!where.values.empty()) rec.values.push_back(where.values[r]);
       }
     }
     if (!kept) ++sum.abandoned_placements;
     if (progress) progress(p + 1, static_cast<long long>(plan.size()));
   }
-  const int n = static_cast<int>(xs.size());
-  set.command.resize(n);
-  set.episode.resize(n);
-  set.step.resize(n);
-  set.x.resize(n, 6);
-  set.z.resize(n, 2);
-  for (int i = 0; i < n; ++i) {
-    set.command[i] = command[i];
-    set.episode[i] = episode[i];
-    set.step[i] = step[i];
-    set.x.row(i) = xs[i].transpose();
-    set.z.row(i) = zs[i].transpose();
-  }
-  set.x_names = {"dx", "dy", "dz", "droll", "dpitch", "dyaw"};
-  set.x_units = {"m", "m", "m", "rad", "rad", "rad"};
-  set.z_names = {"pitch", "roll"};
-  set.z_units = {"rad", "rad"};
-  if (!values.empty()) {  // continuous commands: the first conditioning dimensions of z
-    Eigen::MatrixXd z(n, 5);
-    for (int i = 0; i < n; ++i) z.row(i) << values[i].transpose(), set.z.row(i);
-    set.z = z;
-    set.z_names = {"cmd_long", "cmd_lat", "cmd_turn", "pitch", "roll"};
-    set.z_units = {"command", "command", "command", "rad", "rad"};
-    set.metadata["continuous_command_columns"] = "3";
-  }
-  set.source = "sim";
+  FillSamples(rec, &set);
+  const int n = set.size();
 
   sum.samples = n;
   sum.placements = static_cast<int>(plan.size());
