@@ -21,7 +21,7 @@ namespace dgmm::app {
 namespace {
 
 struct PredictArgs {
-  std::string model, commands, terrain, output, pose_dims, figure, ground;
+  std::string model, commands, terrain, command_values, output, pose_dims, figure, ground;
   std::vector<double> start{0, 0, 0};
   int trajectories = 1000;
   std::uint64_t seed = 1;
@@ -68,26 +68,48 @@ Eigen::VectorXd ParseOneTerrain(const MotionModel& model, const std::string& tex
       if (model.terrain_names[i] == name) d = i;
     }
     if (eq == std::string::npos || d < 0) {
-      throw MakeInputError("--terrain", item, "expected name=value with a terrain name of the model");
+      throw MakeInputError("--terrain", item, "expected name=value with a terrain (or continuous command) name of the model");
     }
     char* end = nullptr;
     z[d] = std::strtod(item.c_str() + eq + 1, &end);
     if (end == item.c_str() + eq + 1 || *end != '\0') throw MakeInputError("--terrain", item, "expected a number after '='");
   }
-  if (!z.allFinite()) throw MakeInputError("--terrain", text, "expected a value for every terrain dimension");
+  if (!z.allFinite()) {
+    std::string missing;
+    for (int i = 0; i < model.terrain_dim; ++i) {
+      if (!std::isfinite(z[i])) missing += (missing.empty() ? "" : ",") + model.terrain_names[i];
+    }
+    throw MakeInputError("--terrain", text, "expected a value for every conditioning dimension; missing " + missing);
+  }
   return z;
 }
 
-// The terrain of every step: one entry for all, or one per step (after label*N expansion),
-// separated by ';'. Empty entries: the terrain marginalised.
-std::vector<Eigen::VectorXd> ParseTerrain(const MotionModel& model, const std::string& text, std::size_t steps) {
+// One entry per step of a ';'-separated list: one entry for all, or one per step (after
+// label*N expansion); none when the text is empty.
+std::vector<std::string> PerStep(const std::string& text, std::size_t steps, const char* flag, const char* what) {
   const std::vector<std::string> items = SplitOn(text, ';');
   if (items.size() > 1 && items.size() != steps) {
-    throw MakeInputError("--terrain", "", std::to_string(items.size()) + " terrains for " + std::to_string(steps) +
-                                              " commands: expected one for all or one per command");
+    throw MakeInputError(flag, "", std::to_string(items.size()) + " " + what + " for " + std::to_string(steps) +
+                                       " commands: expected one for all or one per command");
   }
+  std::vector<std::string> out;
+  for (std::size_t k = 0; k < steps && !items.empty(); ++k) out.push_back(items[items.size() == 1 ? 0 : k]);
+  return out;
+}
+
+// The conditioning value of every step: the continuous command values (--command-values) and the
+// terrain (--terrain), both by the model's z names and merged per step. Nothing given: the
+// terrain marginalised.
+std::vector<Eigen::VectorXd> ParseTerrain(const MotionModel& model, const std::string& terrain,
+                                          const std::string& command_values, std::size_t steps) {
+  const std::vector<std::string> t = PerStep(terrain, steps, "--terrain", "terrains");
+  const std::vector<std::string> c = PerStep(command_values, steps, "--command-values", "command values");
   std::vector<Eigen::VectorXd> z(steps);
-  for (std::size_t k = 0; k < steps && !items.empty(); ++k) z[k] = ParseOneTerrain(model, items[items.size() == 1 ? 0 : k]);
+  for (std::size_t k = 0; k < steps; ++k) {
+    std::string merged = c.empty() ? "" : c[k];
+    if (!t.empty() && !t[k].empty()) merged += (merged.empty() ? "" : ",") + t[k];
+    z[k] = ParseOneTerrain(model, merged);
+  }
   return z;
 }
 
@@ -105,7 +127,7 @@ nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, con
   }
   return {{"model", args.model}, {"pose", {"x_m", "y_m", "z_m", "yaw_rad"}}, {"spatial", p.spatial},
           {"start", args.start}, {"trajectories", args.trajectories}, {"seed", args.seed},
-          {"terrain", args.terrain}, {"steps", steps}};
+          {"terrain", args.terrain}, {"command_values", args.command_values}, {"steps", steps}};
 }
 
 // The trajectory fan (render/trajectory_fan.h) of the prediction, written to args.figure.
@@ -147,7 +169,7 @@ void Run(const PredictArgs& args) {
   }
   const MotionModel model = ReadModel(args.model);
   const std::vector<int> ids = ParseCommands(model, args.commands);
-  const std::vector<Eigen::VectorXd> z = ParseTerrain(model, args.terrain, ids.size());
+  const std::vector<Eigen::VectorXd> z = ParseTerrain(model, args.terrain, args.command_values, ids.size());
   std::vector<predict::Step> steps;
   for (std::size_t k = 0; k < ids.size(); ++k) steps.push_back({ids[k], z[k]});
   WarnWhereDataIsThin(model, ids, z);
@@ -157,6 +179,9 @@ void Run(const PredictArgs& args) {
   options.pose_dims = SplitOn(args.pose_dims, ',');
   if (!args.ground.empty()) {
     if (!args.terrain.empty()) throw MakeInputError("--ground", "", "give either --terrain or --ground, not both");
+    if (!args.command_values.empty()) {
+      throw MakeInputError("--ground", "", "not with --command-values yet: give the terrain with --terrain");
+    }
     const sim::SimConfig ground = sim::LoadSimConfig(args.ground);
     options.ground = predict::PlaneTerrain(model, ground.slope_deg * M_PI / 180);
   }
@@ -197,6 +222,10 @@ void Setup(CLI::App& root) {
       ->required();
   cmd->add_option("--terrain", args->terrain, "terrain to condition on, e.g. pitch=0.1,roll=0 for every command, or one per command separated by ';' "
                   "(default: marginalised)");
+  cmd->add_option("--command-values", args->command_values,
+                  "continuous command values by name (a model fitted on continuous commands, e.g. "
+                  "dgmm import-log --continuous-cols), e.g. vx=0.3,wz=0.1 for every command or one "
+                  "per command separated by ';'; merged with --terrain");
   cmd->add_option("--ground", args->ground,
                   "simulation config whose ground the robot walks on (its slope_deg): each trajectory is conditioned "
                   "on the pitch and roll where it stands; --start's yaw is then the heading on the slope (0 = uphill)");

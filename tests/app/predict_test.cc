@@ -76,6 +76,29 @@ TEST(PredictCommand, WarnsWhenTheTerrainOrCommandIsOutsideTheTrainingData) {
   EXPECT_EQ(outside.err.find("step 1:"), std::string::npos) << outside.err;
 }
 
+// Issue #25: a model of continuous commands (simulated, stored as cmd_long, cmd_lat, cmd_turn in
+// z) is driven by command values per step, merged with the terrain: turning left then right.
+TEST(PredictCommand, ContinuousCommandValuesPerStep) {
+  const auto dir = MakeTempDir("predict_continuous");
+  const std::string set = (dir / "c.h5").string(), model = (dir / "m.h5").string(), out = (dir / "p.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "simulate", "--protocol", "continuous", "--placements", "24", "--seed", "3", "-o",
+                     set}).exit_code, 0);
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", set, "-o", model}).exit_code, 0);
+  const RunResult r = RunDgmm({"predict", model, "--commands", "velocity*2", "--command-values",
+                               "cmd_long=0.3,cmd_lat=0,cmd_turn=0.4;cmd_long=0.3,cmd_lat=0,cmd_turn=-0.4",
+                               "--terrain", "pitch=0.05,roll=0", "--trajectories", "300", "-o", out});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::ifstream in(out);
+  const auto j = nlohmann::json::parse(in);
+  const double yaw1 = j["steps"][0]["mean"][3], yaw2 = j["steps"][1]["mean"][3];
+  EXPECT_GT(yaw1, 0.1);          // turned left
+  EXPECT_LT(yaw2, yaw1 - 0.1);   // then right
+  const RunResult missing = RunDgmm({"predict", model, "--commands", "velocity", "--command-values", "cmd_long=0.3"});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.err.find("missing cmd_lat,cmd_turn,pitch,roll"), std::string::npos) << missing.err;
+  EXPECT_EQ(CountLines(missing.err), 1) << missing.err;
+}
+
 TEST(PredictCommand, TheFigureIsATrajectoryFanOrACleanErrorWithoutADisplay) {
   const auto dir = MakeTempDir("predict_fig");
   const std::string model = (dir / "m.h5").string(), png = (dir / "fan.png").string(), out = (dir / "p.json").string();
