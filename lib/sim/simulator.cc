@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim/actuation_line.h"
 #include "sim/generic_walker.h"
 #include "sim/mujoco_model.h"
 #include "util/error.h"
@@ -19,45 +20,28 @@ struct Simulator::Impl {
   Eigen::Vector3d up;
   double time_s = 0;
 
-  // Joint targets of all legs (leg-major: leg * 3 + joint).
-  using Targets = std::array<double, 3 * kNumLegs>;
-  // Actuation latency: targets in flight, a ring of latency_steps entries; `pending[head]` is
-  // the oldest (computed latency_steps steps ago) and is the one the servos see now.
-  std::vector<Targets> pending;
-  int head = 0;
-  // The targets the servos see now (after the latency); data->ctrl holds them, or with backlash
-  // the dead-banded command q + db(target - q) written before each step.
-  Targets servo{};
+  // The leg servos' targets on their way (latency and backlash: sim/actuation_line.h), in
+  // leg-major order (leg * 3 + joint).
+  ActuationLine line;
 
-  Targets JointTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) const {
-    Targets q;
+  Eigen::VectorXd JointTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) const {
+    Eigen::VectorXd q(3 * kNumLegs);
     for (int leg = 0; leg < kNumLegs; ++leg) {
       const LegAngles angles = LegInverse(parts.legs[leg], feet[leg]);
       for (int j = 0; j < 3; ++j) q[3 * leg + j] = angles[j];
     }
     return q;
   }
-  void WriteCtrl(const Targets& q) {
-    servo = q;
-    for (int leg = 0; leg < kNumLegs; ++leg) {
-      for (int j = 0; j < 3; ++j) data->ctrl[parts.actuator[leg][j]] = q[3 * leg + j];
-    }
-  }
-  // Sets the servo targets at once and fills the latency line with them (no targets in flight).
+  // Sets the servo targets at once (no targets in flight).
   void ResetFootTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) {
-    const Targets q = JointTargets(feet);
-    std::fill(pending.begin(), pending.end(), q);
-    head = 0;
-    WriteCtrl(q);
+    line.Reset(JointTargets(feet));
+    line.Write(data.get());
   }
   // Sends the joint angles reaching the given foot targets; the servos see them after the
   // configured latency (at once when it is zero).
   void SetFootTargets(const std::array<Eigen::Vector3d, kNumLegs>& feet) {
-    const Targets q = JointTargets(feet);
-    if (pending.empty()) return WriteCtrl(q);
-    WriteCtrl(pending[head]);
-    pending[head] = q;
-    head = (head + 1) % static_cast<int>(pending.size());
+    line.Send(JointTargets(feet));
+    line.Write(data.get());
   }
   std::array<Eigen::Vector3d, kNumLegs> NominalFeet() const {
     std::array<Eigen::Vector3d, kNumLegs> feet;
@@ -71,23 +55,9 @@ struct Simulator::Impl {
     pose.rotation = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(data->xmat + 9 * b);
     return pose;
   }
-  // Backlash b as a dead band of each leg servo: ctrl = q + sign(e) max(0, |e| - b/2), e = q* - q
-  // (MuJoCo's position actuator then applies kp * (ctrl - q)). No-op at b = 0.
-  void ApplyBacklash() {
-    const double half = 0.5 * config.actuators.backlash_rad;
-    if (half <= 0) return;
-    for (int leg = 0; leg < kNumLegs; ++leg) {
-      for (int j = 0; j < 3; ++j) {
-        const int a = parts.actuator[leg][j];
-        const double q = data->qpos[model->jnt_qposadr[model->actuator_trnid[2 * a]]];
-        const double e = servo[3 * leg + j] - q;
-        data->ctrl[a] = q + std::copysign(std::max(0.0, std::abs(e) - half), e);
-      }
-    }
-  }
   // One physics step; false on a MuJoCo warning (bad numbers, full contact buffers).
   bool Step() {
-    ApplyBacklash();
+    line.Write(data.get());  // the backlash dead band follows the joints step by step
     time_s += model->opt.timestep;
     return StepChecked(model.get(), data.get());
   }
@@ -140,7 +110,11 @@ Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std
   impl_->data.reset(mj_makeData(impl_->model.get()));
   const int latency_steps =
       static_cast<int>(std::lround(config.actuators.latency_s / config.timestep_s));
-  impl_->pending.resize(latency_steps);
+  std::vector<int> leg_servos;
+  for (int leg = 0; leg < kNumLegs; ++leg) {
+    for (int j = 0; j < 3; ++j) leg_servos.push_back(impl_->parts.actuator[leg][j]);
+  }
+  impl_->line = ActuationLine(impl_->model.get(), leg_servos, latency_steps, config.actuators.backlash_rad);
   mj_setConst(impl_->model.get(), impl_->data.get());
   const double a = config.slope_deg * M_PI / 180;
   impl_->up = Eigen::Vector3d(std::sin(a), 0, std::cos(a));
