@@ -90,16 +90,24 @@ def joint_rows():
     return lines
 
 
+# EM-BIC rows are omitted by `dgmm cv` when a command has fewer training samples in a fold than
+# one full-covariance Gaussian has parameters; then the bars show the DGMM and the paper only.
+em_scored = all("em_bic_" + key in cv[r]["rows"] for r in roles
+                for key in ("without_terrain", "with_terrain"))
 with open(os.path.join(out, "bars.csv"), "w") as f:
-    f.write("setting,ours_dgmm,ours_dgmm_sd,ours_em,ours_em_sd,paper,paper_sd\n")
+    f.write("setting,ours_dgmm,ours_dgmm_sd," + ("ours_em,ours_em_sd," if em_scored else "") +
+            "paper,paper_sd\n")
     for r in roles:
         n = cv[r]["scored_per_repeat"]
         for t, key in ((0, "without_terrain"), (1, "with_terrain")):
             d = (cv_without[r] if t == 0 else cv[r])["rows"]["dgmm_" + key]
-            e = cv[r]["rows"]["em_bic_" + key]
             pm, ps = paper[r][t]
             label = f"{cv[r]['samples']} ({r}) {'with' if t else 'without'} terrain"
-            f.write(f"{label},{d['mean']/n:.6g},{d['sd']/n:.6g},{e['mean']/n:.6g},{e['sd']/n:.6g},"
+            em = ""
+            if em_scored:
+                e = cv[r]["rows"]["em_bic_" + key]
+                em = f"{e['mean']/n:.6g},{e['sd']/n:.6g},"
+            f.write(f"{label},{d['mean']/n:.6g},{d['sd']/n:.6g},{em}"
                     f"{pm/paper_n[r]:.6g},{ps/paper_n[r]:.6g}\n")
 
 print("Written by `scripts/table1.sh` (rerun it to regenerate; figures and JSON in "
@@ -120,6 +128,11 @@ print("|---|---|---|---|---|---|---|")
 for r in roles:
     name = f"{role_name[r]}<br>`{shown(real if r == 'real' else sim)}`"
     def row(label, sett, w_json, t_json, model="dgmm"):
+        if model + "_with_terrain" not in t_json["rows"] or model + "_without_terrain" not in w_json["rows"]:
+            why = (t_json.get("omitted_rows", {}).get(model + "_with_terrain") or
+                   w_json.get("omitted_rows", {}).get(model + "_without_terrain", "not scored"))
+            print(f"| {name} | {label} | {sett} | omitted: {why} | | | |")
+            return
         w = w_json["rows"][model + "_without_terrain"]
         t = t_json["rows"][model + "_with_terrain"]
         gain = t["mean"] - w["mean"]
@@ -179,12 +192,13 @@ for r in roles:
     t = cv[r]["rows"]["dgmm_with_terrain"]
     gain = t["mean"] - w["mean"]
     se = max(w["standard_error"], t["standard_error"])
-    em_k = cv[r]["rows"]["em_bic_with_terrain"]["mean_components"]
+    em = cv[r]["rows"].get("em_bic_with_terrain")
+    em_text = (f"EM-BIC chooses {em['mean_components']:.2f} components per command with terrain."
+               if em else "EM-BIC is not scored (too few training samples per command in a fold).")
     print(f"- {role_name[r]}: at tuned settings terrain {'raises' if gain > 0 else 'lowers'} the "
           f"held-out log-likelihood by {abs(gain):.0f} nats, {'more' if abs(gain) > se else 'less'} "
           f"than one s.e. of a total (≈ {se:.0f}). The DGMM uses {w['mean_components']:.2f} / "
-          f"{t['mean_components']:.2f} Gaussians per command (without / with terrain); EM-BIC "
-          f"chooses {em_k:.2f} components per command with terrain.")
+          f"{t['mean_components']:.2f} Gaussians per command (without / with terrain); {em_text}")
 gains = []
 for r in roles:
     for terrain, t in (("without", tune_without[r]), ("with", tune[r])):
