@@ -17,6 +17,17 @@ std::vector<int> Range(int begin, int end) {
   return v;
 }
 
+// z (raw units, terrain_dim entries: InputError otherwise) in the model's own units, where its
+// mixtures live: standardised when the model was fitted on standardised data.
+Eigen::VectorXd ZInModelUnits(const MotionModel& model, const Eigen::VectorXd& z) {
+  const int p = model.pose_dim, t = model.terrain_dim;
+  if (z.size() != t) {
+    throw InputError("z: " + std::to_string(z.size()) + " values, expected " + std::to_string(t));
+  }
+  if (model.transform.empty()) return z;
+  return (z - model.transform.offset.segment(p, t)).cwiseQuotient(model.transform.scale.segment(p, t));
+}
+
 // "0 ('fwd'), 2 ('turn')": the commands a model has a mixture for.
 std::string ListCommands(const MotionModel& model) {
   std::string out;
@@ -91,19 +102,12 @@ Mixture MotionModel::Conditional(int command, const Eigen::Ref<const Eigen::Vect
 }
 
 Mixture MotionModel::RawPoseDistribution(int command, const Eigen::VectorXd& z) const {
-  std::vector<int> pose(pose_dim);
-  for (int d = 0; d < pose_dim; ++d) pose[d] = d;
   Mixture m;
   if (z.size() == 0) {
-    m = terrain_dim > 0 ? MixtureFor(command).Marginal(pose) : MixtureFor(command);
+    m = terrain_dim > 0 ? MixtureFor(command).Marginal(Range(0, pose_dim)) : MixtureFor(command);
   } else {
     if (terrain_dim == 0) throw InputError("model: fitted without terrain; give no z");
-    if (z.size() != terrain_dim) {
-      throw InputError("z: " + std::to_string(z.size()) + " values, expected " + std::to_string(terrain_dim));
-    }
-    m = transform.empty() ? Conditional(command, z)
-                          : Conditional(command, (z - transform.offset.segment(pose_dim, terrain_dim))
-                                                     .cwiseQuotient(transform.scale.segment(pose_dim, terrain_dim)));
+    m = Conditional(command, ZInModelUnits(*this, z));
   }
   if (transform.empty()) return m;
   const Eigen::VectorXd scale = transform.scale.head(pose_dim), offset = transform.offset.head(pose_dim);
@@ -112,16 +116,8 @@ Mixture MotionModel::RawPoseDistribution(int command, const Eigen::VectorXd& z) 
 
 double MotionModel::SamplesNear(int command, const Eigen::VectorXd& z, double* at_data) const {
   if (terrain_dim == 0) throw InputError("model: fitted without terrain; no z to be near");
-  if (z.size() != terrain_dim) {
-    throw InputError("z: " + std::to_string(z.size()) + " values, expected " + std::to_string(terrain_dim));
-  }
-  std::vector<int> dims(terrain_dim);
-  for (int d = 0; d < terrain_dim; ++d) dims[d] = pose_dim + d;
-  const Mixture marginal = MixtureFor(command).Marginal(dims);
-  const Eigen::VectorXd q =
-      transform.empty() ? z
-                        : Eigen::VectorXd((z - transform.offset.segment(pose_dim, terrain_dim))
-                                              .cwiseQuotient(transform.scale.segment(pose_dim, terrain_dim)));
+  const Eigen::VectorXd q = ZInModelUnits(*this, z);
+  const Mixture marginal = MixtureFor(command).Marginal(Range(pose_dim, dim()));
   // The marginal's mean and covariance: sum_k p_k (S_k + mu_k mu_k^T) - mu mu^T.
   const double total = marginal.total_weight();
   Eigen::VectorXd mean = Eigen::VectorXd::Zero(terrain_dim);
