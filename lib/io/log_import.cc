@@ -270,21 +270,27 @@ void SampleSink::AddContinuous(const CommandRows& c, size_t row, double t0, doub
   continuous_mean.resize(dims);
   continuous_within.resize(dims);
   while (row + 1 < c.t.size() && c.t[row + 1] <= t0) ++row;
-  // sum w v and sum w v^2 over the rows in force, w the time each holds inside [t0, t1].
-  std::vector<double> sum(dims, 0.0), sum2(dims, 0.0);
+  // The rows in force and w_i, the time each holds inside [t0, t1].
+  std::vector<double> w;
   double total = 0;
   for (size_t i = row; i < c.t.size() && (i == row || c.t[i] < t1); ++i) {
     const double hi = i + 1 < c.t.size() ? std::min(c.t[i + 1], t1) : t1;
-    const double w = std::max(0.0, hi - std::max(c.t[i], t0));
-    for (size_t j = 0; j < dims; ++j) {
-      sum[j] += w * c.continuous[i][j];
-      sum2[j] += w * c.continuous[i][j] * c.continuous[i][j];
-    }
-    total += w;
+    w.push_back(std::max(0.0, hi - std::max(c.t[i], t0)));
+    total += w.back();
   }
+  // Mean, then the variation around it (two passes: no cancellation for values far from 0).
   for (size_t j = 0; j < dims; ++j) {
-    const double mean = total > 0 ? sum[j] / total : c.continuous[row][j];
-    const double var = total > 0 ? std::max(0.0, sum2[j] / total - mean * mean) : 0.0;
+    double mean = c.continuous[row][j], var = 0;
+    if (total > 0) {
+      mean = 0;
+      for (size_t k = 0; k < w.size(); ++k) mean += w[k] * c.continuous[row + k][j];
+      mean /= total;
+      for (size_t k = 0; k < w.size(); ++k) {
+        const double e = c.continuous[row + k][j] - mean;
+        var += w[k] * e * e;
+      }
+      var /= total;
+    }
     zs.push_back(mean);
     continuous_mean[j].push_back(mean);
     continuous_within[j].push_back(std::sqrt(var));
