@@ -71,14 +71,9 @@ TEST(MotionModelTest, LikelihoodsFollowMarginalAndConditional) {
   EXPECT_EQ(model.Conditional(2, z).dim(), 2);
 }
 
-// Issue #25: a continuous command is a conditioning dimension like the terrain. A DGMM learnt
-// on x (1-D) given z = (command value, pitch), with x bimodal around 2 c + 0.5 pitch, gives
-// log p(x | c, pitch) equal to the brute-force conditional log p(x, c, pitch) -
-// log integral p(x', c, pitch) dx' (trapezoid rule on a fine grid, which converges exponentially
-// for Gaussian integrands) to 1e-9, at command values inside and between the ones seen.
-TEST(MotionModelTest, ConditioningOnAContinuousCommandEqualsTheNumericalConditional) {
-  std::mt19937_64 rng(25);
-  const int n = 600;
+// n samples of one command ("velocity") with x = dx and z = (cmd_v, pitch), the command value
+// a continuous conditioning dimension; values to be filled by the test.
+SampleSet ContinuousCommandSet(int n) {
   SampleSet set;
   set.commands = Eigen::MatrixXd::Zero(1, 0);
   set.command_labels = {"velocity"};
@@ -88,6 +83,18 @@ TEST(MotionModelTest, ConditioningOnAContinuousCommandEqualsTheNumericalConditio
   set.x_names = {"dx"};
   set.z_names = {"cmd_v", "pitch"};
   set.metadata["continuous_command_columns"] = "1";
+  return set;
+}
+
+// Issue #25: a continuous command is a conditioning dimension like the terrain. A DGMM learnt
+// on x (1-D) given z = (command value, pitch), with x bimodal around 2 c + 0.5 pitch, gives
+// log p(x | c, pitch) equal to the brute-force conditional log p(x, c, pitch) -
+// log integral p(x', c, pitch) dx' (trapezoid rule on a fine grid, which converges exponentially
+// for Gaussian integrands) to 1e-9, at command values inside and between the ones seen.
+TEST(MotionModelTest, ConditioningOnAContinuousCommandEqualsTheNumericalConditional) {
+  std::mt19937_64 rng(25);
+  const int n = 600;
+  SampleSet set = ContinuousCommandSet(n);
   std::uniform_real_distribution<double> command(-0.5, 0.5);
   std::normal_distribution<double> normal;
   for (int i = 0; i < n; ++i) {
@@ -125,14 +132,7 @@ TEST(MotionModelTest, ConditioningOnAContinuousCommandEqualsTheNumericalConditio
 TEST(MotionModelTest, SamplesNearCountsTrainingDataAroundAConditioningValue) {
   std::mt19937_64 rng(26);
   const int n = 8000;
-  SampleSet set;
-  set.commands = Eigen::MatrixXd::Zero(1, 0);
-  set.command_labels = {"velocity"};
-  set.command = Eigen::VectorXi::Zero(n);
-  set.x.resize(n, 1);
-  set.z.resize(n, 2);
-  set.x_names = {"dx"};
-  set.z_names = {"cmd_v", "pitch"};
+  SampleSet set = ContinuousCommandSet(n);
   std::normal_distribution<double> normal;
   for (int i = 0; i < n; ++i) {
     set.z.row(i) << 0.2 * normal(rng), 0.1 * normal(rng);
