@@ -3,14 +3,16 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
+#include "sim/ground.h"
 #include "sim/simulator.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
 
-GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const std::string& source)
-    : config_(config), model_(std::move(model)), source_(source) {
+GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Ground& ground, const std::string& source)
+    : config_(config), model_(std::move(model)), ground_(&ground), source_(source) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
   ApplyExperiment(config, robot_, model_.get());
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
@@ -52,7 +54,8 @@ bool GenericWalker::Fallen() const {
   const Pose pose = RobotPose();
   const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
   const double kMinHeightShare = 0.4;  // of the stance height
-  return pose.rotation(2, 2) < kMaxTiltCos || pose.position_m.z() < kMinHeightShare * robot_.stance_height_m;
+  const double ground_m = ground_->HeightAt(pose.position_m.x(), pose.position_m.y());
+  return pose.rotation(2, 2) < kMaxTiltCos || pose.position_m.z() - ground_m < kMinHeightShare * robot_.stance_height_m;
 }
 
 void GenericWalker::HoldStance() {
@@ -94,11 +97,17 @@ RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
   const Eigen::Matrix3d world = Eigen::AngleAxisd(heading_rad, Eigen::Vector3d::UnitZ()).toRotationMatrix() *
                                 robot_.robot_in_torso.transpose();
   const Eigen::Quaterniond q(world);
-  const double kDrop = 0.02 * robot_.reach_m;  // released just above the ground
+  const double kDrop = 0.02 * robot_.reach_m;  // released just above the ground under the highest foot
+  const Eigen::Rotation2Dd yaw(heading_rad);
+  double ground_m = -std::numeric_limits<double>::infinity();
+  for (const LegChain& leg : robot_.legs) {
+    const Eigen::Vector2d at = Eigen::Vector2d(x_m, y_m) + yaw * leg.stance_m.head<2>();
+    ground_m = std::max(ground_m, ground_->HeightAt(at.x(), at.y()));
+  }
   const int a = robot_.torso_qpos;
   d->qpos[a + 0] = x_m;
   d->qpos[a + 1] = y_m;
-  d->qpos[a + 2] = robot_.stance_height_m + extent + kDrop;
+  d->qpos[a + 2] = ground_m + robot_.stance_height_m + extent + kDrop;
   d->qpos[a + 3] = q.w();
   d->qpos[a + 4] = q.x();
   d->qpos[a + 5] = q.y();

@@ -13,12 +13,14 @@
 namespace dgmm::sim {
 
 enum class RunOutcome;  // simulator.h
+class Ground;           // ground.h
 
 class GenericWalker {
  public:
   // Binds config.robot to `model` (already compiled; the walker owns it from here) and applies
   // the experiment (slope, timestep, leg gains). Throws InputError naming the part at fault.
-  GenericWalker(const SimConfig& config, MjModelPtr model, const std::string& source);
+  // `ground` (placement and the fall test) must outlive the walker.
+  GenericWalker(const SimConfig& config, MjModelPtr model, const Ground& ground, const std::string& source);
 
   mjModel* model() { return model_.get(); }
   // Creates the state (after any edit of the model).
@@ -50,6 +52,7 @@ class GenericWalker {
   std::vector<Eigen::VectorXd> q_;  // each leg's joint targets
   Eigen::VectorXd u_;               // the signal sent now: leg targets (gait) or every actuator's (replay)
   ActuationLine line_;
+  const Ground* ground_;
   std::string source_;
   double time_s_ = 0;
   int control_every_ = 1;

@@ -47,19 +47,24 @@ void SetBodyMass(mjModel* m, int body, double mass_kg) {
 
 }  // namespace
 
-MjModelPtr LoadMjcfString(const std::string& xml, const std::string& source_name) {
+MjModelPtr LoadWithFiles(const std::vector<std::pair<std::string, std::string>>& files,
+                         const std::string& load_path, const std::string& source_name) {
   std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
   mj_defaultVFS(vfs.get());
-  const char* kName = "robot.xml";
-  if (mj_makeEmptyFileVFS(vfs.get(), kName, static_cast<int>(xml.size())) != 0) {
-    throw MakeInputError(source_name, "", "cannot stage the MJCF in memory");
+  for (const auto& [name, text] : files) {
+    if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(text.size())) != 0) {
+      throw MakeInputError(source_name, "", "cannot stage the MJCF in memory");
+    }
+    std::memcpy(vfs->filedata[mj_findFileVFS(vfs.get(), name.c_str())], text.data(), text.size());
   }
-  const int index = mj_findFileVFS(vfs.get(), kName);
-  std::memcpy(vfs->filedata[index], xml.data(), xml.size());
   char error[1000] = "";
-  MjModelPtr model(mj_loadXML(kName, vfs.get(), error, sizeof(error)));
+  MjModelPtr model(mj_loadXML(load_path.c_str(), vfs.get(), error, sizeof(error)));
   if (!model) throw MakeInputError(source_name, "MJCF", error[0] ? error : "MuJoCo cannot load it");
   return model;
+}
+
+MjModelPtr LoadMjcfString(const std::string& xml, const std::string& source_name) {
+  return LoadWithFiles({{"robot.xml", xml}}, "robot.xml", source_name);
 }
 
 MjModelPtr LoadRobotModel(const SimConfig& config) {

@@ -6,6 +6,8 @@
 #include <array>
 #include <memory>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "sim/gait.h"
 #include "sim/sim_config.h"
@@ -27,6 +29,10 @@ extern const char* const kBuiltinRobotMjcf;
 // Compiles MJCF text (no external assets) through an in-memory VFS. Throws InputError
 // "<source_name>: <MuJoCo's message>" on failure.
 MjModelPtr LoadMjcfString(const std::string& xml, const std::string& source_name);
+// Compiles `load_path` with in-memory files (MuJoCo's VFS: found by base name before the disk;
+// relative includes and assets resolve against load_path's folder). Throws InputError.
+MjModelPtr LoadWithFiles(const std::vector<std::pair<std::string, std::string>>& files,
+                         const std::string& load_path, const std::string& source_name);
 // Compiles config.mjcf_path, or the built-in robot when it is empty.
 MjModelPtr LoadRobotModel(const SimConfig& config);
 

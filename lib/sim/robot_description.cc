@@ -6,6 +6,7 @@
 #include <set>
 #include <sstream>
 
+#include "sim/json_fields.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -13,80 +14,8 @@ namespace {
 
 using nlohmann::json;
 
-// Reads one JSON object's fields; keys never asked for are reported as unknown.
-class Fields {
- public:
-  Fields(const json& object, std::string path, const std::string& source)
-      : object_(object), path_(std::move(path)), source_(source) {
-    if (!object_.is_object()) Fail(path_, "expected a JSON object");
-  }
-  const json* Find(const char* key) {
-    used_.insert(key);
-    const auto it = object_.find(key);
-    return it == object_.end() ? nullptr : &*it;
-  }
-  void String(const char* key, std::string* out) {
-    if (const json* v = Find(key)) {
-      if (!v->is_string() || v->get<std::string>().empty()) Fail(Field(key), "expected a non-empty string");
-      *out = v->get<std::string>();
-    }
-  }
-  void Number(const char* key, double* out, double lo, double hi) {
-    if (const json* v = Find(key)) {
-      if (!v->is_number() || !std::isfinite(v->get<double>()) || v->get<double>() < lo || v->get<double>() > hi) {
-        Fail(Field(key), "expected a number in [" + Str(lo) + ", " + Str(hi) + "]");
-      }
-      *out = v->get<double>();
-    }
-  }
-  void Bool(const char* key, bool* out) {
-    if (const json* v = Find(key)) {
-      if (!v->is_boolean()) Fail(Field(key), "expected true or false");
-      *out = v->get<bool>();
-    }
-  }
-  void Strings(const char* key, std::vector<std::string>* out) {
-    if (const json* v = Find(key)) {
-      if (!v->is_array()) Fail(Field(key), "expected an array of names");
-      for (const auto& s : *v) {
-        if (!s.is_string() || s.get<std::string>().empty()) Fail(Field(key), "expected an array of names");
-        out->push_back(s.get<std::string>());
-      }
-    }
-  }
-  void Vector3(const char* key, Eigen::Vector3d* out) {
-    if (const json* v = Find(key)) {
-      if (!v->is_array() || v->size() != 3) Fail(Field(key), "expected an array of 3 numbers");
-      for (int i = 0; i < 3; ++i) {
-        if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of 3 numbers");
-        (*out)[i] = (*v)[i].get<double>();
-      }
-    }
-  }
-  void Done() const {
-    for (const auto& [key, unused] : object_.items()) {
-      if (!used_.count(key)) Fail(Field(key.c_str()), "unknown key");
-    }
-  }
-  std::string Field(const char* key) const { return path_ + "." + key; }
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw MakeInputError(source_, field, problem);
-  }
-
- private:
-  static std::string Str(double v) {
-    std::ostringstream s;
-    s << v;
-    return s.str();
-  }
-  const json& object_;
-  std::string path_;
-  const std::string& source_;
-  std::set<std::string> used_;
-};
-
 FootDescription ReadFoot(const json& j, const std::string& path, const std::string& source) {
-  Fields f(j, path, source);
+  JsonFields f(j, path, source);
   FootDescription foot;
   f.String("site", &foot.site);
   f.String("geom", &foot.geom);
@@ -100,7 +29,7 @@ FootDescription ReadFoot(const json& j, const std::string& path, const std::stri
 }
 
 LegDescription ReadLeg(const json& j, const std::string& path, const std::string& source) {
-  Fields f(j, path, source);
+  JsonFields f(j, path, source);
   LegDescription leg;
   f.String("name", &leg.name);
   f.Strings("joints", &leg.joints);
@@ -120,7 +49,7 @@ LegDescription ReadLeg(const json& j, const std::string& path, const std::string
 }
 
 GaitDescription ReadGait(const json& j, const std::string& source) {
-  Fields f(j, "robot.gait", source);
+  JsonFields f(j, "robot.gait", source);
   GaitDescription g;
   f.String("pattern", &g.pattern);
   if (const json* v = f.Find("phases")) {
@@ -153,7 +82,7 @@ GaitDescription ReadGait(const json& j, const std::string& source) {
 }
 
 ControllerDescription ReadController(const json& j, const std::string& source) {
-  Fields f(j, "robot.controller", source);
+  JsonFields f(j, "robot.controller", source);
   ControllerDescription c;
   f.String("type", &c.type);
   f.String("signal", &c.signal);
@@ -170,7 +99,7 @@ ControllerDescription ReadController(const json& j, const std::string& source) {
   }
   for (std::size_t i = 0; i < recordings->size(); ++i) {
     const std::string path = "robot.controller.recordings[" + std::to_string(i) + "]";
-    Fields r((*recordings)[i], path, source);
+    JsonFields r((*recordings)[i], path, source);
     ReplayRecording rec;
     rec.command = Eigen::Vector3d::Constant(std::nan(""));
     r.Vector3("command", &rec.command);
@@ -195,7 +124,7 @@ RobotDescription RobotDescriptionFromJson(const std::string& json_text, const st
   } catch (const json::exception& e) {
     throw MakeInputError(source, "robot", std::string("not valid JSON: ") + e.what());
   }
-  Fields f(root, "robot", source);
+  JsonFields f(root, "robot", source);
   RobotDescription r;
   f.String("torso_body", &r.torso_body);
   f.String("floor_geom", &r.floor_geom);
@@ -222,7 +151,7 @@ RobotDescription RobotDescriptionFromJson(const std::string& json_text, const st
   if (gait) r.gait = ReadGait(*gait, source);
   if (controller) r.controller = ReadController(*controller, source);
   if (gains) {
-    Fields g(*gains, "robot.leg_gain", source);
+    JsonFields g(*gains, "robot.leg_gain", source);
     for (const auto& [leg, value] : gains->items()) {
       if (!names.count(leg)) g.Fail("robot.leg_gain." + leg, "no leg has this name");
       double v = 1;

@@ -94,6 +94,7 @@ bool SimConfig::IsValid(std::string* error) const {
   const auto& a = actuators;
   const auto& g = gait;
   const auto& n = noise;
+  if (terrain && !terrain->IsValid(error)) return false;
   if (!Check(Finite(slope_deg) && slope_deg > -60 && slope_deg < 60,
              "slope_deg: expected a finite angle in (-60, 60) degrees", error) ||
       !Check(Finite(f.sliding) && f.sliding >= 0 && Finite(f.torsional) && f.torsional >= 0 &&
@@ -226,6 +227,7 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
     n.CheckNoUnknownKeys();
   }
   if (const json* robot = r.Raw("robot")) c.robot = RobotDescriptionFromJson(robot->dump(), source_name);
+  if (const json* terrain = r.Raw("terrain")) c.terrain = TerrainFromJson(terrain->dump(), source_name);
   r.CheckNoUnknownKeys();
   std::string error;
   if (!c.IsValid(&error)) throw MakeInputError(source_name, "", error);
@@ -293,6 +295,7 @@ std::string SimConfigToJson(const SimConfig& c) {
                 {"floor_geom", c.names.floor_geom},
                 {"actuator_prefix", c.names.actuator_prefix}};
   if (c.robot) j["robot"] = json::parse(RobotDescriptionToJson(*c.robot));
+  if (c.terrain) j["terrain"] = json::parse(TerrainToJson(*c.terrain));
   return j.dump(2) + "\n";
 }
 

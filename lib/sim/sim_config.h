@@ -8,6 +8,7 @@
 #include <string>
 
 #include "sim/robot_description.h"
+#include "sim/terrain.h"
 
 namespace dgmm::sim {
 
@@ -95,6 +96,9 @@ struct SimConfig {
   // only slope, timestep and robot.leg_gain are applied; friction, masses, actuators, gait and
   // names above are then unused. Without it, the built-in eight-legged conventions.
   std::optional<RobotDescription> robot;
+  // Ground beyond the plane (terrain.h): a seeded height field over the slope. Without it, the
+  // model's floor plane.
+  std::optional<TerrainDescription> terrain;
 
   // False with a one-line reason (field and expected range) for non-finite or out-of-range values.
   bool IsValid(std::string* error) const;

@@ -3,15 +3,18 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sim/actuation_line.h"
 #include "sim/generic_walker.h"
+#include "sim/ground.h"
 #include "sim/mujoco_model.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
 
 struct Simulator::Impl {
+  std::unique_ptr<Ground> ground;         // the floor plane or the config's height field
   std::unique_ptr<GenericWalker> walker;  // a robot block's robot; else the built-in conventions
   SimConfig config;
   MjModelPtr model;
@@ -65,8 +68,9 @@ struct Simulator::Impl {
     const Pose pose = Torso();
     const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
     const double kMinHeightShare = 0.4;  // of the stance height
+    const double ground_m = ground->HeightAt(pose.position_m.x(), pose.position_m.y());
     return pose.rotation(2, 2) < kMaxTiltCos ||
-           pose.position_m.z() < kMinHeightShare * config.gait.stance_height_m;
+           pose.position_m.z() - ground_m < kMinHeightShare * config.gait.stance_height_m;
   }
   // Runs `steps` steps with targets from `feet_at(step)`; stops at a fall or instability.
   // `sample(s)` runs after every step.
@@ -95,18 +99,21 @@ Simulator::Simulator(const SimConfig& config, const ModelEdit& edit) : impl_(std
   if (!config.IsValid(&error)) throw MakeInputError("simulation config", "", error);
   const std::string source = config.mjcf_path.empty() ? "built-in robot" : config.mjcf_path;
   impl_->config = config;
+  impl_->ground = std::make_unique<Ground>(config);
   if (config.robot) {
-    impl_->walker = std::make_unique<GenericWalker>(config, LoadRobotModel(config), source);
+    impl_->walker = std::make_unique<GenericWalker>(config, impl_->ground->Load(config), *impl_->ground, source);
     if (edit) edit(impl_->walker->model());
+    impl_->ground->Install(impl_->walker->model(), impl_->walker->robot().floor_geom, source);
     impl_->walker->Start();
     const double a = config.slope_deg * M_PI / 180;
     impl_->up = Eigen::Vector3d(std::sin(a), 0, std::cos(a));
     return;
   }
-  impl_->model = LoadRobotModel(config);
+  impl_->model = impl_->ground->Load(config);
   impl_->parts = FindRobotParts(impl_->model.get(), config, source);
   ApplyConfig(config, impl_->parts, impl_->model.get(), source);
   if (edit) edit(impl_->model.get());
+  impl_->ground->Install(impl_->model.get(), impl_->parts.floor_geom, source);
   impl_->data.reset(mj_makeData(impl_->model.get()));
   const int latency_steps =
       static_cast<int>(std::lround(config.actuators.latency_s / config.timestep_s));
@@ -134,10 +141,16 @@ RunOutcome Simulator::Place(double x_m, double y_m, double heading_rad) {
     for (int j = 0; j < 3; ++j) d->qpos[m->jnt_qposadr[s.parts.joint[leg][j]]] = q[j];
   }
   const int q0 = s.parts.torso_qpos;
-  const double kDropM = 0.005;  // released just above the ground
+  const double kDropM = 0.005;  // released just above the ground under the highest foot
+  const Eigen::Rotation2Dd yaw(heading_rad);
+  double ground_m = -std::numeric_limits<double>::infinity();
+  for (const auto& foot : feet) {
+    const Eigen::Vector2d at = Eigen::Vector2d(x_m, y_m) + yaw * foot.head<2>();
+    ground_m = std::max(ground_m, s.ground->HeightAt(at.x(), at.y()));
+  }
   d->qpos[q0 + 0] = x_m;
   d->qpos[q0 + 1] = y_m;
-  d->qpos[q0 + 2] = s.config.gait.stance_height_m + kDropM;
+  d->qpos[q0 + 2] = ground_m + s.config.gait.stance_height_m + kDropM;
   d->qpos[q0 + 3] = std::cos(heading_rad / 2);
   d->qpos[q0 + 4] = 0;
   d->qpos[q0 + 5] = 0;

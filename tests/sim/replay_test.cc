@@ -12,6 +12,7 @@
 
 #include "sim/actuation_line.h"
 #include "sim/generic_walker.h"
+#include "sim/ground.h"
 #include "sim/protocol.h"
 #include "sim/replay.h"
 #include "sim/sim_config.h"
@@ -167,7 +168,8 @@ TEST(Replay, TorquesGoToMotorsThroughTheLatency) {
   c.robot->controller.recordings = {{Eigen::Vector3d::Zero(), stand}, {Eigen::Vector3d(0.5, 0, 0), file}};
   c.actuators.latency_s = 5 * c.timestep_s;
   MjModelPtr model = LoadRobotModel(c);
-  GenericWalker walker(c, std::move(model), "motors");
+  const Ground plane(c);
+  GenericWalker walker(c, std::move(model), plane, "motors");
   walker.Start();
   walker.Place(0, 0, 0);
   std::vector<double> ctrl;

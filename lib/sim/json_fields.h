@@ -1,0 +1,89 @@
+#pragma once
+// Internal to dgmm_sim: strict reading of one JSON object's fields (nlohmann), shared by the
+// config blocks (robot_description.cc, terrain.cc). Errors are InputError
+// "<source>: <path>.<key>: <problem>"; keys never asked for are reported by Done().
+#include <Eigen/Core>
+#include <cmath>
+#include <nlohmann/json.hpp>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "util/error.h"
+
+namespace dgmm::sim {
+
+// Reads one JSON object's fields; keys never asked for are reported as unknown.
+class JsonFields {
+ public:
+  JsonFields(const nlohmann::json& object, std::string path, const std::string& source)
+      : object_(object), path_(std::move(path)), source_(source) {
+    if (!object_.is_object()) Fail(path_, "expected a JSON object");
+  }
+  const nlohmann::json* Find(const char* key) {
+    used_.insert(key);
+    const auto it = object_.find(key);
+    return it == object_.end() ? nullptr : &*it;
+  }
+  void String(const char* key, std::string* out) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_string() || v->get<std::string>().empty()) Fail(Field(key), "expected a non-empty string");
+      *out = v->get<std::string>();
+    }
+  }
+  void Number(const char* key, double* out, double lo, double hi) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_number() || !std::isfinite(v->get<double>()) || v->get<double>() < lo || v->get<double>() > hi) {
+        Fail(Field(key), "expected a number in [" + Str(lo) + ", " + Str(hi) + "]");
+      }
+      *out = v->get<double>();
+    }
+  }
+  void Bool(const char* key, bool* out) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_boolean()) Fail(Field(key), "expected true or false");
+      *out = v->get<bool>();
+    }
+  }
+  void Strings(const char* key, std::vector<std::string>* out) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_array()) Fail(Field(key), "expected an array of names");
+      for (const auto& s : *v) {
+        if (!s.is_string() || s.get<std::string>().empty()) Fail(Field(key), "expected an array of names");
+        out->push_back(s.get<std::string>());
+      }
+    }
+  }
+  void Vector3(const char* key, Eigen::Vector3d* out) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_array() || v->size() != 3) Fail(Field(key), "expected an array of 3 numbers");
+      for (int i = 0; i < 3; ++i) {
+        if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of 3 numbers");
+        (*out)[i] = (*v)[i].get<double>();
+      }
+    }
+  }
+  void Done() const {
+    for (const auto& [key, unused] : object_.items()) {
+      if (!used_.count(key)) Fail(Field(key.c_str()), "unknown key");
+    }
+  }
+  std::string Field(const char* key) const { return path_ + "." + key; }
+  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
+    throw MakeInputError(source_, field, problem);
+  }
+
+ private:
+  static std::string Str(double v) {
+    std::ostringstream s;
+    s << v;
+    return s.str();
+  }
+  const nlohmann::json& object_;
+  std::string path_;
+  const std::string& source_;
+  std::set<std::string> used_;
+};
+
+}  // namespace dgmm::sim
