@@ -54,7 +54,13 @@ bool GenericWalker::Fallen() const {
   const Pose pose = RobotPose();
   const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
   const double kMinHeightShare = 0.4;  // of the stance height
-  const double ground_m = ground_->HeightAt(pose.position_m.x(), pose.position_m.y());
+  double ground_m = 0;  // mean ground height under the feet (a stone under the belly is no fall)
+  if (ground_->field()) {
+    for (const LegChain& leg : robot_.legs) {
+      const Eigen::Vector3d foot = FootPoint(model_.get(), data_.get(), leg);
+      ground_m += ground_->HeightAt(foot.x(), foot.y()) / robot_.legs.size();
+    }
+  }
   return pose.rotation(2, 2) < kMaxTiltCos || pose.position_m.z() - ground_m < kMinHeightShare * robot_.stance_height_m;
 }
 

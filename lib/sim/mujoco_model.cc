@@ -130,6 +130,7 @@ RobotParts FindRobotParts(const mjModel* m, const SimConfig& c, const std::strin
     const std::string foot_name = LegName(c, leg, "foot");
     const int foot_site = RequireId(m, mjOBJ_SITE, foot_name, "site", source);
     const Eigen::Vector3d foot = in_torso(d->site_xpos + 3 * foot_site);
+    parts.foot_site[leg] = foot_site;
 
     LegGeometry g;
     g.hip_m = anchor[0];

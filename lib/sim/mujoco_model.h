@@ -49,6 +49,7 @@ struct RobotParts {
   // Per leg, per joint (hip_yaw, hip_pitch, knee): actuator id and joint qpos address.
   std::array<std::array<int, 3>, kNumLegs> actuator{};
   std::array<std::array<int, 3>, kNumLegs> joint{};
+  std::array<int, kNumLegs> foot_site{};  // <prefix><i>_foot
   std::array<LegGeometry, kNumLegs> legs{};
 };
 

@@ -199,38 +199,62 @@ Eigen::MatrixXd CommandsPlanned(const std::vector<Placement>& plan, const Eigen:
 struct Recorded {
   std::vector<int> command, episode, step;
   std::vector<Eigen::Matrix<double, 6, 1>> xs;
-  std::vector<Eigen::Vector2d> zs;
+  std::vector<Eigen::VectorXd> zs;      // pitch, roll, then the sensed terrain descriptors
   std::vector<Eigen::Vector3d> values;  // the command of each sample (continuous protocol)
 };
 
 // The recorded samples into the set: x, z (continuous commands first, then pitch and roll),
 // episodes, names and units.
-void FillSamples(const Recorded& r, SampleSet* set) {
+void FillSamples(const Recorded& r, const std::vector<std::string>& sensed, SampleSet* set) {
   const int n = static_cast<int>(r.xs.size());
   set->command.resize(n);
   set->episode.resize(n);
   set->step.resize(n);
   set->x.resize(n, 6);
   const int dc = r.values.empty() ? 0 : 3;
-  set->z.resize(n, dc + 2);
+  const int dz = 2 + static_cast<int>(sensed.size());
+  set->z.resize(n, dc + dz);
   for (int i = 0; i < n; ++i) {
     set->command[i] = r.command[i];
     set->episode[i] = r.episode[i];
     set->step[i] = r.step[i];
     set->x.row(i) = r.xs[i].transpose();
     if (dc > 0) set->z.row(i).head(3) = r.values[i].transpose();
-    set->z.row(i).tail(2) = r.zs[i].transpose();
+    set->z.row(i).tail(dz) = r.zs[i].transpose();
   }
   set->x_names = {"dx", "dy", "dz", "droll", "dpitch", "dyaw"};
   set->x_units = {"m", "m", "m", "rad", "rad", "rad"};
   set->z_names = {"pitch", "roll"};
   set->z_units = {"rad", "rad"};
+  for (const std::string& s : sensed) {
+    set->z_names.push_back(s);
+    set->z_units.push_back("m");
+  }
   if (dc > 0) {  // continuous commands: the first conditioning dimensions of z
     set->z_names.insert(set->z_names.begin(), {"cmd_long", "cmd_lat", "cmd_turn"});
     set->z_units.insert(set->z_units.begin(), {"command", "command", "command"});
     set->metadata["continuous_command_columns"] = "3";
   }
   set->source = "sim";
+}
+
+// The sensed terrain descriptors of terrain.h at the robot's current state.
+Eigen::VectorXd SensedTerrain(const Simulator& sim, const std::vector<std::string>& sensed) {
+  Eigen::VectorXd v(static_cast<int>(sensed.size()));
+  for (int i = 0; i < v.size(); ++i) {
+    if (sensed[i] == "foot_relief") {  // the ground under each foot, as contacts report it with the feet down
+      std::vector<Eigen::Vector3d> feet = sim.FootPositions();
+      for (Eigen::Vector3d& f : feet) f.z() = sim.GroundHeight(f.x(), f.y());
+      v[i] = FootRelief(feet);
+    } else {  // height_ahead: one leg reach along the heading
+      const Pose torso = sim.TorsoPose();
+      Eigen::Vector2d ahead = torso.rotation.col(0).head<2>();
+      ahead = ahead.norm() > 1e-9 ? ahead.normalized() : Eigen::Vector2d::UnitX();
+      const Eigen::Vector2d here = torso.position_m.head<2>(), there = here + sim.leg_reach_m() * ahead;
+      v[i] = sim.GroundHeight(there.x(), there.y()) - sim.GroundHeight(here.x(), here.y());
+    }
+  }
+  return v;
 }
 
 // Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
@@ -246,6 +270,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   const int reps = options.executions_per_placement;
 
   Recorded rec;
+  const std::vector<std::string> sensed = config.terrain ? config.terrain->sensed : std::vector<std::string>();
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::normal_distribution<double> unit(0.0, 1.0);
   SimSummary sum;
@@ -259,14 +284,18 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       }
       bool fell = sim.Place(where.x_m, where.y_m, where.heading_rad) != RunOutcome::kCompleted;
       std::vector<Eigen::Matrix<double, 6, 1>> px;
-      std::vector<Eigen::Vector2d> pz;
+      std::vector<Eigen::VectorXd> pz;
       for (int r = 0; r < reps && !fell; ++r) {
         const int id = where.sequence.empty() ? where.command : where.sequence[r];
         const Eigen::Vector3d c =
             where.values.empty() ? Eigen::Vector3d(set.commands.row(id).transpose()) : where.values[r];
         const Eigen::Vector2d z_true = sim.TruePitchRoll();
-        pz.emplace_back(z_true[0] + config.noise.imu_pitch_sd_rad * unit(rng),
-                        z_true[1] + config.noise.imu_roll_sd_rad * unit(rng));
+        const Eigen::VectorXd terrain = SensedTerrain(sim, sensed);
+        Eigen::VectorXd z(2 + terrain.size());
+        z[1] = z_true[1] + config.noise.imu_roll_sd_rad * unit(rng);  // roll's draw first: the order
+        z[0] = z_true[0] + config.noise.imu_pitch_sd_rad * unit(rng); // the shipped sets were made in
+        z.tail(terrain.size()) = terrain;
+        pz.push_back(z);
         const Pose start = TrackerReading(sim.TorsoPose(), config.noise, rng);
         fell = sim.RunCommand(c) != RunOutcome::kCompleted;
         const Pose end = TrackerReading(sim.TorsoPose(), config.noise, rng);
@@ -289,7 +318,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
     if (!kept) ++sum.abandoned_placements;
     if (progress) progress(p + 1, static_cast<long long>(plan.size()));
   }
-  FillSamples(rec, &set);
+  FillSamples(rec, sensed, &set);
   const int n = set.size();
 
   sum.samples = n;
@@ -314,6 +343,10 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
                     "angles ZYX Euler of the relative rotation";
   meta["z_frame"] = "IMU pitch/roll relative to gravity before each execution; pitch > 0 nose "
                     "down, roll > 0 left side up";
+  if (!sensed.empty()) {
+    meta["z_frame"] += "; foot_relief: sd of the feet's heights about their least-squares plane (m); "
+                       "height_ahead: ground one leg reach ahead minus under the torso (m)";
+  }
   if (summary) *summary = sum;
 }
 

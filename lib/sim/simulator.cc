@@ -68,7 +68,12 @@ struct Simulator::Impl {
     const Pose pose = Torso();
     const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
     const double kMinHeightShare = 0.4;  // of the stance height
-    const double ground_m = ground->HeightAt(pose.position_m.x(), pose.position_m.y());
+    double ground_m = 0;  // mean ground height under the feet (a stone under the belly is no fall)
+    if (ground->field()) {
+      for (const int site : parts.foot_site) {
+        ground_m += ground->HeightAt(data->site_xpos[3 * site], data->site_xpos[3 * site + 1]) / kNumLegs;
+      }
+    }
     return pose.rotation(2, 2) < kMaxTiltCos ||
            pose.position_m.z() - ground_m < kMinHeightShare * config.gait.stance_height_m;
   }
@@ -207,6 +212,23 @@ RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command,
 }
 
 Pose Simulator::TorsoPose() const { return impl_->walker ? impl_->walker->RobotPose() : impl_->Torso(); }
+
+std::vector<Eigen::Vector3d> Simulator::FootPositions() const {
+  std::vector<Eigen::Vector3d> feet;
+  if (impl_->walker) {
+    for (const LegChain& leg : impl_->walker->robot().legs) {
+      feet.push_back(FootPoint(impl_->walker->model(), impl_->walker->data(), leg));
+    }
+    return feet;
+  }
+  for (const int site : impl_->parts.foot_site) {
+    const mjtNum* p = impl_->data->site_xpos + 3 * site;
+    feet.emplace_back(p[0], p[1], p[2]);
+  }
+  return feet;
+}
+
+double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->ground->HeightAt(x_m, y_m); }
 
 Eigen::Vector2d Simulator::TruePitchRoll() const {
   return PitchRollFromGravity(TorsoPose().rotation, impl_->up);

@@ -51,7 +51,8 @@ class Simulator {
   RunOutcome Place(double x_m, double y_m, double heading_rad);
   // Runs the gait for command_duration_s. `trajectory` (optional) receives the torso pose every
   // `sample_every` steps. Stops early on a fall/flip (torso tilted > 60 deg from the slope normal
-  // or its centre below 40% of the stance height) or numerical instability.
+  // or its centre below 40% of the stance height above the mean ground under the feet) or
+  // numerical instability.
   RunOutcome RunCommand(const Eigen::Vector3d& command, std::vector<Pose>* trajectory = nullptr,
                         int sample_every = 10);
   // As above, calling observer(*this) every `observe_every` steps (e.g. to take snapshots).
@@ -61,6 +62,11 @@ class Simulator {
   RunOutcome Stand(double seconds);
 
   Pose TorsoPose() const;                // true torso pose in the slope frame
+  // Every foot's point in the slope frame (the built-in robot: its foot sites; a robot block's:
+  // each leg's foot).
+  std::vector<Eigen::Vector3d> FootPositions() const;
+  // The ground's height along the slope normal at (x, y) of the slope frame (0 on the plane).
+  double GroundHeight(double x_m, double y_m) const;
   Eigen::Vector2d TruePitchRoll() const; // <pitch, roll> relative to gravity (rad)
   Eigen::Vector3d Up() const;            // unit vector against gravity, slope frame
   double time_s() const;                 // simulated time since construction

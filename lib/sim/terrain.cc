@@ -1,5 +1,6 @@
 #include "sim/terrain.h"
 
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -100,6 +101,13 @@ std::string Str(double v) {
 }  // namespace
 
 bool TerrainDescription::IsValid(std::string* error) const {
+  for (std::size_t i = 0; i < sensed.size(); ++i) {
+    const bool known = sensed[i] == "foot_relief" || sensed[i] == "height_ahead";
+    if (!Check(known, "terrain.sensed: expected foot_relief or height_ahead, got \"" + sensed[i] + "\"", error) ||
+        !Check(std::count(sensed.begin(), sensed.end(), sensed[i]) == 1, "terrain.sensed: " + sensed[i] + " twice", error)) {
+      return false;
+    }
+  }
   const auto finite_pos = [](double v) { return std::isfinite(v) && v > 0; };
   const auto finite_nonneg = [](double v) { return std::isfinite(v) && v >= 0; };
   if (!Check(finite_pos(half_size_m) && half_size_m <= 1000, "terrain.half_size_m: expected a number in (0, 1000]", error) ||
@@ -152,6 +160,7 @@ TerrainDescription TerrainFromJson(const std::string& json_text, const std::stri
     c.Number("radius_m", &t.stones.radius_m, 0, 1000);
     c.Number("per_m2", &t.stones.per_m2, 0, 1e4);
   });
+  f.Strings("sensed", &t.sensed);
   child("steps", [&](JsonFields& c) {
     c.Number("height_m", &t.steps.height_m, 0, 1000);
     c.Number("length_m", &t.steps.length_m, 0, 1000);
@@ -173,6 +182,7 @@ std::string TerrainToJson(const TerrainDescription& t) {
   j["rough"] = {{"rms_height_m", t.rough.rms_height_m}, {"correlation_length_m", t.rough.correlation_length_m}};
   j["stones"] = {{"height_m", t.stones.height_m}, {"radius_m", t.stones.radius_m}, {"per_m2", t.stones.per_m2}};
   j["steps"] = {{"height_m", t.steps.height_m}, {"length_m", t.steps.length_m}};
+  if (!t.sensed.empty()) j["sensed"] = t.sensed;
   return j.dump();
 }
 
@@ -212,6 +222,19 @@ double HeightField::RmsHeight() const {
   mean /= std::max<std::size_t>(1, h_.size());
   for (float v : h_) sq += (v - mean) * (v - mean);
   return std::sqrt(sq / std::max<std::size_t>(1, h_.size()));
+}
+
+double FootRelief(const std::vector<Eigen::Vector3d>& feet) {
+  const int n = static_cast<int>(feet.size());
+  if (n < 4) return 0;
+  Eigen::MatrixXd a(n, 3);
+  Eigen::VectorXd z(n);
+  for (int i = 0; i < n; ++i) {
+    a.row(i) << 1, feet[i].x(), feet[i].y();
+    z[i] = feet[i].z();
+  }
+  const Eigen::VectorXd residual = z - a * a.colPivHouseholderQr().solve(z);
+  return std::sqrt(residual.squaredNorm() / n);
 }
 
 std::vector<std::string> TerrainScaleWarnings(const TerrainDescription& t, double stance_height_m, double foot_radius_m) {

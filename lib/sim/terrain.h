@@ -38,6 +38,12 @@ struct TerrainDescription {
   RoughGround rough;
   Stones stones;
   Steps steps;
+  // Terrain as the robot senses it at the start of an execution, recorded as extra conditioning
+  // dimensions of z after pitch and roll: "foot_relief" (m, sd of the ground's heights under the
+  // feet about their least-squares plane: what foot contacts tell with the feet down) and
+  // "height_ahead" (m, ground one leg reach ahead minus under the torso: what a depth camera
+  // sees). Both exact (no sensor noise).
+  std::vector<std::string> sensed;
 
   // False with a one-line reason (field and expected range); at most kMaxCells grid points.
   bool IsValid(std::string* error) const;
@@ -73,6 +79,10 @@ class HeightField {
   double half_ = 0, resolution_ = 0, min_ = 0, max_ = 0;
   std::vector<float> h_;
 };
+
+// sd (m) of the points' heights about their least-squares plane z = a + b x + c y (0 for
+// fewer than four points).
+double FootRelief(const std::vector<Eigen::Vector3d>& feet_m);
 
 // Advice when the ground is far off the robot's scale (empty when it is not): e.g. steps or
 // stones higher than the stance height, or a grid coarser than the feet.

@@ -172,3 +172,36 @@ TEST(ProtocolTest, ParsesNamesAndRejectsBadOptions) {
 
 }  // namespace
 }  // namespace dgmm::sim
+
+namespace dgmm::sim {
+namespace {
+
+TEST(ProtocolSensedTerrainTest, RecordsTheTerrainAsTheRobotSensesIt) {
+  SimConfig c;
+  c.slope_deg = 5;
+  TerrainDescription t;
+  t.half_size_m = 2.5;
+  t.resolution_m = 0.04;
+  t.stones = {0.04, 0.1, 3};
+  t.sensed = {"foot_relief", "height_ahead"};
+  c.terrain = t;
+  const SampleSet set = SimulateProtocol(c, Short(5));
+  ASSERT_EQ(set.z.cols(), 4);
+  EXPECT_EQ(set.z_names, (std::vector<std::string>{"pitch", "roll", "foot_relief", "height_ahead"}));
+  EXPECT_EQ(set.z_units[3], "m");
+  EXPECT_GE(set.z.col(2).minCoeff(), 0.0);
+  EXPECT_GT(set.z.col(2).maxCoeff(), 2e-3);  // some placement has a foot on a stone
+  EXPECT_GT(set.z.col(3).cwiseAbs().maxCoeff(), 1e-3);
+
+  // The same on featureless ground: nothing ahead, the feet in one plane.
+  c.terrain->stones = {};
+  const SampleSet flat = SimulateProtocol(c, Short(5));
+  EXPECT_EQ(flat.z.col(3).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(flat.z.col(2).maxCoeff(), 0.0);
+  // Without sensed descriptors, the set is the one the plane config records (pitch, roll).
+  c.terrain->sensed.clear();
+  EXPECT_EQ(SimulateProtocol(c, Short(5)).z.cols(), 2);
+}
+
+}  // namespace
+}  // namespace dgmm::sim

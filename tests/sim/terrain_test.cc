@@ -115,6 +115,26 @@ TEST(TerrainTest, JsonRoundTripsAndRefusesBadFields) {
             std::string::npos);
 }
 
+TEST(TerrainTest, FootReliefIsTheSpreadAboutTheFeetsPlane) {
+  std::vector<Eigen::Vector3d> feet;
+  for (int i = 0; i < 6; ++i) {
+    const double x = std::cos(i), y = std::sin(2 * i);
+    feet.emplace_back(x, y, 0.1 + 0.2 * x - 0.3 * y);  // a tilted plane: no relief
+  }
+  EXPECT_NEAR(FootRelief(feet), 0.0, 1e-12);
+  feet[0].z() += 0.06;  // one foot on a stone
+  const double relief = FootRelief(feet);
+  EXPECT_GT(relief, 0.01);
+  EXPECT_LT(relief, 0.06);
+  EXPECT_EQ(FootRelief({feet[0], feet[1], feet[2]}), 0.0);  // three points always fit a plane
+}
+
+TEST(TerrainTest, SensedDescriptorsAreNamedOnce) {
+  EXPECT_EQ(TerrainFromJson(R"({"sensed": ["height_ahead", "foot_relief"]})", "t").sensed.size(), 2u);
+  EXPECT_THROW(TerrainFromJson(R"({"sensed": ["lidar"]})", "t"), InputError);
+  EXPECT_THROW(TerrainFromJson(R"({"sensed": ["foot_relief", "foot_relief"]})", "t"), InputError);
+}
+
 TEST(TerrainTest, WarnsWhenTheGroundIsOffTheRobotsScale) {
   TerrainDescription t = Rough(0.005, 0.1);
   EXPECT_TRUE(TerrainScaleWarnings(t, 0.14, 0.02).empty());
