@@ -61,6 +61,7 @@ void RunSimulate(const SimulateArgs& args) {
     throw MakeInputError(args.config_path, "", "every placement fell; nothing to write (" +
                                                    summary.BriefReport() + ")");
   }
+  for (const std::string& w : summary.warnings) Warn(args.config_path + ": " + w);
   WriteSampleSet(set, args.output);
   if (args.json) {
     nlohmann::json j = {{"output", args.output},

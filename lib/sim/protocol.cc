@@ -322,6 +322,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   const int n = set.size();
 
   sum.samples = n;
+  sum.warnings = sim.ScaleWarnings();
   sum.placements = static_cast<int>(plan.size());
   sum.simulated_seconds = sim.time_s();
   sum.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;

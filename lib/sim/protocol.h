@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "core/sample_set.h"
 #include "sim/sim_config.h"
@@ -56,6 +57,7 @@ struct SimSummary {
   double simulated_seconds = 0;
   double wall_seconds = 0;
   double cpu_seconds = 0;  // process CPU time while simulating (wall time suffers on a busy machine)
+  std::vector<std::string> warnings;  // the config against the robot's scale (Simulator::ScaleWarnings)
 
   double SimulatedPerWallSecond() const;
   double SamplesPerWallSecond() const;

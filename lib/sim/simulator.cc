@@ -228,6 +228,19 @@ std::vector<Eigen::Vector3d> Simulator::FootPositions() const {
   return feet;
 }
 
+std::vector<std::string> Simulator::ScaleWarnings() const {
+  const SimConfig& c = impl_->config;
+  if (!c.terrain) return {};
+  double stance = c.gait.stance_height_m, foot = 0;
+  if (impl_->walker) {
+    stance = impl_->walker->robot().stance_height_m;
+    for (const LegChain& leg : impl_->walker->robot().legs) foot = std::max(foot, leg.foot_extent_m);
+  } else {
+    for (const LegGeometry& leg : impl_->parts.legs) foot = std::max(foot, leg.foot_radius_m);
+  }
+  return TerrainScaleWarnings(*c.terrain, stance, foot);
+}
+
 double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->ground->HeightAt(x_m, y_m); }
 
 Eigen::Vector2d Simulator::TruePitchRoll() const {

@@ -78,6 +78,10 @@ class Simulator {
   const std::array<LegGeometry, kNumLegs>& legs() const;
   const SimConfig& config() const;
 
+  // Advice on the config against this robot's scale (terrain.h TerrainScaleWarnings); empty
+  // when nothing is far off.
+  std::vector<std::string> ScaleWarnings() const;
+
   // Visible geoms (alpha > 0) at the current state, slope frame.
   std::vector<GeomSnapshot> Geometry() const;
 

@@ -246,9 +246,12 @@ std::vector<std::string> TerrainScaleWarnings(const TerrainDescription& t, doubl
   warn(tallest > 0.5 * stance_height_m,
        "terrain: features up to " + Str(tallest) + " m against a stance height of " + Str(stance_height_m) +
            " m; the feet may not clear them (expected under half the stance height)");
-  warn(foot_radius_m > 0 && t.resolution_m > 2 * foot_radius_m,
-       "terrain.resolution_m: " + Str(t.resolution_m) + " m is coarser than the feet (radius " + Str(foot_radius_m) +
-           " m); the ground under a foot is a single facet");
+  warn(foot_radius_m > 0 && t.resolution_m > 5 * foot_radius_m,
+       "terrain.resolution_m: " + Str(t.resolution_m) + " m is over 5 foot radii (" + Str(foot_radius_m) +
+           " m); the ground is coarse facets under the feet");
+  warn(foot_radius_m > 0 && t.resolution_m < foot_radius_m,
+       "terrain.resolution_m: " + Str(t.resolution_m) + " m is under the foot radius (" + Str(foot_radius_m) +
+           " m); MuJoCo makes a contact per grid prism under a foot, which slows the simulation (docs/simulation.md)");
   warn(t.rough.rms_height_m > 0 && t.rough.correlation_length_m < 2 * t.resolution_m,
        "terrain.rough.correlation_length_m: under two grid points; the ground is grid noise");
   return warnings;

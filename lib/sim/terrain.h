@@ -84,8 +84,9 @@ class HeightField {
 // fewer than four points).
 double FootRelief(const std::vector<Eigen::Vector3d>& feet_m);
 
-// Advice when the ground is far off the robot's scale (empty when it is not): e.g. steps or
-// stones higher than the stance height, or a grid coarser than the feet.
+// Advice when the ground is far off the robot's scale (empty when it is not): features over half
+// the stance height, a grid coarser than 5 foot radii or finer than one, a correlation length
+// under two grid points.
 std::vector<std::string> TerrainScaleWarnings(const TerrainDescription& terrain, double stance_height_m,
                                               double foot_radius_m);
 

@@ -143,7 +143,10 @@ TEST(TerrainTest, WarnsWhenTheGroundIsOffTheRobotsScale) {
   EXPECT_NE(TerrainScaleWarnings(t, 0.14, 0.02)[0].find("stance height"), std::string::npos);
   t.steps = {};
   t.resolution_m = 0.05;
-  EXPECT_EQ(TerrainScaleWarnings(t, 0.14, 0.01).size(), 1u);
+  EXPECT_TRUE(TerrainScaleWarnings(t, 0.14, 0.02).empty());
+  EXPECT_EQ(TerrainScaleWarnings(t, 0.14, 0.005).size(), 1u);  // coarse facets under small feet
+  t.resolution_m = 0.01;
+  EXPECT_EQ(TerrainScaleWarnings(t, 0.14, 0.02).size(), 1u);   // many contacts per foot
 }
 
 }  // namespace
