@@ -67,12 +67,16 @@ ScenePrimitive ToPrimitive(const sim::GeomSnapshot& g, const Eigen::Matrix3d& le
     case T::kSphere: p.type = ScenePrimitive::Type::kSphere; break;
     case T::kCapsule: p.type = ScenePrimitive::Type::kCapsule; break;
     case T::kCylinder: p.type = ScenePrimitive::Type::kCylinder; break;
+    case T::kHeightField: p.type = ScenePrimitive::Type::kHeightField; break;
     default: p.type = ScenePrimitive::Type::kBox; break;
   }
   p.size = g.size;
   p.position = level * g.position_m;
   p.rotation = level * g.rotation;
   p.rgba = g.rgba;
+  p.grid = g.grid;
+  p.spacing = g.spacing_m;
+  p.heights = g.heights;
   if (g.type == T::kPlane) {  // a 3 m tile under the robot instead of the whole plane
     p.size = Eigen::Vector3d(1.5, 1.5, 0);
     p.position = level * Eigen::Vector3d(torso.x(), torso.y(), 0);

@@ -1,5 +1,6 @@
 #include "render/robot_view.h"
 
+#include <cmath>
 #include <vtkActor.h>
 #include <vtkCamera.h>
 #include <vtkCubeSource.h>
@@ -8,7 +9,10 @@
 #include <vtkLight.h>
 #include <vtkMatrix4x4.h>
 #include <vtkPlaneSource.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
 #include <vtkPolyDataAlgorithm.h>
+#include <vtkPolyDataNormals.h>
 #include <vtkPolyDataMapper.h>
 #include <vtkProperty.h>
 #include <vtkRenderWindow.h>
@@ -93,6 +97,29 @@ void AddPrimitive(vtkRenderer* renderer, const ScenePrimitive& p) {
       }
       break;
     }
+    case Type::kHeightField: {
+      // The grid as a plane source of that resolution, its points lifted to the heights.
+      auto plane = Ptr<vtkPlaneSource>::New();
+      const double h = 0.5 * (p.grid - 1) * p.spacing;
+      plane->SetOrigin(-h, -h, 0);
+      plane->SetPoint1(h, -h, 0);
+      plane->SetPoint2(-h, h, 0);
+      plane->SetResolution(p.grid - 1, p.grid - 1);
+      plane->Update();
+      auto surface = Ptr<vtkPolyData>::New();
+      surface->DeepCopy(plane->GetOutput());
+      vtkPoints* points = surface->GetPoints();
+      for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
+        double xyz[3];
+        points->GetPoint(i, xyz);
+        xyz[2] = p.heights[static_cast<std::size_t>(i)];
+        points->SetPoint(i, xyz);
+      }
+      auto normals = Ptr<vtkPolyDataNormals>::New();
+      normals->SetInputData(surface);
+      AddActor(renderer, normals, p.rotation, p.position, p.rgba);
+      break;
+    }
     case Type::kPlane: {
       auto plane = Ptr<vtkPlaneSource>::New();
       const double hx = p.size[0] > 0 ? p.size[0] : 2, hy = p.size[1] > 0 ? p.size[1] : 2;
@@ -123,6 +150,15 @@ void AddPrimitive(vtkRenderer* renderer, const ScenePrimitive& p) {
 }
 
 bool Finite(const ScenePrimitive& p) {
+  if (p.type == ScenePrimitive::Type::kHeightField) {
+    if (p.grid < 2 || !(p.spacing > 0) || !std::isfinite(p.spacing) ||
+        p.heights.size() != static_cast<std::size_t>(p.grid) * p.grid) {
+      return false;
+    }
+    for (float h : p.heights) {
+      if (!std::isfinite(h)) return false;
+    }
+  }
   return p.size.allFinite() && p.position.allFinite() && p.rotation.allFinite() &&
          p.rgba.allFinite();
 }
@@ -143,7 +179,7 @@ void RenderSceneStrip(const std::vector<SceneView>& scenes, const SceneStripOpti
   if (!problem.empty()) throw MakeInputError(png_path, "options", problem);
   for (const auto& scene : scenes) {
     for (const auto& p : scene.primitives) {
-      if (!Finite(p)) throw MakeInputError(png_path, "primitives", "non-finite geometry");
+      if (!Finite(p)) throw MakeInputError(png_path, "primitives", "non-finite geometry or a height field whose heights are not grid x grid");
     }
   }
   RequireDisplay();

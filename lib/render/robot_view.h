@@ -10,14 +10,18 @@ namespace dgmm {
 
 // One solid in world coordinates. Sizes follow MuJoCo's geom_size: box half-extents (x, y, z);
 // sphere radius (size[0]); capsule/cylinder radius and half-length along local z (size[0],
-// size[1]); plane half-extents x, y (size[0], size[1]) drawn as a finite tile.
+// size[1]); plane half-extents x, y (size[0], size[1]) drawn as a finite tile; a height field:
+// `grid` x `grid` heights (row-major, row = local y) spaced `spacing` apart, centred on position.
 struct ScenePrimitive {
-  enum class Type { kPlane, kSphere, kCapsule, kCylinder, kBox };
+  enum class Type { kPlane, kSphere, kCapsule, kCylinder, kBox, kHeightField };
   Type type = Type::kBox;
   Eigen::Vector3d size = Eigen::Vector3d::Zero();
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // local -> world
   Eigen::Vector4d rgba = Eigen::Vector4d::Ones();
+  int grid = 0;           // kHeightField only
+  double spacing = 0;
+  std::vector<float> heights;
 };
 
 // A pinhole camera looking from `position` at `focal_point`.

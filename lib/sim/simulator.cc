@@ -284,6 +284,7 @@ std::vector<GeomSnapshot> Simulator::Geometry() const {
       case mjGEOM_CAPSULE: g.type = GeomSnapshot::Type::kCapsule; break;
       case mjGEOM_CYLINDER: g.type = GeomSnapshot::Type::kCylinder; break;
       case mjGEOM_BOX: g.type = GeomSnapshot::Type::kBox; break;
+      case mjGEOM_HFIELD: g.type = GeomSnapshot::Type::kHeightField; break;
       default: g.type = GeomSnapshot::Type::kOther; break;
     }
     for (int k = 0; k < 3; ++k) {
@@ -292,6 +293,15 @@ std::vector<GeomSnapshot> Simulator::Geometry() const {
     }
     g.rotation = Eigen::Map<const Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>>(d->geom_xmat + 9 * i);
     for (int k = 0; k < 4; ++k) g.rgba[k] = m->geom_rgba[4 * i + k];
+    if (g.type == GeomSnapshot::Type::kHeightField) {
+      const HeightField* field = impl_->ground->field();
+      if (!field) continue;  // a height field of the robot's own MJCF: not drawn
+      g.grid = field->size();
+      g.spacing_m = field->resolution_m();
+      g.heights = field->heights();
+      g.position_m.setZero();
+      g.rotation.setIdentity();
+    }
     geoms.push_back(g);
   }
   return geoms;

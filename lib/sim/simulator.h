@@ -24,12 +24,17 @@ using ModelEdit = std::function<void(mjModel_*)>;
 
 // A drawable geometric primitive of the simulated scene, in the slope frame (for robot_view).
 struct GeomSnapshot {
-  enum class Type { kPlane, kSphere, kCapsule, kCylinder, kBox, kOther };
+  enum class Type { kPlane, kSphere, kCapsule, kCylinder, kBox, kHeightField, kOther };
   Type type = Type::kOther;
   Eigen::Vector3d size = Eigen::Vector3d::Zero();  // MuJoCo geom_size (half-sizes / radius, half-length)
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // geom -> slope frame
   Eigen::Vector4d rgba = Eigen::Vector4d::Ones();
+  // kHeightField: the ground's grid x grid heights (m, row-major, row = y), `spacing_m` apart,
+  // centred on position_m (terrain.h).
+  int grid = 0;
+  double spacing_m = 0;
+  std::vector<float> heights;
 };
 
 // Why a command execution ended.
