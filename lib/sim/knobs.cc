@@ -70,6 +70,27 @@ void AddTrackerNoiseKnob(const SimConfig& config, std::vector<Knob>* knobs) {
   }
 }
 
+void AddGroundKnobs(const SimConfig& config, std::vector<Knob>* knobs) {
+  if (!config.terrain) return;
+  const TerrainDescription& t = *config.terrain;
+  const auto add = [&](bool has, KnobKind kind, const char* name) {
+    if (has) knobs->push_back(MakeKnob(kind, -1, name, "ground", "", 1.0, 0.0, 3.0, {0.5, 1.5}));
+  };
+  add(t.rough.rms_height_m > 0, KnobKind::kGroundRoughness, "terrain.rough.rms_scale");
+  add(t.stones.height_m > 0 && t.stones.per_m2 > 0, KnobKind::kGroundStoneHeight, "terrain.stones.height_scale");
+  add(t.steps.height_m > 0, KnobKind::kGroundStepHeight, "terrain.steps.height_scale");
+}
+
+void ApplyGroundKnob(const SimConfig& config, KnobKind kind, double factor, SimConfig* out) {
+  if (!config.terrain || !out->terrain) throw MakeInputError("simulation config", "terrain", "no terrain to scale");
+  switch (kind) {
+    case KnobKind::kGroundRoughness: out->terrain->rough.rms_height_m = config.terrain->rough.rms_height_m * factor; break;
+    case KnobKind::kGroundStoneHeight: out->terrain->stones.height_m = config.terrain->stones.height_m * factor; break;
+    case KnobKind::kGroundStepHeight: out->terrain->steps.height_m = config.terrain->steps.height_m * factor; break;
+    default: break;
+  }
+}
+
 void ScaleTrackerNoise(const SimConfig& config, double factor, SimConfig* out) {
   const auto& n = config.noise;
   out->noise.tracker_position_sd_m = n.tracker_position_sd_m * factor;
@@ -162,6 +183,7 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
   knobs.push_back(MakeKnob(KnobKind::kBacklash, -1, "actuators.backlash_rad", "backlash", "rad", bl, 0.0, 0.2,
                            {bl + 0.03 <= 0.2 ? bl + 0.03 : bl - 0.03}));
   // Last: a measurement-side knob of the simulator (the tracker's noise), config-level.
+  AddGroundKnobs(config, &knobs);
   AddTrackerNoiseKnob(config, &knobs);
   return knobs;
 }
@@ -214,6 +236,9 @@ SimConfig ApplyKnobs(const SimConfig& config, const std::vector<Knob>& knobs,
       case KnobKind::kBacklash: c.actuators.backlash_rad = v.value; break;
       case KnobKind::kFrictionScale: break;  // a robot block's knob only
       case KnobKind::kTrackerNoiseScale: ScaleTrackerNoise(config, v.value, &c); break;
+      case KnobKind::kGroundRoughness:
+      case KnobKind::kGroundStoneHeight:
+      case KnobKind::kGroundStepHeight: ApplyGroundKnob(config, k.kind, v.value, &c); break;
     }
   }
   if (payload) {

@@ -4,7 +4,8 @@
 // contact softness (solref) and impedance (solimp dmax, width), all-body mass scale, a payload on
 // the torso, actuator gain per leg (legs = the torso's child subtrees that carry actuators), per
 // side (sign of the leg root's y), of all legs (kp), joint damping, actuation latency, backlash,
-// and last the tracker's noise scale (when the config has tracker noise). Each knob knows its
+// the ground's own shape (factors on the terrain block's roughness, stone and step heights, when
+// it has them), and last the tracker's noise scale (when the config has tracker noise). Each knob knows its
 // nominal value, a physical range, the probe values simulated for its signature (docs/sim2real.md,
 // "Signatures from the simulator") and how to apply a value (to the SimConfig, or to the compiled
 // mjModel through a ModelEdit).
@@ -37,6 +38,9 @@ enum class KnobKind {
   kBacklash,           // gear-train free play of every leg joint [rad] (actuators.backlash_rad)
   kTrackerNoiseScale,  // factor on the four tracker sd's of config.noise (not the IMU's)
   kFrictionScale,      // factor on every geom's sliding friction (a robot block's robot)
+  kGroundRoughness,    // factor on terrain.rough.rms_height_m (a config with terrain)
+  kGroundStoneHeight,  // factor on terrain.stones.height_m
+  kGroundStepHeight,   // factor on terrain.steps.height_m
 };
 
 // Confusion-matrix family of a knob (docs/sim2real.md, "report.json verdict").
@@ -96,6 +100,11 @@ double PayloadProbeMass(const SimConfig& config);
 // has any tracker noise, and applies a value of it (the four tracker sd's of `config` scaled into
 // out->noise; the IMU's untouched).
 void AddTrackerNoiseKnob(const SimConfig& config, std::vector<Knob>* knobs);
+// The ground's knobs shared by every robot (family "ground"): a factor in [0, 3] on each terrain
+// feature the config has (terrain.rough.rms_scale, terrain.stones.height_scale,
+// terrain.steps.height_scale); none on the plane. ApplyGroundKnob sets one on `out`.
+void AddGroundKnobs(const SimConfig& config, std::vector<Knob>* knobs);
+void ApplyGroundKnob(const SimConfig& config, KnobKind kind, double factor, SimConfig* out);
 void ScaleTrackerNoise(const SimConfig& config, double factor, SimConfig* out);
 
 }  // namespace dgmm::sim

@@ -122,6 +122,7 @@ std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
   knobs.push_back(MakeKnob(KnobKind::kDampingScale, -1, "joints.damping_scale", "joint_damping", "", 1.0, 0.05, 10.0,
                        {0.25, 4.0}));
   AddActuationKnobs(config, m, &knobs);
+  AddGroundKnobs(config, &knobs);
   AddTrackerNoiseKnob(config, &knobs);
   return knobs;
 }
@@ -155,6 +156,9 @@ SimConfig ApplyRobotKnobs(const SimConfig& config, const std::vector<Knob>& knob
         }
         break;
       case KnobKind::kTrackerNoiseScale: ScaleTrackerNoise(config, v.value, &c); break;
+      case KnobKind::kGroundRoughness:
+      case KnobKind::kGroundStoneHeight:
+      case KnobKind::kGroundStepHeight: ApplyGroundKnob(config, k.kind, v.value, &c); break;
       default:
         throw MakeInputError(config.mjcf_path, k.name, "not a knob of a robot block's robot");
     }

@@ -185,3 +185,41 @@ TEST(Knobs, NewKnobsChangeAShortProtocolOnTheShippedRobots) {
 
 }  // namespace
 }  // namespace dgmm::sim
+
+namespace dgmm::sim {
+namespace {
+
+TEST(GroundKnobsTest, TheGroundsOwnShapeIsAKnobOnRoughGroundOnly) {
+  const auto names = [](const std::vector<Knob>& knobs) {
+    std::vector<std::string> out;
+    for (const Knob& k : knobs) {
+      if (k.family == "ground") out.push_back(k.name);
+    }
+    return out;
+  };
+  SimConfig c;
+  EXPECT_TRUE(names(EnumerateKnobs(c)).empty());
+  TerrainDescription t;
+  t.half_size_m = 2;
+  t.rough = {0.01, 0.2};
+  t.stones = {0.05, 0.1, 1};
+  c.terrain = t;
+  const std::vector<Knob> knobs = EnumerateKnobs(c);
+  EXPECT_EQ(names(knobs), (std::vector<std::string>{"terrain.rough.rms_scale", "terrain.stones.height_scale"}));
+  int stones = -1;
+  for (int i = 0; i < static_cast<int>(knobs.size()); ++i) {
+    if (knobs[i].name == "terrain.stones.height_scale") stones = i;
+  }
+  ModelEdit edit;
+  const SimConfig higher = ApplyKnobs(c, knobs, {{stones, 2.0}}, &edit);
+  EXPECT_DOUBLE_EQ(higher.terrain->stones.height_m, 0.1);
+  EXPECT_DOUBLE_EQ(higher.terrain->rough.rms_height_m, 0.01);
+  EXPECT_GT(HeightField::Generate(*higher.terrain).max_m(), HeightField::Generate(t).max_m() + 0.03);
+  // The same for a robot block's robot.
+  SimConfig hexapod = LoadSimConfig(std::string(DGMM_SOURCE_DIR) + "/datasets/robots/hexapod.json");
+  hexapod.terrain = t;
+  EXPECT_EQ(names(EnumerateKnobs(hexapod)).size(), 2u);
+}
+
+}  // namespace
+}  // namespace dgmm::sim
