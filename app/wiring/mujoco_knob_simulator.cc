@@ -106,6 +106,12 @@ sim2real::CellRecording MujocoKnobSimulator::RecordCell(const sim2real::Cell& ce
   options.placements = cell.placements;
   options.executions_per_placement = cell.executions_per_placement;
   options.seed = cell.seed;
+  if (config_.terrain) {  // rough ground: pitch and roll depend on the position too
+    options.headings_rad = sim::HeadingsForTerrain(config_, options, cell.terrain(0), cell.terrain(1));
+    std::snprintf(where, sizeof where, "headings matched per placement on the %.3g deg slope's rough ground",
+                  config_.slope_deg);
+    out.placement = where;
+  }
   sim::ModelEdit edit;
   const sim::SimConfig c = sim::ApplyKnobs(config_, sim_knobs_, ToSim(values), &edit);
   out.set = sim::SimulateCell(c, options, nullptr, edit);

@@ -395,11 +395,15 @@ SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSumm
     set.command_labels = {"cell"};
     row = 0;
   }
+  if (!cell.headings_rad.empty() && static_cast<int>(cell.headings_rad.size()) != cell.placements) {
+    throw MakeInputError("cell options", "headings_rad", "expected one heading per placement");
+  }
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::vector<Placement> plan(cell.placements);
-  for (auto& p : plan) {
+  for (int i = 0; i < cell.placements; ++i) {
+    Placement& p = plan[i];
     p.command = row;
-    p.heading_rad = cell.heading_rad;
+    p.heading_rad = cell.headings_rad.empty() ? cell.heading_rad : cell.headings_rad[i];
     p.x_m = position(rng);
     p.y_m = position(rng);
   }
@@ -408,21 +412,51 @@ SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSumm
   return set;
 }
 
-double HeadingForTerrain(const SimConfig& config, double pitch_rad, double roll_rad, int headings,
-                         const ModelEdit& edit) {
-  if (headings < 1 || !std::isfinite(pitch_rad) || !std::isfinite(roll_rad)) {
-    throw MakeInputError("terrain", "", "headings >= 1 and a finite pitch and roll");
-  }
-  Simulator sim(config, edit);
-  double best = 0, best_d = INFINITY;
+namespace {
+
+// The heading whose settled pose at (x, y) reads closest to (pitch, roll); NaN when every heading fell.
+double BestHeading(Simulator& sim, double x_m, double y_m, double pitch_rad, double roll_rad, int headings) {
+  double best = NAN, best_d = INFINITY;
   for (int h = 0; h < headings; ++h) {
     const double heading = -kPi + 2 * kPi * h / headings;
-    if (sim.Place(0.0, 0.0, heading) != RunOutcome::kCompleted) continue;
+    if (sim.Place(x_m, y_m, heading) != RunOutcome::kCompleted) continue;
     const Eigen::Vector2d z = sim.TruePitchRoll();
     const double d = std::hypot(z[0] - pitch_rad, z[1] - roll_rad);
     if (d < best_d) best_d = d, best = heading;
   }
-  if (!std::isfinite(best_d)) throw MakeInputError("terrain", "", "the robot fell at every heading");
+  return best;
+}
+
+void CheckTerrainTarget(int headings, double pitch_rad, double roll_rad) {
+  if (headings < 1 || !std::isfinite(pitch_rad) || !std::isfinite(roll_rad)) {
+    throw MakeInputError("terrain", "", "headings >= 1 and a finite pitch and roll");
+  }
+}
+
+}  // namespace
+
+std::vector<double> HeadingsForTerrain(const SimConfig& config, const CellOptions& cell, double pitch_rad,
+                                       double roll_rad, int headings) {
+  CheckTerrainTarget(headings, pitch_rad, roll_rad);
+  Simulator sim(config);
+  std::mt19937_64 rng(cell.seed);  // the positions SimulateCell draws
+  std::uniform_real_distribution<double> position(-1.0, 1.0);
+  std::vector<double> out;
+  for (int i = 0; i < cell.placements; ++i) {
+    const double x = position(rng), y = position(rng);
+    const double best = BestHeading(sim, x, y, pitch_rad, roll_rad, headings);
+    if (!std::isfinite(best)) throw MakeInputError("terrain", "", "the robot fell at every heading at a placement");
+    out.push_back(best);
+  }
+  return out;
+}
+
+double HeadingForTerrain(const SimConfig& config, double pitch_rad, double roll_rad, int headings,
+                         const ModelEdit& edit) {
+  CheckTerrainTarget(headings, pitch_rad, roll_rad);
+  Simulator sim(config, edit);
+  const double best = BestHeading(sim, 0.0, 0.0, pitch_rad, roll_rad, headings);
+  if (!std::isfinite(best)) throw MakeInputError("terrain", "", "the robot fell at every heading");
   return best;
 }
 

@@ -84,6 +84,8 @@ SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& optio
 struct CellOptions {
   Eigen::Vector3d command = Eigen::Vector3d::Zero();  // (long, lat, turn)
   double heading_rad = 0;  // slope frame, 0 = facing uphill
+  // One heading per placement (e.g. HeadingsForTerrain on rough ground); empty: heading_rad for all.
+  std::vector<double> headings_rad;
   int placements = 4;
   int executions_per_placement = 5;
   std::uint64_t seed = 0;
@@ -100,5 +102,10 @@ SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSumm
 // given one, among `headings` evenly spaced headings (the robot placed at the slope's centre).
 double HeadingForTerrain(const SimConfig& config, double pitch_rad, double roll_rad, int headings = 24,
                          const ModelEdit& edit = {});
+// The same search at each of the cell's placement positions (those SimulateCell draws from
+// cell.seed): on rough ground the IMU's pitch and roll depend on where the robot stands as well as
+// on its heading. Returns one heading per placement.
+std::vector<double> HeadingsForTerrain(const SimConfig& config, const CellOptions& cell, double pitch_rad,
+                                       double roll_rad, int headings = 24);
 
 }  // namespace dgmm::sim

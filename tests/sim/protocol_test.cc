@@ -205,3 +205,31 @@ TEST(ProtocolSensedTerrainTest, RecordsTheTerrainAsTheRobotSensesIt) {
 
 }  // namespace
 }  // namespace dgmm::sim
+
+namespace dgmm::sim {
+namespace {
+
+TEST(ProtocolCellTest, OnRoughGroundEachPlacementGetsItsOwnHeading) {
+  SimConfig c;
+  c.slope_deg = 10;
+  CellOptions cell;
+  cell.command = Eigen::Vector3d(0.5, 0, 0);
+  cell.placements = 3;
+  cell.executions_per_placement = 1;
+  cell.seed = 4;
+  // On the plane every position reads the same: one heading for all.
+  const std::vector<double> plane = HeadingsForTerrain(c, cell, 0.1, 0.05, 12);
+  ASSERT_EQ(plane.size(), 3u);
+  EXPECT_EQ(plane[0], HeadingForTerrain(c, 0.1, 0.05, 12));
+  EXPECT_EQ(plane[1], plane[0]);
+  EXPECT_EQ(plane[2], plane[0]);
+  // The placements then stand where asked and face as matched.
+  cell.headings_rad = plane;
+  const SampleSet set = SimulateCell(c, cell);
+  EXPECT_EQ(set.size(), 3);
+  cell.headings_rad.pop_back();
+  EXPECT_THROW(SimulateCell(c, cell), InputError);
+}
+
+}  // namespace
+}  // namespace dgmm::sim
