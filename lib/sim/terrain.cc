@@ -129,6 +129,8 @@ bool TerrainDescription::IsValid(std::string* error) const {
                    (std::isfinite(stones.radius_m) && stones.radius_m >= resolution_m && stones.radius_m <= half_size_m),
                "terrain.stones.radius_m: expected a number in [resolution_m, half_size_m]", error) &&
          Check(finite_nonneg(stones.per_m2) && stones.per_m2 <= 1e4, "terrain.stones.per_m2: expected a number in [0, 10000]", error) &&
+         Check(stones.height_m == 0 || stones.per_m2 * 4 * half_size_m * half_size_m <= kMaxStones,
+               "terrain.stones.per_m2: at most " + Str(kMaxStones) + " stones on the ground (per_m2 x its area)", error) &&
          Check(finite_nonneg(steps.height_m), "terrain.steps.height_m: expected a number >= 0", error) &&
          Check(steps.height_m == 0 || (std::isfinite(steps.length_m) && steps.length_m >= resolution_m),
                "terrain.steps.length_m: expected a number >= resolution_m", error);

@@ -48,6 +48,7 @@ struct TerrainDescription {
   // False with a one-line reason (field and expected range); at most kMaxCells grid points.
   bool IsValid(std::string* error) const;
   static constexpr long long kMaxCells = 4'000'000;
+  static constexpr double kMaxStones = 1e6;  // expected count
 };
 
 // Parses the `terrain` block (JSON text of one object): InputError "<source>: terrain.<field>: <problem>"

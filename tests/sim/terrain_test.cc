@@ -110,6 +110,9 @@ TEST(TerrainTest, JsonRoundTripsAndRefusesBadFields) {
   EXPECT_NE(error(R"({"rough": {"rms": 0.1}})").find("terrain.rough.rms: unknown key"), std::string::npos);
   EXPECT_NE(error(R"({"stones": {"height_m": -1}})").find("terrain.stones.height_m"), std::string::npos);
   EXPECT_NE(error(R"({"seed": 1.5})").find("terrain.seed"), std::string::npos);
+  EXPECT_NE(error(R"({"half_size_m": 500, "resolution_m": 1, "stones": {"height_m": 0.1, "radius_m": 1, "per_m2": 10}})")
+                .find("stones on the ground"),
+            std::string::npos);
   EXPECT_NE(error(R"({"half_size_m": 100, "resolution_m": 0.01})").find("grid points"), std::string::npos);
   EXPECT_NE(error(R"({"rough": {"rms_height_m": 0.1, "correlation_length_m": 0.001}})").find("correlation_length_m"),
             std::string::npos);
