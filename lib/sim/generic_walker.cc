@@ -41,6 +41,12 @@ bool GenericWalker::Step() {
   return StepChecked(model_.get(), data_.get());
 }
 
+std::vector<Eigen::Vector3d> GenericWalker::FootPoints() const {
+  std::vector<Eigen::Vector3d> feet;
+  for (const LegChain& leg : robot_.legs) feet.push_back(FootPoint(model_.get(), data_.get(), leg));
+  return feet;
+}
+
 Pose GenericWalker::RobotPose() const {
   Pose pose;
   const int b = robot_.torso_body;
@@ -54,13 +60,8 @@ bool GenericWalker::Fallen() const {
   const Pose pose = RobotPose();
   const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
   const double kMinHeightShare = 0.4;  // of the stance height
-  double ground_m = 0;  // mean ground height under the feet (a stone under the belly is no fall)
-  if (ground_->field()) {
-    for (const LegChain& leg : robot_.legs) {
-      const Eigen::Vector3d foot = FootPoint(model_.get(), data_.get(), leg);
-      ground_m += ground_->HeightAt(foot.x(), foot.y()) / robot_.legs.size();
-    }
-  }
+  // From the mean ground under the feet: a stone under the belly is no fall.
+  const double ground_m = ground_->field() ? ground_->MeanUnder(FootPoints()) : 0.0;
   return pose.rotation(2, 2) < kMaxTiltCos || pose.position_m.z() - ground_m < kMinHeightShare * robot_.stance_height_m;
 }
 
@@ -104,12 +105,9 @@ RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
                                 robot_.robot_in_torso.transpose();
   const Eigen::Quaterniond q(world);
   const double kDrop = 0.02 * robot_.reach_m;  // released just above the ground under the highest foot
-  const Eigen::Rotation2Dd yaw(heading_rad);
-  double ground_m = -std::numeric_limits<double>::infinity();
-  for (const LegChain& leg : robot_.legs) {
-    const Eigen::Vector2d at = Eigen::Vector2d(x_m, y_m) + yaw * leg.stance_m.head<2>();
-    ground_m = std::max(ground_m, ground_->HeightAt(at.x(), at.y()));
-  }
+  std::vector<Eigen::Vector2d> stance;
+  for (const LegChain& leg : robot_.legs) stance.push_back(leg.stance_m.head<2>());
+  const double ground_m = ground_->HighestUnder(x_m, y_m, heading_rad, stance);
   const int a = robot_.torso_qpos;
   d->qpos[a + 0] = x_m;
   d->qpos[a + 1] = y_m;

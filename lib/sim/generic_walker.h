@@ -32,6 +32,7 @@ class GenericWalker {
   RunOutcome Run(const Eigen::Vector3d& command, const std::function<void(int)>& observe);
 
   Pose RobotPose() const;  // the robot frame (forward, left, up) in the slope frame
+  std::vector<Eigen::Vector3d> FootPoints() const;  // each leg's foot, slope frame
   double time_s() const { return time_s_; }
   const mjModel* model() const { return model_.get(); }
   const mjData* data() const { return data_.get(); }

@@ -1,8 +1,10 @@
 #include "sim/ground.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 
 #include "util/error.h"
 
@@ -46,6 +48,24 @@ MjModelPtr Ground::Load(const SimConfig& config) const {
   if (!std::filesystem::is_regular_file(path, ec)) throw MakeInputError(config.mjcf_path, "MJCF", "file not found");
   const std::string wrapper = GroundWrapperMjcf(path.filename().string(), *field_);
   return LoadWithFiles({{kWrapperName, wrapper}}, (path.parent_path() / kWrapperName).string(), config.mjcf_path);
+}
+
+double Ground::MeanUnder(const std::vector<Eigen::Vector3d>& points) const {
+  double mean = 0;
+  if (!field_) return mean;
+  for (const Eigen::Vector3d& p : points) mean += HeightAt(p.x(), p.y()) / points.size();
+  return mean;
+}
+
+double Ground::HighestUnder(double x_m, double y_m, double heading_rad,
+                            const std::vector<Eigen::Vector2d>& offsets) const {
+  const Eigen::Rotation2Dd yaw(heading_rad);
+  double highest = -std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& o : offsets) {
+    const Eigen::Vector2d at = Eigen::Vector2d(x_m, y_m) + yaw * o;
+    highest = std::max(highest, HeightAt(at.x(), at.y()));
+  }
+  return highest;
 }
 
 void Ground::Install(mjModel* m, int floor, const std::string& source) const {

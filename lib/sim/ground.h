@@ -6,8 +6,10 @@
 // (so floor knobs act on it) and the plane is hidden and no longer collides.
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Core>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "sim/mujoco_model.h"
 #include "sim/sim_config.h"
@@ -30,6 +32,11 @@ class Ground {
   // Ground height along the slope normal at (x, y) of the slope frame (0 on the plane).
   double HeightAt(double x_m, double y_m) const { return field_ ? field_->At(x_m, y_m) : 0.0; }
   const HeightField* field() const { return field_ ? &*field_ : nullptr; }
+  // The mean ground height under the points' (x, y) (the fall test's reference); 0 on the plane.
+  double MeanUnder(const std::vector<Eigen::Vector3d>& points_m) const;
+  // The highest ground under the points `offsets_m` (robot frame x, y) of a robot standing at
+  // (x, y) with heading `heading_rad` (placement drops it onto this).
+  double HighestUnder(double x_m, double y_m, double heading_rad, const std::vector<Eigen::Vector2d>& offsets_m) const;
 
  private:
   std::optional<HeightField> field_;

@@ -371,6 +371,21 @@ SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& optio
   return set;
 }
 
+namespace {
+
+// A cell's placement positions, the first draws of its seed's generator (x then y per placement).
+std::vector<Eigen::Vector2d> CellPositions(int placements, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> position(-1.0, 1.0);
+  std::vector<Eigen::Vector2d> out(placements);
+  for (Eigen::Vector2d& p : out) {
+    p.x() = position(rng);
+    p.y() = position(rng);
+  }
+  return out;
+}
+
+}  // namespace
+
 SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSummary* summary,
                        const ModelEdit& edit) {
   std::string error;
@@ -398,14 +413,14 @@ SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSumm
   if (!cell.headings_rad.empty() && static_cast<int>(cell.headings_rad.size()) != cell.placements) {
     throw MakeInputError("cell options", "headings_rad", "expected one heading per placement");
   }
-  std::uniform_real_distribution<double> position(-1.0, 1.0);
+  const std::vector<Eigen::Vector2d> where = CellPositions(cell.placements, rng);
   std::vector<Placement> plan(cell.placements);
   for (int i = 0; i < cell.placements; ++i) {
     Placement& p = plan[i];
     p.command = row;
     p.heading_rad = cell.headings_rad.empty() ? cell.heading_rad : cell.headings_rad[i];
-    p.x_m = position(rng);
-    p.y_m = position(rng);
+    p.x_m = where[i].x();
+    p.y_m = where[i].y();
   }
   RunPlan(config, options, plan, rng, {}, summary, edit, &set);
   set.metadata["protocol"] = "cell";
@@ -439,12 +454,10 @@ std::vector<double> HeadingsForTerrain(const SimConfig& config, const CellOption
                                        double roll_rad, int headings) {
   CheckTerrainTarget(headings, pitch_rad, roll_rad);
   Simulator sim(config);
-  std::mt19937_64 rng(cell.seed);  // the positions SimulateCell draws
-  std::uniform_real_distribution<double> position(-1.0, 1.0);
+  std::mt19937_64 rng(cell.seed);
   std::vector<double> out;
-  for (int i = 0; i < cell.placements; ++i) {
-    const double x = position(rng), y = position(rng);
-    const double best = BestHeading(sim, x, y, pitch_rad, roll_rad, headings);
+  for (const Eigen::Vector2d& at : CellPositions(cell.placements, rng)) {  // those SimulateCell draws
+    const double best = BestHeading(sim, at.x(), at.y(), pitch_rad, roll_rad, headings);
     if (!std::isfinite(best)) throw MakeInputError("terrain", "", "the robot fell at every heading at a placement");
     out.push_back(best);
   }

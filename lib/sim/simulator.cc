@@ -64,16 +64,20 @@ struct Simulator::Impl {
     time_s += model->opt.timestep;
     return StepChecked(model.get(), data.get());
   }
+  std::vector<Eigen::Vector3d> FootSites() const {
+    std::vector<Eigen::Vector3d> feet;
+    for (const int site : parts.foot_site) {
+      const mjtNum* p = data->site_xpos + 3 * site;
+      feet.emplace_back(p[0], p[1], p[2]);
+    }
+    return feet;
+  }
   bool Fallen() const {
     const Pose pose = Torso();
     const double kMaxTiltCos = 0.5;      // 60 degrees from the slope normal
     const double kMinHeightShare = 0.4;  // of the stance height
-    double ground_m = 0;  // mean ground height under the feet (a stone under the belly is no fall)
-    if (ground->field()) {
-      for (const int site : parts.foot_site) {
-        ground_m += ground->HeightAt(data->site_xpos[3 * site], data->site_xpos[3 * site + 1]) / kNumLegs;
-      }
-    }
+    // From the mean ground under the feet: a stone under the belly is no fall.
+    const double ground_m = ground->field() ? ground->MeanUnder(FootSites()) : 0.0;
     return pose.rotation(2, 2) < kMaxTiltCos ||
            pose.position_m.z() - ground_m < kMinHeightShare * config.gait.stance_height_m;
   }
@@ -147,12 +151,9 @@ RunOutcome Simulator::Place(double x_m, double y_m, double heading_rad) {
   }
   const int q0 = s.parts.torso_qpos;
   const double kDropM = 0.005;  // released just above the ground under the highest foot
-  const Eigen::Rotation2Dd yaw(heading_rad);
-  double ground_m = -std::numeric_limits<double>::infinity();
-  for (const auto& foot : feet) {
-    const Eigen::Vector2d at = Eigen::Vector2d(x_m, y_m) + yaw * foot.head<2>();
-    ground_m = std::max(ground_m, s.ground->HeightAt(at.x(), at.y()));
-  }
+  std::vector<Eigen::Vector2d> stance;
+  for (const auto& foot : feet) stance.push_back(foot.head<2>());
+  const double ground_m = s.ground->HighestUnder(x_m, y_m, heading_rad, stance);
   d->qpos[q0 + 0] = x_m;
   d->qpos[q0 + 1] = y_m;
   d->qpos[q0 + 2] = ground_m + s.config.gait.stance_height_m + kDropM;
@@ -214,18 +215,7 @@ RunOutcome Simulator::RunCommand(const Eigen::Vector3d& command,
 Pose Simulator::TorsoPose() const { return impl_->walker ? impl_->walker->RobotPose() : impl_->Torso(); }
 
 std::vector<Eigen::Vector3d> Simulator::FootPositions() const {
-  std::vector<Eigen::Vector3d> feet;
-  if (impl_->walker) {
-    for (const LegChain& leg : impl_->walker->robot().legs) {
-      feet.push_back(FootPoint(impl_->walker->model(), impl_->walker->data(), leg));
-    }
-    return feet;
-  }
-  for (const int site : impl_->parts.foot_site) {
-    const mjtNum* p = impl_->data->site_xpos + 3 * site;
-    feet.emplace_back(p[0], p[1], p[2]);
-  }
-  return feet;
+  return impl_->walker ? impl_->walker->FootPoints() : impl_->FootSites();
 }
 
 std::vector<std::string> Simulator::ScaleWarnings() const {

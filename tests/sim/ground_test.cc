@@ -138,11 +138,6 @@ TEST_F(GroundTest, MissingRobotFileIsNamed) {
   }
 }
 
-}  // namespace
-}  // namespace dgmm::sim
-
-namespace dgmm::sim {
-namespace {
 
 TEST(GroundScaleTest, TheSimulatorWarnsOfGroundOffItsRobotsScale) {
   SimConfig c;

@@ -183,11 +183,6 @@ TEST(Knobs, NewKnobsChangeAShortProtocolOnTheShippedRobots) {
   }
 }
 
-}  // namespace
-}  // namespace dgmm::sim
-
-namespace dgmm::sim {
-namespace {
 
 TEST(GroundKnobsTest, TheGroundsOwnShapeIsAKnobOnRoughGroundOnly) {
   const auto names = [](const std::vector<Knob>& knobs) {

@@ -170,11 +170,6 @@ TEST(ProtocolTest, ParsesNamesAndRejectsBadOptions) {
   EXPECT_THROW(SimulateProtocol(bad, ProtocolOptions{}), InputError);
 }
 
-}  // namespace
-}  // namespace dgmm::sim
-
-namespace dgmm::sim {
-namespace {
 
 TEST(ProtocolSensedTerrainTest, RecordsTheTerrainAsTheRobotSensesIt) {
   SimConfig c;
@@ -203,11 +198,6 @@ TEST(ProtocolSensedTerrainTest, RecordsTheTerrainAsTheRobotSensesIt) {
   EXPECT_EQ(SimulateProtocol(c, Short(5)).z.cols(), 2);
 }
 
-}  // namespace
-}  // namespace dgmm::sim
-
-namespace dgmm::sim {
-namespace {
 
 TEST(ProtocolCellTest, OnRoughGroundEachPlacementGetsItsOwnHeading) {
   SimConfig c;
