@@ -5,11 +5,14 @@
 #include <fmt/format.h>
 #include <fstream>
 #include <memory>
+#include <optional>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
 #include "app/command.h"
+#include "app/wiring/ground_surface.h"
 #include "io/model_io.h"
+#include "predict/ground_terrain.h"
 #include "predict/predict.h"
 #include "render/display.h"
 #include "sim/sim_config.h"
@@ -131,12 +134,15 @@ nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, con
 }
 
 // The trajectory fan (render/trajectory_fan.h) of the prediction, written to args.figure.
-void WriteFigure(const predict::Prediction& p, const PredictArgs& args) {
+void WriteFigure(const predict::Prediction& p, const PredictArgs& args,
+                 const std::function<double(double, double)>& ground_height) {
   std::vector<Eigen::MatrixX2d> steps;
   for (const auto& s : p.steps) steps.push_back(s.poses.leftCols(2));
   const std::string title = "Where " + std::to_string(p.steps.size()) + " commands take the robot (" +
                             std::to_string(args.trajectories) + " trajectories): 50% (white) and 90% (orange) regions";
-  RenderHeatMap(TrajectoryFan(steps, Eigen::Vector2d(args.start[0], args.start[1]), title), args.figure);
+  HeatMapSpec fan = TrajectoryFan(steps, Eigen::Vector2d(args.start[0], args.start[1]), title);
+  if (ground_height) fan.contours.push_back(GroundContours(fan.background.range, ground_height));
+  RenderHeatMap(fan, args.figure);
 }
 
 // One warning line per step whose conditioning value (terrain, continuous commands) lies where
@@ -162,6 +168,20 @@ void WarnWhereDataIsThin(const MotionModel& model, const std::vector<int>& ids,
   }
 }
 
+// A height field is finite: trajectories that leave it read its edge heights.
+void WarnOffTheField(const predict::Prediction& p, const sim::TerrainDescription& terrain, const std::string& file) {
+  for (std::size_t k = 0; k < p.steps.size(); ++k) {
+    const Eigen::MatrixXd& poses = p.steps[k].poses;
+    const auto off = (poses.leftCols(2).array().abs() > terrain.half_size_m).rowwise().any().count();
+    if (off == 0) continue;
+    std::fprintf(stderr,
+                 "dgmm: warning: predict: %s: %ld of %ld trajectories leave the height field "
+                 "(+-%g m) by step %zu; beyond it the ground's edge heights are used\n",
+                 file.c_str(), static_cast<long>(off), static_cast<long>(poses.rows()), terrain.half_size_m, k + 1);
+    return;
+  }
+}
+
 void Run(const PredictArgs& args) {
   if (!args.figure.empty()) RequireDisplay();  // before any work or output
   for (const std::string& out : {args.output, args.figure}) {
@@ -177,16 +197,20 @@ void Run(const PredictArgs& args) {
   options.trajectories = args.trajectories;
   options.seed = args.seed;
   options.pose_dims = SplitOn(args.pose_dims, ',');
+  std::optional<sim::SimConfig> ground;
+  predict::GroundSurface surface;
   if (!args.ground.empty()) {
     if (!args.terrain.empty()) throw MakeInputError("--ground", "", "give either --terrain or --ground, not both");
     if (!args.command_values.empty()) {
       throw MakeInputError("--ground", "", "not with --command-values yet: give the terrain with --terrain");
     }
-    const sim::SimConfig ground = sim::LoadSimConfig(args.ground);
-    options.ground = predict::PlaneTerrain(model, ground.slope_deg * M_PI / 180);
+    ground = sim::LoadSimConfig(args.ground);
+    surface = GroundSurfaceOf(*ground);
+    options.ground = predict::GroundTerrain(model, surface);
   }
   const auto p = predict::Predict(model, Eigen::Vector3d(args.start[0], args.start[1], args.start[2]), steps, options);
-  if (!args.figure.empty()) WriteFigure(p, args);
+  if (ground && ground->terrain) WarnOffTheField(p, *ground->terrain, args.ground);
+  if (!args.figure.empty()) WriteFigure(p, args, surface.height);
   if (!args.output.empty()) {
     AtomicFile file(args.output);
     std::ofstream(file.temp_path()) << ToJson(model, ids, p, args).dump(2) << "\n";
@@ -227,8 +251,10 @@ void Setup(CLI::App& root) {
                   "dgmm import-log --continuous-cols), e.g. vx=0.3,wz=0.1 for every command or one "
                   "per command separated by ';'; merged with --terrain");
   cmd->add_option("--ground", args->ground,
-                  "simulation config whose ground the robot walks on (its slope_deg): each trajectory is conditioned "
-                  "on the pitch and roll where it stands; --start's yaw is then the heading on the slope (0 = uphill)");
+                  "simulation config whose ground the robot walks on (its slope_deg and terrain block): each trajectory is "
+                  "conditioned on the terrain where it stands (pitch and roll of the ground under its feet, and "
+                  "foot_relief / height_ahead when the model has them); --start is then x, y in the slope frame "
+                  "and the heading on the slope (0 = uphill)");
   cmd->add_option("--figure", args->figure,
                   "trajectory fan (PNG): where the trajectories are after each command, each step's 50% and 90% "
                   "regions and the mean path (needs an X display, e.g. xvfb-run -a)");

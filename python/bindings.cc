@@ -14,6 +14,7 @@
 #include "em/em_model.h"
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
+#include "predict/ground_terrain.h"
 #include "predict/predict.h"
 #include "util/error.h"
 
@@ -206,7 +207,7 @@ void BindFitAndPredict(py::module_& m) {
           o.trajectories = trajectories;
           o.seed = seed;
           o.pose_dims = pose_dims;
-          if (ground_slope_deg) o.ground = predict::PlaneTerrain(model, *ground_slope_deg * M_PI / 180);
+          if (ground_slope_deg) o.ground = predict::GroundTerrain(model, {*ground_slope_deg * M_PI / 180});
           const predict::Prediction p = predict::Predict(model, start, steps, o);
           const int n = static_cast<int>(p.steps.size());
           py::array_t<double> poses({n, trajectories, 4}), mean({n, 4}), cov({n, 4, 4});

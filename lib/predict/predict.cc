@@ -131,23 +131,4 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
   return out;
 }
 
-std::function<Eigen::VectorXd(const Eigen::Vector4d&)> PlaneTerrain(const MotionModel& model, double slope_rad) {
-  int pitch = -1, roll = -1;
-  for (int i = 0; i < model.terrain_dim; ++i) {
-    if (model.terrain_names[i] == "pitch") pitch = i;
-    if (model.terrain_names[i] == "roll") roll = i;
-  }
-  if (model.terrain_dim != 2 || pitch < 0 || roll < 0) {
-    throw MakeInputError("model", "terrain", "a ground of its own needs a model whose terrain is (pitch, roll)");
-  }
-  return [=](const Eigen::Vector4d& pose) {
-    const double p = std::asin(-std::sin(slope_rad) * std::cos(pose[3]));
-    const double r = std::asin(std::clamp(-std::sin(slope_rad) * std::sin(pose[3]) / std::cos(p), -1.0, 1.0));
-    Eigen::VectorXd z(2);
-    z[pitch] = p;
-    z[roll] = r;
-    return z;
-  };
-}
-
 }  // namespace dgmm::predict

@@ -21,7 +21,7 @@ struct PredictOptions {
   std::vector<std::string> pose_dims;
   // The terrain under a pose (x, y, z, yaw) for steps without a terrain of their own: each
   // trajectory is conditioned on the ground where it stands before the step (e.g. a plane's
-  // pitch and roll at its heading, PlaneTerrain). Empty: steps without a terrain marginalise it.
+  // pitch and roll at its heading, GroundTerrain of ground_terrain.h). Empty: steps without a terrain marginalise it.
   std::function<Eigen::VectorXd(const Eigen::Vector4d& pose)> ground;
   bool IsValid(std::string* error) const;
 };
@@ -45,12 +45,6 @@ struct Prediction {
   bool spatial = false;  // SE(3) composition
   std::vector<StepPrediction> steps;
 };
-
-// The IMU pitch and roll of a robot standing on a plane tilted by slope_rad about the world y
-// axis (uphill = +x), at heading yaw (0 = facing uphill): pitch = asin(-sin a cos yaw) (nose
-// down > 0), roll = asin(-sin a sin yaw / cos pitch) (left side up > 0), in that order, placed at
-// the model's terrain dimensions named "pitch" and "roll" (InputError when it has other ones).
-std::function<Eigen::VectorXd(const Eigen::Vector4d&)> PlaneTerrain(const MotionModel& model, double slope_rad);
 
 // Start pose: x, y (m), yaw (rad) in the world; z, roll and pitch start at zero. A model fitted
 // on standardised data is conditioned and sampled in its own units and reported in raw ones. Throws

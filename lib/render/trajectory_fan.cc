@@ -93,4 +93,15 @@ HeatMapSpec TrajectoryFan(const std::vector<Eigen::MatrixX2d>& steps, const Eige
   return spec;
 }
 
+ContourOverlay GroundContours(const PlotRange& range, const std::function<double(double, double)>& height) {
+  constexpr int kCells = 150;
+  ContourOverlay ground{DensityGrid{range, Eigen::MatrixXd::Zero(kCells, kCells)}, 8, {150, 150, 150}, 1.0f,
+                        "ground height"};
+  for (int j = 0; j < kCells; ++j) {
+    for (int i = 0; i < kCells; ++i) ground.grid.values(j, i) = height(ground.grid.x(i), ground.grid.y(j));
+  }
+  ground.grid.values.array() -= ground.grid.values.minCoeff();  // levels are drawn as shares of the top
+  return ground;
+}
+
 }  // namespace dgmm

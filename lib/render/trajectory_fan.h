@@ -3,6 +3,7 @@
 // are after each command (a histogram of all steps' positions, log colour), each step's 50% and
 // 90% regions as ellipses and the mean path from the start. Plain arrays in: no lib/predict here.
 #include <Eigen/Dense>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,5 +19,9 @@ Eigen::MatrixX2d RegionEllipse(const Eigen::MatrixX2d& points, double share, int
 // steps[k]: the (x, y) of every trajectory after command k + 1 (rows); start: (x, y) before.
 HeatMapSpec TrajectoryFan(const std::vector<Eigen::MatrixX2d>& steps, const Eigen::Vector2d& start,
                           const std::string& title);
+
+// Height contours of the ground under a fan (grey, 8 levels evenly over the window's height range),
+// height(x, y) in metres sampled on a 150 x 150 grid over `range`.
+ContourOverlay GroundContours(const PlotRange& range, const std::function<double(double, double)>& height);
 
 }  // namespace dgmm

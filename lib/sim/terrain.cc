@@ -1,11 +1,11 @@
 #include "sim/terrain.h"
 
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <random>
 #include <sstream>
 
+#include "core/plane_fit.h"
 #include "sim/json_fields.h"
 #include "util/error.h"
 
@@ -227,16 +227,7 @@ double HeightField::RmsHeight() const {
 }
 
 double FootRelief(const std::vector<Eigen::Vector3d>& feet) {
-  const int n = static_cast<int>(feet.size());
-  if (n < 4) return 0;
-  Eigen::MatrixXd a(n, 3);
-  Eigen::VectorXd z(n);
-  for (int i = 0; i < n; ++i) {
-    a.row(i) << 1, feet[i].x(), feet[i].y();
-    z[i] = feet[i].z();
-  }
-  const Eigen::VectorXd residual = z - a * a.colPivHouseholderQr().solve(z);
-  return std::sqrt(residual.squaredNorm() / n);
+  return feet.size() < 4 ? 0.0 : FitPlane(feet).rms_residual;
 }
 
 std::vector<std::string> TerrainScaleWarnings(const TerrainDescription& t, double stance_height_m, double foot_radius_m) {

@@ -119,3 +119,39 @@ TEST(PredictCommand, TheFigureIsATrajectoryFanOrACleanErrorWithoutADisplay) {
 
 }  // namespace
 }  // namespace dgmm::test
+
+namespace dgmm::test {
+namespace {
+
+// Issue #26: --ground with a terrain block conditions every trajectory on the height field under
+// it: on the shipped rough ground the prediction differs from the bare 10-degree plane's, and a
+// start off the field is warned about.
+TEST(PredictCommand, TheGroundsHeightFieldConditionsEachTrajectory) {
+  const auto dir = MakeTempDir("predict_field");
+  const std::string model = (dir / "m.h5").string(), rough = (dir / "rough.json").string(),
+                    plane = (dir / "plane.json").string(), plane_cfg = (dir / "plane_cfg.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", SourcePath("datasets/rough_ground_1660.h5").string(), "-o", model, "--seed", "1"})
+                .exit_code, 0);
+  std::ofstream(plane_cfg) << "{\"slope_deg\": 10}\n";
+  const std::vector<std::string> walk = {"predict", model, "--commands", "+0.5,0,0*6", "--trajectories", "400",
+                                         "--start", "-0.4,0.2,0.3"};
+  auto with = [&](std::vector<std::string> args, const std::string& config, const std::string& out) {
+    args.insert(args.end(), {"--ground", config, "-o", out});
+    return RunDgmm(args);
+  };
+  const RunResult r = with(walk, SourcePath("datasets/robots/rough_ground.json").string(), rough);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err.find("leave the height field"), std::string::npos) << r.err;
+  ASSERT_EQ(with(walk, plane_cfg, plane).exit_code, 0);
+  std::ifstream ir(rough), ip(plane);
+  const auto jr = nlohmann::json::parse(ir), jp = nlohmann::json::parse(ip);
+  EXPECT_NE(jr["steps"][5]["mean"], jp["steps"][5]["mean"]);
+  std::vector<std::string> edge = walk;
+  edge[edge.size() - 1] = "2.9,0,0";
+  const RunResult off = with(edge, SourcePath("datasets/robots/rough_ground.json").string(), rough);
+  ASSERT_EQ(off.exit_code, 0) << off.err;
+  EXPECT_NE(off.err.find("leave the height field"), std::string::npos) << off.err;
+}
+
+}  // namespace
+}  // namespace dgmm::test
