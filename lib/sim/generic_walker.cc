@@ -38,7 +38,9 @@ bool GenericWalker::Step() {
   line_.Send(u_);
   line_.Write(data_.get());
   time_s_ += model_->opt.timestep;
-  return StepChecked(model_.get(), data_.get());
+  const bool ok = StepChecked(model_.get(), data_.get());
+  self_contacts_.Observe(model_.get(), data_.get());
+  return ok;
 }
 
 std::vector<Eigen::Vector3d> GenericWalker::FootPoints() const {

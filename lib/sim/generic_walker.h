@@ -8,6 +8,7 @@
 #include "sim/actuation_line.h"
 #include "sim/legged_robot.h"
 #include "sim/pose.h"
+#include "sim/self_contact.h"
 #include "sim/sim_config.h"
 
 namespace dgmm::sim {
@@ -37,6 +38,7 @@ class GenericWalker {
   const mjModel* model() const { return model_.get(); }
   const mjData* data() const { return data_.get(); }
   const LeggedRobot& robot() const { return robot_; }
+  const SelfContacts& self_contacts() const { return self_contacts_; }
 
  private:
   bool Step();
@@ -57,6 +59,7 @@ class GenericWalker {
   std::string source_;
   double time_s_ = 0;
   int control_every_ = 1;
+  SelfContacts self_contacts_;
 };
 
 }  // namespace dgmm::sim

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <map>
 #include <random>
 #include <sstream>
 
@@ -238,6 +239,15 @@ void FillSamples(const Recorded& r, const std::vector<std::string>& sensed, Samp
   set->source = "sim";
 }
 
+// The robot touched itself in some executions: say how often, where and what to do.
+std::string SelfContactWarning(const SimSummary& sum, const std::string& pair, const std::string& command) {
+  return "robot: its legs or body touched each other in " + std::to_string(sum.self_contact_executions) + " of " +
+         std::to_string(sum.executions) + " executions (most often " + pair + ", most in command " + command +
+         "); the simulation keeps those collisions as physics. If the real robot's parts cannot meet, make "
+         "them collide with the ground only in the MJCF (contype/conaffinity or <contact><exclude>); if they "
+         "can, shorten the gait's steps (robot.gait.stride_reach)";
+}
+
 // The sensed terrain descriptors of terrain.h at the robot's current state.
 Eigen::VectorXd SensedTerrain(const Simulator& sim, const std::vector<std::string>& sensed) {
   Eigen::VectorXd v(static_cast<int>(sensed.size()));
@@ -274,6 +284,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::normal_distribution<double> unit(0.0, 1.0);
   SimSummary sum;
+  std::map<int, long long> self_contact_by_command;  // steps in contact per command
   for (int p = 0; p < static_cast<int>(plan.size()); ++p) {
     Placement where = plan[p];
     bool kept = false;
@@ -297,7 +308,11 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
         z.tail(terrain.size()) = terrain;
         pz.push_back(z);
         const Pose start = TrackerReading(sim.TorsoPose(), config.noise, rng);
+        const long long touched = sim.SelfContactSteps();
         fell = sim.RunCommand(c) != RunOutcome::kCompleted;
+        ++sum.executions;
+        if (sim.SelfContactSteps() > touched) ++sum.self_contact_executions;
+        self_contact_by_command[id] += sim.SelfContactSteps() - touched;
         const Pose end = TrackerReading(sim.TorsoPose(), config.noise, rng);
         px.push_back(DeltaPoseBody(start, end));
       }
@@ -323,6 +338,11 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
 
   sum.samples = n;
   sum.warnings = sim.ScaleWarnings();
+  if (sum.self_contact_executions > 0) {
+    const auto worst = std::max_element(self_contact_by_command.begin(), self_contact_by_command.end(),
+                                        [](const auto& a, const auto& b) { return a.second < b.second; });
+    sum.warnings.push_back(SelfContactWarning(sum, sim.SelfContactPair(), set.command_labels.at(worst->first)));
+  }
   sum.placements = static_cast<int>(plan.size());
   sum.simulated_seconds = sim.time_s();
   sum.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;

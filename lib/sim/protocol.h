@@ -57,7 +57,10 @@ struct SimSummary {
   double simulated_seconds = 0;
   double wall_seconds = 0;
   double cpu_seconds = 0;  // process CPU time while simulating (wall time suffers on a busy machine)
-  std::vector<std::string> warnings;  // the config against the robot's scale (Simulator::ScaleWarnings)
+  int executions = 0;               // commands run (fallen ones included)
+  int self_contact_executions = 0;  // of which the robot touched itself (Simulator::SelfContactSteps)
+  // The config against the robot's scale (Simulator::ScaleWarnings) and the robot touching itself.
+  std::vector<std::string> warnings;
 
   double SimulatedPerWallSecond() const;
   double SamplesPerWallSecond() const;

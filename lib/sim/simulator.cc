@@ -19,6 +19,7 @@ struct Simulator::Impl {
   SimConfig config;
   MjModelPtr model;
   MjDataPtr data;
+  SelfContacts self_contacts;
   RobotParts parts;
   Eigen::Vector3d up;
   double time_s = 0;
@@ -62,7 +63,9 @@ struct Simulator::Impl {
   bool Step() {
     line.Write(data.get());  // the backlash dead band follows the joints step by step
     time_s += model->opt.timestep;
-    return StepChecked(model.get(), data.get());
+    const bool ok = StepChecked(model.get(), data.get());
+    self_contacts.Observe(model.get(), data.get());
+    return ok;
   }
   std::vector<Eigen::Vector3d> FootSites() const {
     std::vector<Eigen::Vector3d> feet;
@@ -229,6 +232,15 @@ std::vector<std::string> Simulator::ScaleWarnings() const {
     for (const LegGeometry& leg : impl_->parts.legs) foot = std::max(foot, leg.foot_radius_m);
   }
   return TerrainScaleWarnings(*c.terrain, stance, foot);
+}
+
+long long Simulator::SelfContactSteps() const {
+  return impl_->walker ? impl_->walker->self_contacts().steps() : impl_->self_contacts.steps();
+}
+
+std::string Simulator::SelfContactPair() const {
+  return impl_->walker ? impl_->walker->self_contacts().MostFrequentPair(impl_->walker->model())
+                       : impl_->self_contacts.MostFrequentPair(impl_->model.get());
 }
 
 double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->ground->HeightAt(x_m, y_m); }

@@ -87,6 +87,12 @@ class Simulator {
   // when nothing is far off.
   std::vector<std::string> ScaleWarnings() const;
 
+  // Physics steps since construction in which the robot touched itself (two of its bodies in
+  // contact: a leg striking another leg or the body; self_contact.h), and the pair met most often
+  // ("<body> with <body>", empty when none).
+  long long SelfContactSteps() const;
+  std::string SelfContactPair() const;
+
   // Visible geoms (alpha > 0) at the current state, slope frame.
   std::vector<GeomSnapshot> Geometry() const;
 
