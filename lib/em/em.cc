@@ -17,8 +17,9 @@ namespace dgmm {
 namespace {
 
 using em_internal::kMaxFixedDim;
+using em_internal::NormaliseBlock;
 using em_internal::SquaredMahalanobisBlock;
-using em_internal::WeightedScatter;
+using em_internal::WeightedMoments;
 
 // Added to every component's responsibility sum, as scikit-learn does, so an emptied component
 // keeps a finite (tiny) weight and mean instead of dividing by zero.
@@ -39,6 +40,8 @@ struct Parameters {
 // Samples are processed in blocks of kBlock rows so that every intermediate of the E and M steps
 // stays in L1 cache (X is n x d column-major: a block of one column is contiguous).
 constexpr Eigen::Index kBlock = 256;
+// Components whose block pointers fit on the stack for the vectorised normalisation (more: Eigen).
+constexpr int kMaxComponentsOnStack = 64;
 
 // The E and M steps over the rows of X (n x d) with the responsibilities (n x K) and block
 // buffers allocated once per fit.
@@ -87,63 +90,41 @@ class EmWorkspace {
         }
         log_prob_.col(k).head(b) = constant(k) - 0.5 * m2;
       }
-      auto row_max = row_max_.head(b);
-      auto row_sum = row_sum_.head(b);
-      row_max = log_prob_.col(0).head(b);
-      for (int k = 1; k < K_; ++k) row_max = row_max.max(log_prob_.col(k).head(b));
-      row_sum.setZero();
-      for (int k = 0; k < K_; ++k) {
-        auto r = resp_.col(k).segment(i0, b).array();
-        r = (log_prob_.col(k).head(b) - row_max).exp();
-        row_sum += r;
-      }
-      total += (row_max + row_sum.log()).sum();
-      row_sum = row_sum.inverse();
-      for (int k = 0; k < K_; ++k) resp_.col(k).segment(i0, b).array() *= row_sum;
+      total += NormaliseRows(i0, b);
     }
     return total / static_cast<double>(n);
   }
 
-  // M-step from the current responsibilities: counts, means, covariances
-  // sum_i r_ik (x_i - mu_k)(x_i - mu_k)^T / n_k + reg_covar I (two passes: means first, then
-  // centred sums, for accuracy far from the origin), and the precision factors. False when a
-  // covariance is not positive definite.
+  // M-step from the current responsibilities: counts n_k = sum_i r_ik (+ kTinyCount), means and
+  // covariances sum_i r_ik (x_i - mu_k)(x_i - mu_k)^T / n_k + reg_covar I, and the precision
+  // factors. One pass per component gathers the moments about a shift s near mu_k (the previous
+  // means; the first step computes them directly): with F = sum r (x - s), S = sum r (x - s)(x - s)^T
+  // and R = sum r, mu = s + F / n_k and n_k Sigma = S - F F^T (2 / n_k - R / n_k^2), exact and free
+  // of cancellation because s is close to mu. False when a covariance is not positive definite.
   bool MStep(Parameters* p) {
-    const Eigen::Index n = X_.rows(), d = X_.cols();
-    p->counts = resp_.colwise().sum().transpose().array() + kTinyCount;
+    const Eigen::Index d = X_.cols();
+    const Eigen::VectorXd sums = resp_.colwise().sum().transpose();
+    p->counts = sums.array() + kTinyCount;
     p->log_weights = (p->counts / p->counts.sum()).array().log();
-    p->means.noalias() = resp_.transpose() * X_;
-    p->means.array().colwise() /= p->counts.array();
+    if (p->means.rows() != K_ || p->means.cols() != d) {  // the first step: no previous means
+      p->means.noalias() = resp_.transpose() * X_;
+      p->means.array().colwise() /= p->counts.array();
+    }
     p->covariances.resize(K_);
     p->precision_cholesky.resize(K_);
     p->log_det_precision.resize(K_);
     const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(d, d);
     for (int k = 0; k < K_; ++k) {
+      const Eigen::VectorXd shift = p->means.row(k).transpose();
+      Eigen::VectorXd first = Eigen::VectorXd::Zero(d);
       Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(d, d);  // lower triangle accumulated
-      if (d <= kMaxFixedDim) {
-        const double* cols[kMaxFixedDim];
-        double mean[kMaxFixedDim];
-        for (Eigen::Index a = 0; a < d; ++a) {
-          cols[a] = X_.col(a).data();
-          mean[a] = p->means(k, a);
-        }
-        WeightedScatter(cols, n, static_cast<int>(d), resp_.col(k).data(), mean, cov.data());
-      } else {
-        for (Eigen::Index i0 = 0; i0 < n; i0 += kBlock) {
-          const Eigen::Index b = std::min(kBlock, n - i0);
-          const auto r = resp_.col(k).segment(i0, b).array();
-          for (Eigen::Index j = 0; j < d; ++j) {
-            centred_.col(j).head(b) = X_.col(j).segment(i0, b).array() - p->means(k, j);
-            weighted_.col(j).head(b) = centred_.col(j).head(b).array() * r;
-          }
-          for (Eigen::Index a = 0; a < d; ++a)
-            for (Eigen::Index c = 0; c <= a; ++c)
-              cov(a, c) += weighted_.col(a).head(b).dot(centred_.col(c).head(b));
-        }
-      }
+      Moments(k, shift, &first, &cov);
       for (Eigen::Index a = 0; a < d; ++a)
         for (Eigen::Index c = 0; c < a; ++c) cov(c, a) = cov(a, c);
-      cov /= p->counts(k);
+      const double nk = p->counts(k);
+      cov -= first * first.transpose() * (2 / nk - sums(k) / (nk * nk));
+      p->means.row(k) = (shift + first / nk).transpose();
+      cov /= nk;
       cov.diagonal().array() += reg_covar_;
       Eigen::LLT<Eigen::MatrixXd> llt(cov);
       if (llt.info() != Eigen::Success) return false;
@@ -157,6 +138,57 @@ class EmWorkspace {
   }
 
  private:
+  // The block's responsibilities from log_prob_ (rows i0 .. i0 + b of resp_) by log-sum-exp;
+  // returns sum_i log p(x_i) over the block.
+  double NormaliseRows(Eigen::Index i0, Eigen::Index b) {
+    if (K_ <= kMaxComponentsOnStack) {  // the vectorised kernel
+      const double* logp[kMaxComponentsOnStack];
+      double* resp[kMaxComponentsOnStack];
+      for (int k = 0; k < K_; ++k) {
+        logp[k] = &log_prob_(0, k);
+        resp[k] = resp_.col(k).data() + i0;
+      }
+      NormaliseBlock(logp, K_, b, resp, row_max_.data(), row_sum_.data());
+      return (row_max_.head(b) + row_sum_.head(b).log()).sum();
+    }
+    auto row_max = row_max_.head(b);
+    auto row_sum = row_sum_.head(b);
+    row_max = log_prob_.col(0).head(b);
+    for (int k = 1; k < K_; ++k) row_max = row_max.max(log_prob_.col(k).head(b));
+    row_sum.setZero();
+    for (int k = 0; k < K_; ++k) {
+      auto r = resp_.col(k).segment(i0, b).array();
+      r = (log_prob_.col(k).head(b) - row_max).exp();
+      row_sum += r;
+    }
+    const double total = (row_max + row_sum.log()).sum();
+    row_sum = row_sum.inverse();
+    for (int k = 0; k < K_; ++k) resp_.col(k).segment(i0, b).array() *= row_sum;
+    return total;
+  }
+
+  // first += sum_i r_ik (x_i - shift), lower triangle of second += sum_i r_ik (x_i - shift)(x_i - shift)^T.
+  void Moments(int k, const Eigen::VectorXd& shift, Eigen::VectorXd* first, Eigen::MatrixXd* second) {
+    const Eigen::Index n = X_.rows(), d = X_.cols();
+    if (d <= kMaxFixedDim) {
+      const double* cols[kMaxFixedDim];
+      for (Eigen::Index a = 0; a < d; ++a) cols[a] = X_.col(a).data();
+      WeightedMoments(cols, n, static_cast<int>(d), resp_.col(k).data(), shift.data(), first->data(), second->data());
+      return;
+    }
+    for (Eigen::Index i0 = 0; i0 < n; i0 += kBlock) {
+      const Eigen::Index b = std::min(kBlock, n - i0);
+      const auto r = resp_.col(k).segment(i0, b).array();
+      for (Eigen::Index j = 0; j < d; ++j) {
+        centred_.col(j).head(b) = X_.col(j).segment(i0, b).array() - shift(j);
+        weighted_.col(j).head(b) = centred_.col(j).head(b).array() * r;
+        (*first)(j) += weighted_.col(j).head(b).sum();
+      }
+      for (Eigen::Index a = 0; a < d; ++a)
+        for (Eigen::Index c = 0; c <= a; ++c) (*second)(a, c) += weighted_.col(a).head(b).dot(centred_.col(c).head(b));
+    }
+  }
+
   const Eigen::MatrixXd& X_;
   int K_;
   double reg_covar_;

@@ -14,9 +14,18 @@ constexpr int kMaxFixedDim = 8;
 void SquaredMahalanobisBlock(const double* const* cols, Eigen::Index b, int d, const double* U,
                              const double* shift, double* m2);
 
-// Lower triangle of cov (d x d, column-major) += sum_i r[i] (x_i - mean)(x_i - mean)^T over the
-// n samples. 1 <= d <= kMaxFixedDim.
-void WeightedScatter(const double* const* cols, Eigen::Index n, int d, const double* r,
-                     const double* mean, double* cov);
+// The weighted moments about a shift s, in one pass over the n samples:
+//   first[a] += sum_i r[i] (x_ia - s_a),  lower triangle of second (d x d, column-major)
+//   += sum_i r[i] (x_i - s)(x_i - s)^T.   1 <= d <= kMaxFixedDim.
+void WeightedMoments(const double* const* cols, Eigen::Index n, int d, const double* r,
+                     const double* shift, double* first, double* second);
+
+// The E-step's normalisation of one block of b samples and K components, by log-sum-exp:
+// resp[k][i] = exp(logp[k][i] - m_i) / s_i with m_i = max_k logp[k][i] (row_max[i]) and
+// s_i = sum_k exp(logp[k][i] - m_i) (row_sum[i]); log p(x_i) = m_i + log s_i. logp[k], resp[k]: b values each.
+// exp by Cody-Waite reduction to |r| <= ln 2 / 2 and a degree-13 Taylor polynomial (relative error
+// under 1e-15; exponents under -708 give 0), four lanes at a time.
+void NormaliseBlock(const double* const* logp, int K, Eigen::Index b, double* const* resp, double* row_max,
+                    double* row_sum);
 
 }  // namespace dgmm::em_internal
