@@ -172,6 +172,12 @@ sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, 
   if (!*simulator) return sim2real::Analyse(sim, real, nullptr, options, *why);
   try {
     sim2real::Analysis a = sim2real::Analyse(sim, real, simulator->get(), options, *why);
+    if (!a.candidates.unwalkable_probes.empty()) {
+      std::string probes;
+      for (const std::string& p : a.candidates.unwalkable_probes) probes += (probes.empty() ? "" : ", ") + p;
+      ctx->notes.push_back("not candidates: " + probes + " (the robot fell in most placements at that value, too few "
+                           "paired samples for a signature)");
+    }
     if (!a.inputs.recording_from_metadata) {
       ctx->notes.push_back(args.sim + " records no protocol and seed (metadata): the signatures re-record protocol "
                            "paper with --seed " + std::to_string(args.seed) + ", not the sim set's own recording");

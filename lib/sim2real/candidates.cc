@@ -97,7 +97,12 @@ void AddKnobCandidates(const KnobSimulator& sim, const AnalysisInputs& in, const
       }
       continue;
     }
-    set->shifts.push_back(PairedShift::Fit(set->nominal, p.set, in.sim_set, slope_ridge));
+    try {
+      set->shifts.push_back(PairedShift::Fit(set->nominal, p.set, in.sim_set, slope_ridge));
+    } catch (const InputError&) {  // too few paired samples: the robot fell at this value
+      set->unwalkable_probes.push_back(k.name + Fmt("@%.4g", p.value));
+      continue;
+    }
     const int s = static_cast<int>(set->shifts.size()) - 1;
     if (payload) {
       const int slot = k.role == Knob::Role::kPayloadMass ? 0 : k.role == Knob::Role::kPayloadX ? 1 : 2;
@@ -139,6 +144,7 @@ void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vecto
   std::stable_sort(probes.begin(), probes.end(), [](const Probe& a, const Probe& b) { return a.knob < b.knob; });
   set->candidates.clear(), set->library.clear(), set->externals.clear(), set->shifts.clear();
   set->inert_knobs.clear();
+  set->unwalkable_probes.clear();
   AddTrackerEffects(in, set);
   AddKnobCandidates(sim, in, probes, slope_ridge, set);
   AddPayload(sim, set);

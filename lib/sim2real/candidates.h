@@ -57,6 +57,9 @@ struct CandidateSet {
   int tracker_knob = -1, tracker_shift = -1;  // the tracker-noise knob's spread probe
   double tracker_probe = 1;
   std::vector<std::string> inert_knobs;
+  // "knob@probe" whose recording kept too few paired samples for a signature (the robot fell in
+  // most placements at that value): not candidates, listed so the report can say so.
+  std::vector<std::string> unwalkable_probes;
   bool legs_probed = false;
   std::string legs_note;                    // why per-leg probes were or were not recorded
   int recorded = 0, from_cache = 0, requests = 0;

@@ -92,6 +92,7 @@ json KnobsJson(const Analysis& a) {
   return {{"candidates", cands}, {"selection_steps", StepsJson(a)}, {"removed_by_backward_pass", removed},
           {"refinement", trace}, {"refined", refined}, {"family_inclusion", family},
           {"bootstrap_resamples", a.confidence.resamples}, {"inert_knobs", set.inert_knobs},
+          {"unwalkable_probes", set.unwalkable_probes},
           {"per_leg_probes", {{"recorded", set.legs_probed}, {"why", set.legs_note}}}, {"spread", spread},
           {"recordings", {{"signatures", set.recorded}, {"signatures_from_cache", set.from_cache},
                           {"signature_requests", set.requests}, {"refinement", r.recorded},

@@ -48,5 +48,21 @@ TEST(Candidates, ACandidatesDesignIsItsRecordedShift) {
   EXPECT_TRUE(d.isApprox(expected));
 }
 
+// A probe at which the robot falls in most placements leaves too few paired samples for a
+// signature: it is listed, not a candidate, and the other candidates stand.
+TEST(Candidates, AProbeThatTopplesTheRobotIsListedNotFatal) {
+  test::FakeSimulator toppling;
+  toppling.topples_below_friction = 0.65;  // the friction probe (0.6) falls
+  const test::FakePair pair = test::MakeFakePair(toppling, {{test::kFriction, 0.7}});
+  const AnalysisOptions options = test::FastOptions();
+  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, options.seed);
+  const Baseline base = LocateMismatch(in, options.locate);
+  const CandidateSet set = BuildCandidates(toppling, in, base, options.candidates);
+  EXPECT_EQ(set.unwalkable_probes, std::vector<std::string>{"floor.friction@0.6"});
+  EXPECT_LT(test::CandidateOf(set, "floor.friction@0.6"), 0);
+  EXPECT_GE(test::CandidateOf(set, "payload"), 0);
+  EXPECT_GE(test::CandidateOf(set, "actuators.side.left.gain@0.5"), 0);
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real

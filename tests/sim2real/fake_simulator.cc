@@ -152,6 +152,7 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
   s.source = "fake simulator";
   s.metadata["protocol"] = recording.protocol;
   s.metadata["seed"] = std::to_string(recording.seed);
+  if (k.v[kFriction] < topples_below_friction) return s.Subset({0, 1, 2, 3, 4});
   return s;
 }
 

@@ -56,6 +56,8 @@ class FakeSimulator : public KnobSimulator {
   // A recording with extras (the planted real set), `seed` its common random numbers.
   SampleSet RecordWith(const Recording& recording, const std::vector<KnobValue>& values, const FakeExtras& extras) const;
   int records() const { return records_; }
+  // Friction values below this topple the robot: the recording keeps one placement only.
+  double topples_below_friction = 0;
   int cells() const { return cells_; }
 
  private:
