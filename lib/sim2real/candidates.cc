@@ -181,6 +181,18 @@ bool SideImplicated(const CandidateSet& set, const FitProblem& fp, const Baselin
   return false;
 }
 
+// Why the sides cannot gate the per-leg probes: a side probe toppled the robot (empty if none did).
+std::string SideProbeToppled(const CandidateSet& set, const std::vector<Knob>& knobs) {
+  for (const std::string& probe : set.unwalkable_probes) {
+    for (const Knob& k : knobs) {
+      if (!k.side.empty() && probe.rfind(k.name + "@", 0) == 0) {
+        return "the side probe " + probe + " toppled the robot, so the sides could not be tested first";
+      }
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 bool CandidateOptions::IsValid(std::string* error) const {
@@ -245,8 +257,8 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
     if (!options.legs_only_when_implicated && !legs.empty()) set.legs_note = "per-leg probes recorded (always)";
     return set;
   }
-  std::string why;
-  if (!SideImplicated(set, MakeCandidateProblem(in, base, set), base, options, &why)) {
+  std::string why = SideProbeToppled(set, knobs);
+  if (why.empty() && !SideImplicated(set, MakeCandidateProblem(in, base, set), base, options, &why)) {
     set.legs_note = "per-leg probes not recorded: no side knob is implicated by the first pass";
     return set;
   }

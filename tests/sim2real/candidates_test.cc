@@ -64,5 +64,21 @@ TEST(Candidates, AProbeThatTopplesTheRobotIsListedNotFatal) {
   EXPECT_GE(test::CandidateOf(set, "actuators.side.left.gain@0.5"), 0);
 }
 
+// When a side probe topples the robot the sides cannot say whether a leg is weak: every leg is
+// probed instead.
+TEST(Candidates, ASideProbeThatTopplesTheRobotSendsStraightToTheLegs) {
+  test::FakeSimulator toppling;
+  toppling.topples_below_side_gain = 0.55;  // the side probes (0.5) fall
+  const test::FakePair pair = test::MakeFakePair(toppling, {{test::kFriction, 0.7}});
+  const AnalysisOptions options = test::FastOptions();
+  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, options.seed);
+  const Baseline base = LocateMismatch(in, options.locate);
+  const CandidateSet set = BuildCandidates(toppling, in, base, options.candidates);
+  EXPECT_EQ(set.unwalkable_probes.size(), 2u);
+  EXPECT_TRUE(set.legs_probed) << set.legs_note;
+  EXPECT_NE(set.legs_note.find("toppled"), std::string::npos) << set.legs_note;
+  EXPECT_GE(test::CandidateOf(set, "actuators.leg1.gain@0.5"), 0);
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real

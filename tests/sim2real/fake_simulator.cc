@@ -1,5 +1,6 @@
 #include "tests/sim2real/fake_simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -152,7 +153,9 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
   s.source = "fake simulator";
   s.metadata["protocol"] = recording.protocol;
   s.metadata["seed"] = std::to_string(recording.seed);
-  if (k.v[kFriction] < topples_below_friction) return s.Subset({0, 1, 2, 3, 4});
+  if (k.v[kFriction] < topples_below_friction || std::min(k.v[kLeftGain], k.v[kRightGain]) < topples_below_side_gain) {
+    return s.Subset({0, 1, 2, 3, 4});
+  }
   return s;
 }
 

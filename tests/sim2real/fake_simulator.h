@@ -58,6 +58,7 @@ class FakeSimulator : public KnobSimulator {
   int records() const { return records_; }
   // Friction values below this topple the robot: the recording keeps one placement only.
   double topples_below_friction = 0;
+  double topples_below_side_gain = 0;  // likewise for either side's gain
   int cells() const { return cells_; }
 
  private:
