@@ -48,16 +48,21 @@ TEST(Candidates, ACandidatesDesignIsItsRecordedShift) {
   EXPECT_TRUE(d.isApprox(expected));
 }
 
+// The candidates of `simulator` on a pair with friction planted at 0.7.
+CandidateSet CandidatesOfPlantedFriction(const test::FakeSimulator& simulator) {
+  const test::FakePair pair = test::MakeFakePair(simulator, {{test::kFriction, 0.7}});
+  const AnalysisOptions options = test::FastOptions();
+  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, options.seed);
+  const Baseline base = LocateMismatch(in, options.locate);
+  return BuildCandidates(simulator, in, base, options.candidates);
+}
+
 // A probe at which the robot falls in most placements leaves too few paired samples for a
 // signature: it is listed, not a candidate, and the other candidates stand.
 TEST(Candidates, AProbeThatTopplesTheRobotIsListedNotFatal) {
   test::FakeSimulator toppling;
   toppling.topples_below_friction = 0.65;  // the friction probe (0.6) falls
-  const test::FakePair pair = test::MakeFakePair(toppling, {{test::kFriction, 0.7}});
-  const AnalysisOptions options = test::FastOptions();
-  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, options.seed);
-  const Baseline base = LocateMismatch(in, options.locate);
-  const CandidateSet set = BuildCandidates(toppling, in, base, options.candidates);
+  const CandidateSet set = CandidatesOfPlantedFriction(toppling);
   EXPECT_EQ(set.unwalkable_probes, std::vector<std::string>{"floor.friction@0.6"});
   EXPECT_LT(test::CandidateOf(set, "floor.friction@0.6"), 0);
   EXPECT_GE(test::CandidateOf(set, "payload"), 0);
@@ -69,11 +74,7 @@ TEST(Candidates, AProbeThatTopplesTheRobotIsListedNotFatal) {
 TEST(Candidates, ASideProbeThatTopplesTheRobotSendsStraightToTheLegs) {
   test::FakeSimulator toppling;
   toppling.topples_below_side_gain = 0.55;  // the side probes (0.5) fall
-  const test::FakePair pair = test::MakeFakePair(toppling, {{test::kFriction, 0.7}});
-  const AnalysisOptions options = test::FastOptions();
-  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, options.seed);
-  const Baseline base = LocateMismatch(in, options.locate);
-  const CandidateSet set = BuildCandidates(toppling, in, base, options.candidates);
+  const CandidateSet set = CandidatesOfPlantedFriction(toppling);
   EXPECT_EQ(set.unwalkable_probes.size(), 2u);
   EXPECT_TRUE(set.legs_probed) << set.legs_note;
   EXPECT_NE(set.legs_note.find("toppled"), std::string::npos) << set.legs_note;
