@@ -1,5 +1,6 @@
 // `dgmm predict`: where a sequence of commands takes the robot, with how sure the model is: the
 // pose distribution after each command (lib/predict/predict.h), as JSON and a table.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
@@ -12,6 +13,7 @@
 #include "app/command.h"
 #include "app/wiring/ground_surface.h"
 #include "io/model_io.h"
+#include "io/sample_set_io.h"
 #include "predict/ground_terrain.h"
 #include "predict/predict.h"
 #include "render/display.h"
@@ -24,8 +26,9 @@ namespace dgmm::app {
 namespace {
 
 struct PredictArgs {
-  std::string model, commands, terrain, command_values, output, pose_dims, figure, ground;
+  std::string model, commands, terrain, command_values, output, pose_dims, figure, ground, persistence;
   std::vector<double> start{0, 0, 0};
+  bool walking = false;
   int trajectories = 1000;
   std::uint64_t seed = 1;
 };
@@ -58,8 +61,9 @@ std::vector<int> ParseCommands(const MotionModel& model, const std::string& text
   return ids;
 }
 
-// "pitch=0.1,roll=0" by the model's terrain names.
-Eigen::VectorXd ParseOneTerrain(const MotionModel& model, const std::string& text) {
+// "pitch=0.1,roll=0" by the model's terrain names; with `partial` the dimensions not named stay NaN
+// (read off the ground).
+Eigen::VectorXd ParseOneTerrain(const MotionModel& model, const std::string& text, bool partial = false) {
   if (text.empty()) return {};
   if (model.terrain_dim == 0) throw MakeInputError("--terrain", "", "the model was fitted without terrain");
   Eigen::VectorXd z = Eigen::VectorXd::Constant(model.terrain_dim, NAN);
@@ -77,7 +81,7 @@ Eigen::VectorXd ParseOneTerrain(const MotionModel& model, const std::string& tex
     z[d] = std::strtod(item.c_str() + eq + 1, &end);
     if (end == item.c_str() + eq + 1 || *end != '\0') throw MakeInputError("--terrain", item, "expected a number after '='");
   }
-  if (!z.allFinite()) {
+  if (!partial && !z.allFinite()) {
     std::string missing;
     for (int i = 0; i < model.terrain_dim; ++i) {
       if (!std::isfinite(z[i])) missing += (missing.empty() ? "" : ",") + model.terrain_names[i];
@@ -104,16 +108,28 @@ std::vector<std::string> PerStep(const std::string& text, std::size_t steps, con
 // terrain (--terrain), both by the model's z names and merged per step. Nothing given: the
 // terrain marginalised.
 std::vector<Eigen::VectorXd> ParseTerrain(const MotionModel& model, const std::string& terrain,
-                                          const std::string& command_values, std::size_t steps) {
+                                          const std::string& command_values, std::size_t steps, bool partial) {
   const std::vector<std::string> t = PerStep(terrain, steps, "--terrain", "terrains");
   const std::vector<std::string> c = PerStep(command_values, steps, "--command-values", "command values");
   std::vector<Eigen::VectorXd> z(steps);
   for (std::size_t k = 0; k < steps; ++k) {
     std::string merged = c.empty() ? "" : c[k];
     if (!t.empty() && !t[k].empty()) merged += (merged.empty() ? "" : ",") + t[k];
-    z[k] = ParseOneTerrain(model, merged);
+    z[k] = ParseOneTerrain(model, merged, partial);
   }
   return z;
+}
+
+// The names --command-values gives (they are not read off the ground).
+std::vector<std::string> CommandValueNames(const std::string& command_values) {
+  std::vector<std::string> names;
+  for (const std::string& step : SplitOn(command_values, ';')) {
+    for (const std::string& item : SplitOn(step, ',')) {
+      const std::string name = item.substr(0, item.find('='));
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  return names;
 }
 
 nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, const predict::Prediction& p,
@@ -130,7 +146,8 @@ nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, con
   }
   return {{"model", args.model}, {"pose", {"x_m", "y_m", "z_m", "yaw_rad"}}, {"spatial", p.spatial},
           {"start", args.start}, {"trajectories", args.trajectories}, {"seed", args.seed},
-          {"terrain", args.terrain}, {"command_values", args.command_values}, {"steps", steps}};
+          {"terrain", args.terrain}, {"command_values", args.command_values}, {"persistence_from", args.persistence},
+          {"steps", steps}};
 }
 
 // The trajectory fan (render/trajectory_fan.h) of the prediction, written to args.figure.
@@ -152,7 +169,7 @@ void WarnWhereDataIsThin(const MotionModel& model, const std::vector<int>& ids,
                          const std::vector<Eigen::VectorXd>& z) {
   constexpr double kThin = 0.01;
   for (std::size_t k = 0; k < ids.size(); ++k) {
-    if (z[k].size() == 0) continue;
+    if (z[k].size() == 0 || !z[k].allFinite()) continue;  // read off the ground per trajectory
     double at_data = 0;
     const double near = model.SamplesNear(ids[k], z[k], &at_data);
     if (near >= kThin * at_data) continue;
@@ -182,6 +199,20 @@ void WarnOffTheField(const predict::Prediction& p, const sim::TerrainDescription
   }
 }
 
+// The persistence of deviations estimated from the episodes of `path`, one line per pose dimension.
+predict::StepPersistence PersistenceFrom(const MotionModel& model, const std::string& path) {
+  const predict::PersistenceSummary s = predict::EstimatePersistence(model, ReadSampleSet(path));
+  std::printf("persistence from %s (%d episodes; %d pairs of consecutive steps; %d first steps): corr(step t, t + l) "
+              "= a phi^l; the first command's spread from standing relative to the model's\n",
+              path.c_str(), s.episodes, s.pairs[0], s.first_steps);
+  for (int d = 0; d < model.pose_dim; ++d) {
+    std::printf("  %-8s a = %.2f  phi = %.2f  (lag 1: %+.2f)  first step from standing x%.2f\n",
+                model.pose_names[d].c_str(), s.persistence.shared[d], s.persistence.decay[d], s.lag_correlation(d, 0),
+                s.persistence.first_scale[d]);
+  }
+  return s.persistence;
+}
+
 void Run(const PredictArgs& args) {
   if (!args.figure.empty()) RequireDisplay();  // before any work or output
   for (const std::string& out : {args.output, args.figure}) {
@@ -189,7 +220,8 @@ void Run(const PredictArgs& args) {
   }
   const MotionModel model = ReadModel(args.model);
   const std::vector<int> ids = ParseCommands(model, args.commands);
-  const std::vector<Eigen::VectorXd> z = ParseTerrain(model, args.terrain, args.command_values, ids.size());
+  const std::vector<Eigen::VectorXd> z =
+      ParseTerrain(model, args.terrain, args.command_values, ids.size(), !args.ground.empty());
   std::vector<predict::Step> steps;
   for (std::size_t k = 0; k < ids.size(); ++k) steps.push_back({ids[k], z[k]});
   WarnWhereDataIsThin(model, ids, z);
@@ -197,16 +229,15 @@ void Run(const PredictArgs& args) {
   options.trajectories = args.trajectories;
   options.seed = args.seed;
   options.pose_dims = SplitOn(args.pose_dims, ',');
+  if (!args.persistence.empty()) options.persistence = PersistenceFrom(model, args.persistence);
+  options.from_rest = !args.walking;
   std::optional<sim::SimConfig> ground;
   predict::GroundSurface surface;
   if (!args.ground.empty()) {
     if (!args.terrain.empty()) throw MakeInputError("--ground", "", "give either --terrain or --ground, not both");
-    if (!args.command_values.empty()) {
-      throw MakeInputError("--ground", "", "not with --command-values yet: give the terrain with --terrain");
-    }
     ground = sim::LoadSimConfig(args.ground);
     surface = GroundSurfaceOf(*ground);
-    options.ground = predict::GroundTerrain(model, surface);
+    options.ground = predict::GroundTerrain(model, surface, CommandValueNames(args.command_values));
   }
   const auto p = predict::Predict(model, Eigen::Vector3d(args.start[0], args.start[1], args.start[2]), steps, options);
   if (ground && ground->terrain) WarnOffTheField(p, *ground->terrain, args.ground);
@@ -255,6 +286,15 @@ void Setup(CLI::App& root) {
                   "conditioned on the terrain where it stands (pitch and roll of the ground under its feet, and "
                   "foot_relief / height_ahead when the model has them); --start is then x, y in the slope frame "
                   "and the heading on the slope (0 = uphill)");
+  cmd->add_option("--persistence", args->persistence,
+                  "sample set with recorded episodes (e.g. the training set of dgmm simulate --protocol "
+                  "trajectories): how the robot's deviations from the model carry over to the next commands is "
+                  "estimated from it and each trajectory's draws are correlated accordingly (default: every "
+                  "command drawn independently, which under-states the spread after many commands when "
+                  "deviations persist)");
+  cmd->add_flag("--walking", args->walking,
+               "the robot is already walking before the first command (with --persistence: the first command's "
+               "spread is the model's, not that of a start from standing)");
   cmd->add_option("--figure", args->figure,
                   "trajectory fan (PNG): where the trajectories are after each command, each step's 50% and 90% "
                   "regions and the mean path (needs an X display, e.g. xvfb-run -a)");

@@ -192,7 +192,7 @@ void BindFitAndPredict(py::module_& m) {
   m.def("predict",
         [](const MotionModel& model, const std::vector<int>& commands, const std::optional<Eigen::MatrixXd>& terrain,
            const Eigen::Vector3d& start, int trajectories, std::uint64_t seed, const std::vector<std::string>& pose_dims,
-           std::optional<double> ground_slope_deg) {
+           std::optional<double> ground_slope_deg, const std::optional<py::dict>& persistence, bool walking) {
           std::vector<predict::Step> steps;
           for (std::size_t k = 0; k < commands.size(); ++k) {
             predict::Step s{commands[k], {}};
@@ -208,6 +208,14 @@ void BindFitAndPredict(py::module_& m) {
           o.seed = seed;
           o.pose_dims = pose_dims;
           if (ground_slope_deg) o.ground = predict::GroundTerrain(model, {*ground_slope_deg * M_PI / 180});
+          o.from_rest = !walking;
+          if (persistence) {
+            o.persistence.shared = (*persistence)["shared"].cast<Eigen::VectorXd>();
+            o.persistence.decay = (*persistence)["decay"].cast<Eigen::VectorXd>();
+            if (persistence->contains("first_scale")) {
+              o.persistence.first_scale = (*persistence)["first_scale"].cast<Eigen::VectorXd>();
+            }
+          }
           const predict::Prediction p = predict::Predict(model, start, steps, o);
           const int n = static_cast<int>(p.steps.size());
           py::array_t<double> poses({n, trajectories, 4}), mean({n, 4}), cov({n, 4, 4});
@@ -232,10 +240,33 @@ void BindFitAndPredict(py::module_& m) {
         py::arg("model"), py::arg("commands"), py::arg("terrain") = std::nullopt,
         py::arg("start") = Eigen::Vector3d::Zero(), py::arg("trajectories") = 1000, py::arg("seed") = 1,
         py::arg("pose_dims") = std::vector<std::string>{}, py::arg("ground_slope_deg") = std::nullopt,
+        py::arg("persistence") = std::nullopt, py::arg("walking") = false,
         "Where a command sequence takes the robot (as `dgmm predict`): poses (steps x trajectories x "
         "[x, y, z, yaw]), their mean and covariance per step. pose_dims: the model's names for dx, dy, dyaw "
         "(planar composition) or dx, dy, dyaw, dz, droll, dpitch; default: SE(3) when the model has them all. "
-        "ground_slope_deg: condition each trajectory on a plane's pitch and roll at its heading (as --ground).");
+        "ground_slope_deg: condition each trajectory on a plane's pitch and roll at its heading (as --ground). "
+        "persistence: estimate_persistence's dict; correlates each trajectory's draws from step to step (as --persistence). "
+        "walking: the robot walks before the first command (as --walking).");
+  m.def("estimate_persistence",
+        [](const MotionModel& model, const SampleSet& set, int max_lag) {
+          predict::PersistenceOptions o;
+          o.max_lag = max_lag;
+          const predict::PersistenceSummary s = predict::EstimatePersistence(model, set, o);
+          py::dict out;
+          out["shared"] = s.persistence.shared;
+          out["decay"] = s.persistence.decay;
+          out["first_scale"] = s.persistence.first_scale;
+          out["first_steps"] = s.first_steps;
+          out["lag_correlation"] = s.lag_correlation;
+          out["pairs"] = s.pairs;
+          out["episodes"] = s.episodes;
+          return out;
+        },
+        py::arg("model"), py::arg("set"), py::arg("max_lag") = 5,
+        "How the model's deviations persist over consecutive steps of the set's episodes (as predict "
+        "--persistence): dict of shared (a) and decay (phi) per pose dimension, corr(t, t + l) = a phi^l, "
+        "first_scale (the first step's spread from standing relative to the model's), "
+        "with the measured lag correlations (pose dims x max_lag) and pairs per lag.");
 }
 
 }  // namespace

@@ -9,8 +9,12 @@ trajectories (the Mahalanobis distance of the outcome under the predicted mean a
 compared with the same quantile of the predicted trajectories' own distances), planar SE(2)
 composition of (dx, dy, dyaw) in the slope plane. Prints a Markdown table.
 
+With --persistence each model is also run with the persistence of its deviations from step to step
+estimated from its own training set (`dgmm predict --persistence`, lib/predict/step_persistence.h).
+
 Usage: scripts/predict_calibration.py [--build build] [--train datasets/scorpion_sim_830.h5 | trajectories]
                                       [--train-seed 6] [--seeds 5] [--horizon 10] [--trajectories 2000]
+                                      [--persistence]
 --train trajectories trains on 300 trajectory episodes of its own (seed --train-seed), recorded
 like the held-out ones: every step a fresh command, as a planner would send them.
 Seeds: develop on --seeds 5, report once on a range not looked at before (docs/prediction.md).
@@ -43,7 +47,7 @@ def compose(x, episode_rows):
     return np.array(out)
 
 
-def coverage(dgmm, model, s, episodes, horizon, trajectories, seed):
+def coverage(dgmm, model, persistence, s, episodes, horizon, trajectories, seed):
     """Counts of outcomes inside the 50% and 90% regions per horizon, and the number of episodes."""
     x, z, command, episode, step = s.x, s.z, s.command, s.episode, s.step
     inside = np.zeros((horizon, 2))
@@ -56,7 +60,7 @@ def coverage(dgmm, model, s, episodes, horizon, trajectories, seed):
         used += 1
         truth = compose(x, rows)
         p = dgmm.predict(model, [int(c) for c in command[rows]], terrain=z[rows], trajectories=trajectories,
-                         seed=seed + int(e), pose_dims=["dx", "dy", "dyaw"])
+                         seed=seed + int(e), pose_dims=["dx", "dy", "dyaw"], persistence=persistence)
         for k in range(horizon):
             xy = p["poses"][k][:, :2]
             mean = xy.mean(0)
@@ -76,6 +80,8 @@ def main():
     ap.add_argument("--seeds", default="5", help="trajectory seeds, e.g. 5 or 200-203")
     ap.add_argument("--horizon", type=int, default=10)
     ap.add_argument("--trajectories", type=int, default=2000)
+    ap.add_argument("--persistence", action="store_true",
+                    help="also predict with the persistence of deviations estimated from the training set")
     a = ap.parse_args()
     dgmm = load_module(a.build)
     tmp = tempfile.mkdtemp()
@@ -84,8 +90,15 @@ def main():
         train_path = os.path.join(tmp, "train.h5")
         simulate(a.build, a.horizon, a.train_seed, train_path, placements=300)
     train = dgmm.SampleSet.read(train_path)
-    models = {"DGMM": dgmm.DGMM(seed=1).fit(train).model_,
+    fitted = {"DGMM": dgmm.DGMM(seed=1).fit(train).model_,
               "one Gaussian": dgmm.EMMixture(n_components=1, seed=1).fit(train).model_}
+    models = {name: (m, None) for name, m in fitted.items()}
+    if a.persistence:
+        for name, m in fitted.items():
+            p = dgmm.estimate_persistence(m, train)
+            print(f"{name}: persistence a = {np.round(p['shared'], 2).tolist()}, phi = {np.round(p['decay'], 2).tolist()} "
+                  f"({', '.join(train.x_names)})")
+            models[name + " + persistence"] = (m, p)
     lo, _, hi = a.seeds.partition("-")
     seeds = range(int(lo), int(hi or lo) + 1)
     totals = {name: np.zeros((a.horizon, 2)) for name in models}
@@ -96,8 +109,8 @@ def main():
         path = os.path.join(tmp, f"trajectories_{seed}.h5")
         simulate(a.build, a.horizon, seed, path)
         s = dgmm.SampleSet.read(path)
-        for name, model in models.items():
-            inside, used = coverage(dgmm, model, s, np.unique(s.episode), a.horizon, a.trajectories, 1000 * seed)
+        for name, (model, persistence) in models.items():
+            inside, used = coverage(dgmm, model, persistence, s, np.unique(s.episode), a.horizon, a.trajectories, 1000 * seed)
             totals[name] += inside
         episodes_used += used
     trained_on = f"300 trajectory episodes (seed {a.train_seed})" if a.train == "trajectories" else a.train

@@ -128,6 +128,18 @@ Eigen::MatrixXd Mixture::Sample(int n, std::mt19937_64& rng) const {
   return out;
 }
 
+Eigen::MatrixXd Mixture::SampleWithNoise(const Eigen::Ref<const Eigen::MatrixXd>& noise, std::mt19937_64& rng) const {
+  assert(noise.rows() == dim_ && (!empty() || noise.cols() == 0));
+  Eigen::MatrixXd out(dim_, noise.cols());
+  if (noise.cols() == 0) return out;
+  std::discrete_distribution<int> pick(weights_.begin(), weights_.end());
+  for (Eigen::Index j = 0; j < noise.cols(); ++j) {
+    const Gaussian& g = components_[pick(rng)];
+    out.col(j) = g.mean() + g.cholesky_l().triangularView<Eigen::Lower>() * noise.col(j);
+  }
+  return out;
+}
+
 Mixture::Mode Mixture::MaxDensity(const ModeSearchOptions& options) const {
   std::vector<Eigen::VectorXd> starts;
   starts.reserve(components_.size());

@@ -67,6 +67,9 @@ class Mixture {
 
   // n draws, returned as the columns of a d x n matrix.
   Eigen::MatrixXd Sample(int n, std::mt19937_64& rng) const;
+  // One draw per column of `noise` (d x n, standard normal, e.g. correlated across calls):
+  // x_j = mu_k + L_k noise_j with component k drawn by weight.
+  Eigen::MatrixXd SampleWithNoise(const Eigen::Ref<const Eigen::MatrixXd>& noise, std::mt19937_64& rng) const;
 
   // argmax_x p(x) and log p there. Fixed-point mode search (Carreira-Perpinan 2000) started
   // from every component mean; the best local maximum found wins.

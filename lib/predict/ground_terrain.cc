@@ -1,6 +1,7 @@
 #include "predict/ground_terrain.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -10,18 +11,24 @@
 namespace dgmm::predict {
 namespace {
 
-enum class Sensed { kPitch, kRoll, kFootRelief, kHeightAhead };
+enum class Sensed { kPitch, kRoll, kFootRelief, kHeightAhead, kGiven };
 
-std::vector<Sensed> SensedDimensions(const MotionModel& model) {
+std::vector<Sensed> SensedDimensions(const MotionModel& model, const std::vector<std::string>& given) {
   std::vector<Sensed> out;
+  bool any = false;
   for (const std::string& name : model.terrain_names) {
+    if (std::find(given.begin(), given.end(), name) != given.end()) {
+      out.push_back(Sensed::kGiven);
+      continue;
+    }
+    any = true;
     if (name == "pitch") out.push_back(Sensed::kPitch);
     else if (name == "roll") out.push_back(Sensed::kRoll);
     else if (name == "foot_relief") out.push_back(Sensed::kFootRelief);
     else if (name == "height_ahead") out.push_back(Sensed::kHeightAhead);
     else throw MakeInputError("model", "terrain", "\"" + name + "\" is not something a ground gives (pitch, roll, foot_relief, height_ahead)");
   }
-  if (out.empty()) throw MakeInputError("model", "terrain", "has no terrain dimensions to read off a ground");
+  if (!any) throw MakeInputError("model", "terrain", "has no terrain dimensions to read off a ground");
   return out;
 }
 
@@ -62,8 +69,9 @@ Eigen::Vector2d PitchRoll(double slope_rad, const Eigen::Vector3d& n, double yaw
 
 }  // namespace
 
-std::function<Eigen::VectorXd(const Eigen::Vector4d&)> GroundTerrain(const MotionModel& model, const GroundSurface& ground) {
-  const std::vector<Sensed> dims = SensedDimensions(model);
+std::function<Eigen::VectorXd(const Eigen::Vector4d&)> GroundTerrain(const MotionModel& model, const GroundSurface& ground,
+                                                                    const std::vector<std::string>& given) {
+  const std::vector<Sensed> dims = SensedDimensions(model, given);
   CheckFootprint(ground);
   return [dims, ground](const Eigen::Vector4d& pose) {
     PlaneFit plane;
@@ -72,6 +80,7 @@ std::function<Eigen::VectorXd(const Eigen::Vector4d&)> GroundTerrain(const Motio
     Eigen::VectorXd z(static_cast<int>(dims.size()));
     for (int i = 0; i < z.size(); ++i) {
       switch (dims[i]) {
+        case Sensed::kGiven: z[i] = NAN; break;
         case Sensed::kPitch: z[i] = pr[0]; break;
         case Sensed::kRoll: z[i] = pr[1]; break;
         case Sensed::kFootRelief: z[i] = ground.footprint_m.size() < 4 ? 0.0 : plane.rms_residual; break;

@@ -8,6 +8,7 @@
 //   frame as the IMU reads them (lib/sim/pose.h).
 #include <Eigen/Core>
 #include <functional>
+#include <string>
 #include <vector>
 
 #include "core/motion_model.h"
@@ -27,9 +28,11 @@ struct GroundSurface {
 // The model's terrain at a pose (x, y, z, yaw; yaw 0 = facing uphill), by the names the simulator
 // records: "pitch" and "roll" (rad, nose down and left side up > 0), "foot_relief" (m, sd of the
 // ground under the feet about its plane) and "height_ahead" (m, the ground one reach ahead minus
-// under the torso). InputError naming the part for other names or a footprint that cannot carry a
+// under the torso). Dimensions named in `given` (continuous command values each step supplies)
+// are left NaN. InputError naming the part for other names or a footprint that cannot carry a
 // height field.
 std::function<Eigen::VectorXd(const Eigen::Vector4d& pose)> GroundTerrain(const MotionModel& model,
-                                                                           const GroundSurface& ground);
+                                                                           const GroundSurface& ground,
+                                                                           const std::vector<std::string>& given = {});
 
 }  // namespace dgmm::predict

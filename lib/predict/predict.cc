@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <random>
 
 #include "util/error.h"
@@ -63,23 +64,57 @@ bool PredictOptions::IsValid(std::string* error) const {
     if (error) *error = "trajectories: expected 1 to 10^7";
     return false;
   }
-  return true;
+  return persistence.empty() || persistence.IsValid(error);
 }
 
 namespace {
 
+// Standard normal noise of every trajectory for one step after another (pose_dim x n), each
+// dimension's correlated with the previous steps' by a StepPersistence.
+class PersistentNoise {
+ public:
+  PersistentNoise(const StepPersistence& p, int n, bool from_rest) : p_(p), n_(n), from_rest_(from_rest) {}
+  Eigen::MatrixXd Next(std::mt19937_64& rng) {
+    std::normal_distribution<double> normal;
+    auto draw = [&] { return Eigen::MatrixXd(Eigen::MatrixXd::NullaryExpr(p_.shared.size(), n_, [&] { return normal(rng); })); };
+    const Eigen::ArrayXd phi = p_.decay.array(), a = p_.shared.array();
+    const bool first = u_.size() == 0;
+    if (first) {
+      u_ = draw();
+    } else {
+      u_ = (u_.array().colwise() * phi + draw().array().colwise() * (1 - phi.square()).sqrt()).matrix();
+    }
+    Eigen::MatrixXd eps = (u_.array().colwise() * a.sqrt() + draw().array().colwise() * (1 - a).sqrt()).matrix();
+    if (first && from_rest_ && p_.first_scale.size() > 0) eps = p_.first_scale.asDiagonal() * eps;
+    return eps;
+  }
+
+ private:
+  const StepPersistence& p_;
+  int n_;
+  bool from_rest_;
+  Eigen::MatrixXd u_;  // the persistent part u_t
+};
+
 // n pose changes (pose_dim x n) of step `k`, in raw units: from the step's terrain (or none), or
-// with options.ground from the terrain under each trajectory's pose before the step.
+// with options.ground from the terrain under each trajectory's pose before the step; with `noise`
+// (persistence) each drawn through that step's correlated noise.
 Eigen::MatrixXd DrawStep(const MotionModel& model, const Step& step, const PredictOptions& options,
-                         const Eigen::MatrixXd& poses, std::mt19937_64& rng) {
+                         const Eigen::MatrixXd& poses, PersistentNoise* noise, std::mt19937_64& rng) {
   const int n = static_cast<int>(poses.rows());
-  if (step.terrain.size() > 0 || !options.ground) {
-    return model.RawPoseDistribution(step.command, step.terrain).Sample(n, rng);
+  const Eigen::MatrixXd eps = noise ? noise->Next(rng) : Eigen::MatrixXd();
+  auto draw = [&](const Mixture& p, int first, int count) {
+    return noise ? p.SampleWithNoise(eps.middleCols(first, count), rng) : p.Sample(count, rng);
+  };
+  if (!options.ground || (step.terrain.size() > 0 && step.terrain.allFinite())) {
+    return draw(model.RawPoseDistribution(step.command, step.terrain), 0, n);
   }
   Eigen::MatrixXd dx(model.pose_dim, n);
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector4d pose = poses.row(i).transpose();
-    dx.col(i) = model.RawPoseDistribution(step.command, options.ground(pose)).Sample(1, rng);
+    Eigen::VectorXd z = options.ground(poses.row(i).transpose());
+    if (step.terrain.size() > 0) z = step.terrain.array().isNaN().select(z, step.terrain);
+    if (!z.allFinite()) throw MakeInputError("predict", "terrain", "a dimension is given neither by the step nor by the ground");
+    dx.col(i) = draw(model.RawPoseDistribution(step.command, z), i, 1);
   }
   return dx;
 }
@@ -104,7 +139,13 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
   Eigen::MatrixXd before(n, 4);  // every trajectory's pose before the step: x, y, z, yaw
   before.leftCols(3) = position;
   before.col(3).setConstant(start.z());
+  if (!options.persistence.empty() && options.persistence.shared.size() != model.pose_dim) {
+    throw MakeInputError("predict", "persistence", "expected one value per pose dimension of the model (" +
+                                                       std::to_string(model.pose_dim) + ")");
+  }
   std::mt19937_64 rng(options.seed);
+  std::optional<PersistentNoise> noise;
+  if (!options.persistence.empty()) noise.emplace(options.persistence, n, options.from_rest);
   for (std::size_t k = 0; k < steps.size(); ++k) {
     const Step& step = steps[k];
     if (!model.HasCommand(step.command)) {
@@ -114,7 +155,10 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
       throw MakeInputError("predict", "terrain", "step " + std::to_string(k + 1) + ": expected " +
                                                      std::to_string(model.terrain_dim) + " terrain values");
     }
-    const Eigen::MatrixXd dx = DrawStep(model, step, options, before, rng);  // pose_dim x n
+    if (!options.ground && !step.terrain.allFinite()) {
+      throw MakeInputError("predict", "terrain", "step " + std::to_string(k + 1) + ": expected finite terrain values");
+    }
+    const Eigen::MatrixXd dx = DrawStep(model, step, options, before, noise ? &*noise : nullptr, rng);  // pose_dim x n
     StepPrediction s;
     s.poses.resize(n, 4);
     for (int i = 0; i < n; ++i) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/motion_model.h"
+#include "predict/step_persistence.h"
 
 namespace dgmm::predict {
 
@@ -23,11 +24,19 @@ struct PredictOptions {
   // trajectory is conditioned on the ground where it stands before the step (e.g. a plane's
   // pitch and roll at its heading, GroundTerrain of ground_terrain.h). Empty: steps without a terrain marginalise it.
   std::function<Eigen::VectorXd(const Eigen::Vector4d& pose)> ground;
+  // How deviations carry from one command to the next (step_persistence.h, one value per pose
+  // dimension of the model); empty: every step drawn independently given its command and terrain.
+  StepPersistence persistence;
+  // The robot stands before the first command (persistence.first_scale applies); false: it is
+  // already walking.
+  bool from_rest = true;
   bool IsValid(std::string* error) const;
 };
 
 // One step of the sequence: the command's id in the model and the terrain to condition on (empty:
-// p(x | c), the terrain marginalised).
+// p(x | c), the terrain marginalised). With PredictOptions::ground, NaN entries (or an empty
+// terrain) are read off the ground under each trajectory and the others (continuous command
+// values, say) are kept.
 struct Step {
   int command = -1;
   Eigen::VectorXd terrain;

@@ -59,6 +59,29 @@ TEST(PredictCommand, TerrainPerStepConditionsEachStepOnItsOwn) {
   EXPECT_NE(ja["steps"][1]["mean"], jb["steps"][1]["mean"]);
 }
 
+// --persistence estimates how deviations carry over from the set's episodes (the 390 set: 78
+// placements of 5 repeats), prints it per pose dimension and records it; a missing set is one
+// line and writes nothing.
+TEST(PredictCommand, PersistenceIsEstimatedFromASetsEpisodes) {
+  const auto dir = MakeTempDir("predict_persist");
+  const std::string set = SourcePath("datasets/scorpion_sim_390.h5").string();
+  const std::string model = (dir / "m.h5").string(), out = (dir / "p.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", set, "-o", model}).exit_code, 0);
+  const RunResult r = RunDgmm({"predict", model, "--commands", "+0.5,0,0*4", "--persistence", set, "--trajectories",
+                               "200", "-o", out});
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("persistence from " + set + " (78 episodes; 312 pairs"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("dyaw     a = "), std::string::npos) << r.out;
+  std::ifstream in(out);
+  EXPECT_EQ(nlohmann::json::parse(in)["persistence_from"], set);
+  const std::string missing = (dir / "none.h5").string(), out2 = (dir / "q.json").string();
+  const RunResult bad = RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--persistence", missing, "-o", out2});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_EQ(CountLines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("none.h5"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(out2));
+}
+
 // A conditioning value far outside the training data (the 390 set's pitch stays within about
 // +-0.35 rad on its 18-degree slope) draws one warning line naming it; one inside does not.
 TEST(PredictCommand, WarnsWhenTheTerrainOrCommandIsOutsideTheTrainingData) {
@@ -78,12 +101,18 @@ TEST(PredictCommand, WarnsWhenTheTerrainOrCommandIsOutsideTheTrainingData) {
 
 // Issue #25: a model of continuous commands (simulated, stored as cmd_long, cmd_lat, cmd_turn in
 // z) is driven by command values per step, merged with the terrain: turning left then right.
+// A model of 24 simulated placements of continuous commands, fitted with the defaults: its path.
+std::string ContinuousModel(const std::filesystem::path& dir) {
+  const std::string set = (dir / "c.h5").string(), model = (dir / "m.h5").string();
+  EXPECT_EQ(RunDgmm({"--quiet", "simulate", "--protocol", "continuous", "--placements", "24", "--seed", "3", "-o",
+                     set}).exit_code, 0);
+  EXPECT_EQ(RunDgmm({"--quiet", "fit", set, "-o", model}).exit_code, 0);
+  return model;
+}
+
 TEST(PredictCommand, ContinuousCommandValuesPerStep) {
   const auto dir = MakeTempDir("predict_continuous");
-  const std::string set = (dir / "c.h5").string(), model = (dir / "m.h5").string(), out = (dir / "p.json").string();
-  ASSERT_EQ(RunDgmm({"--quiet", "simulate", "--protocol", "continuous", "--placements", "24", "--seed", "3", "-o",
-                     set}).exit_code, 0);
-  ASSERT_EQ(RunDgmm({"--quiet", "fit", set, "-o", model}).exit_code, 0);
+  const std::string model = ContinuousModel(dir), out = (dir / "p.json").string();
   const RunResult r = RunDgmm({"predict", model, "--commands", "velocity*2", "--command-values",
                                "cmd_long=0.3,cmd_lat=0,cmd_turn=0.4;cmd_long=0.3,cmd_lat=0,cmd_turn=-0.4",
                                "--terrain", "pitch=0.05,roll=0", "--trajectories", "300", "-o", out});
@@ -96,6 +125,30 @@ TEST(PredictCommand, ContinuousCommandValuesPerStep) {
   const RunResult missing = RunDgmm({"predict", model, "--commands", "velocity", "--command-values", "cmd_long=0.3"});
   EXPECT_NE(missing.exit_code, 0);
   EXPECT_NE(missing.err.find("missing cmd_lat,cmd_turn,pitch,roll"), std::string::npos) << missing.err;
+  EXPECT_EQ(CountLines(missing.err), 1) << missing.err;
+}
+
+// Command values with --ground: each step's values as given, pitch and roll read off the slope
+// under each trajectory: the same velocity carries the robot further facing downhill than uphill.
+TEST(PredictCommand, ContinuousCommandValuesOnTheGround) {
+  const auto dir = MakeTempDir("predict_continuous_ground");
+  const std::string model = ContinuousModel(dir), slope = (dir / "slope.json").string();
+  std::ofstream(slope) << R"({"slope_deg": 18})";
+  auto distance = [&](const std::string& heading) {
+    const std::string out = (dir / ("p" + heading + ".json")).string();
+    const RunResult r = RunDgmm({"--quiet", "predict", model, "--commands", "velocity*3", "--command-values",
+                                 "cmd_long=0.3,cmd_lat=0,cmd_turn=0", "--ground", slope, "--start", "0,0," + heading,
+                                 "--trajectories", "300", "-o", out});
+    EXPECT_EQ(r.exit_code, 0) << r.err;
+    std::ifstream in(out);
+    const auto mean = nlohmann::json::parse(in)["steps"][2]["mean"];
+    return std::hypot(double(mean[0]), double(mean[1]));
+  };
+  EXPECT_LT(distance("0"), distance("3.14159"));
+  const RunResult missing = RunDgmm({"predict", model, "--commands", "velocity", "--command-values", "cmd_long=0.3",
+                                     "--ground", slope});
+  EXPECT_NE(missing.exit_code, 0);
+  EXPECT_NE(missing.err.find("cmd_lat"), std::string::npos) << missing.err;
   EXPECT_EQ(CountLines(missing.err), 1) << missing.err;
 }
 

@@ -96,6 +96,30 @@ def test_predict_follows_the_commands():
     assert up["mean"][1, 0] < -down["mean"][1, 0]
 
 
+def test_persistence_matches_the_command_line_and_widens_only_later_steps(tmp_path):
+    s = dgmm.SampleSet.read(SHIPPED)
+    est = dgmm.DGMM(seed=1).fit(s)
+    p = dgmm.estimate_persistence(est.model_, s)
+    assert p["episodes"] == 78 and p["pairs"][0] == 312 and p["lag_correlation"].shape == (6, 5)
+    assert p["first_steps"] == 78 and p["first_scale"].shape == (6,)
+    # The command line prints the same estimate (two decimals) for every pose dimension.
+    est.save(tmp_path / "m.h5")
+    out = subprocess.run([CLI, "predict", str(tmp_path / "m.h5"), "--commands", "+0.5,0,0", "--persistence", SHIPPED,
+                          "--trajectories", "10"], check=True, capture_output=True, text=True).stdout
+    for name, a, phi, first in zip(s.x_names, p["shared"], p["decay"], p["first_scale"]):
+        assert f"{name:<8} a = {a:.2f}  phi = {phi:.2f}" in out and f"standing x{first:.2f}" in out
+    # Fully persistent dyaw: the first step is as without persistence, later ones spread wider.
+    forward = next(i for i, l in est.model_.command_labels.items() if l == "+0.5,0,0")
+    strong = {"shared": np.array([0, 0, 0, 0, 0, 1.0]), "decay": np.array([0, 0, 0, 0, 0, 0.95])}
+    plain = dgmm.predict(est.model_, [forward] * 8, terrain=np.array([[0.0, 0.0]]), trajectories=4000, seed=3)
+    held = dgmm.predict(est.model_, [forward] * 8, terrain=np.array([[0.0, 0.0]]), trajectories=4000, seed=3,
+                        persistence=strong)
+    assert abs(held["covariance"][0, 3, 3] / plain["covariance"][0, 3, 3] - 1) < 0.15
+    assert held["covariance"][7, 3, 3] > 3 * plain["covariance"][7, 3, 3]
+    with pytest.raises(ValueError):
+        dgmm.predict(est.model_, [forward], persistence={"shared": np.zeros(2), "decay": np.zeros(2)})
+
+
 def test_estimator_conventions():
     est = dgmm.DGMM(k=0.5)
     assert est.get_params()["k"] == 0.5
