@@ -92,6 +92,11 @@ CvOptions MakeCvOptions(const CvArgs& args, const SampleSet& set) {
   return options;
 }
 
+// The terrain change of each family, by its JSON key.
+std::vector<std::pair<std::string, const CvTerrainChange*>> TerrainChanges(const CvSummary& summary) {
+  return {{"dgmm", &summary.dgmm_terrain_change}, {"em_bic", &summary.em_terrain_change}};
+}
+
 nlohmann::json CvJson(const CvArgs& args, const CvOptions& options, const CvSummary& summary) {
   nlohmann::json out = {{"file", args.path},
                         {"samples", summary.samples},
@@ -112,6 +117,10 @@ nlohmann::json CvJson(const CvArgs& args, const CvOptions& options, const CvSumm
   for (const Row& row : Rows(summary)) {
     if (row.score->evaluated) out["rows"][row.key] = ScoreJson(*row.score);
     if (!row.omitted->empty()) out["omitted_rows"][row.key] = *row.omitted;
+  }
+  out["terrain_change"] = nlohmann::json::object();
+  for (const auto& [key, change] : TerrainChanges(summary)) {
+    if (change->evaluated) out["terrain_change"][key] = {{"mean", change->mean}, {"paired_standard_error", change->standard_error}};
   }
   return out;
 }
@@ -146,6 +155,12 @@ void PrintCvTable(const CvArgs& args, const CvSummary& summary) {
     if (!row.omitted->empty()) std::cout << row.label << ": omitted, " << *row.omitted << "\n";
   }
   if (!summary.has_terrain) std::cout << "(the set has no terrain: no with-terrain rows)\n";
+  for (const auto& [key, change] : TerrainChanges(summary)) {
+    if (!change->evaluated) continue;
+    const double z = change->standard_error > 0 ? change->mean / change->standard_error : 0;
+    std::cout << fmt::format("conditioning on terrain changes {} by {:+.1f} (paired std. error {:.1f}, {:+.1f} of them)\n",
+                             key == "dgmm" ? "DGMM" : "EM-BIC", change->mean, change->standard_error, z);
+  }
 }
 
 void RunCv(const CvArgs& args) {

@@ -282,6 +282,22 @@ Mixture FitEmByBic(const Eigen::MatrixXd& Y, const EmOptions& em, int max_compon
   return std::move(best->mixture);
 }
 
+namespace {
+
+// One repeat's share of a terrain change: the paired differences of the per-sample held-out
+// log-likelihoods with and without terrain (the same samples in the same order).
+void AddTerrainChange(const std::vector<double>& with, const std::vector<double>& without, int repeats,
+                      CvTerrainChange* change) {
+  if (with.empty() || with.size() != without.size()) return;
+  std::vector<double> d(with.size());
+  for (std::size_t i = 0; i < d.size(); ++i) d[i] = with[i] - without[i];
+  change->evaluated = true;
+  change->mean += std::accumulate(d.begin(), d.end(), 0.0) / repeats;
+  change->standard_error += std::sqrt(static_cast<double>(d.size())) * SampleSd(d) / repeats;
+}
+
+}  // namespace
+
 CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "cross-validation", error);
@@ -367,6 +383,8 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
       }
     }
     summary.unscored_per_repeat = unscored;
+    AddTerrainChange(all[kDgmmWith], all[kDgmmWithout], options.repeats, &summary.dgmm_terrain_change);
+    AddTerrainChange(all[kEmWith], all[kEmWithout], options.repeats, &summary.em_terrain_change);
     for (int v = 0; v < kVariants; ++v) {
       if (all[v].empty()) continue;
       scores[v]->evaluated = true;

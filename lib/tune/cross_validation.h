@@ -88,6 +88,16 @@ struct CvScore {
   double mean_components = 0;
 };
 
+// What conditioning on terrain changes for one model family, L(with) - L(without). Both rows score
+// the same held-out samples with the same folds, so its standard error is that of the paired
+// per-sample differences, sqrt(n_scored) * sd(l_i(with) - l_i(without)), averaged over repeats:
+// smaller than either row's own when the two models agree on which samples are hard.
+struct CvTerrainChange {
+  bool evaluated = false;
+  double mean = 0;            // mean over repeats of L_r(with) - L_r(without)
+  double standard_error = 0;  // of the paired differences
+};
+
 struct CvSummary {
   int samples = 0;
   int commands = 0;
@@ -102,6 +112,7 @@ struct CvSummary {
   // "leave-one-episode-out (6 episodes)" or "5 folds stratified by command (asked)".
   std::string folds_by;
   CvScore dgmm_without_terrain, dgmm_with_terrain, em_without_terrain, em_with_terrain;
+  CvTerrainChange dgmm_terrain_change, em_terrain_change;  // evaluated when both rows are
   // Non-empty when that EM-BIC row was asked for but omitted, and why (a command with fewer
   // training samples than the parameters of one full-covariance Gaussian: EM would fit noise).
   std::string em_without_terrain_omitted, em_with_terrain_omitted;

@@ -39,6 +39,12 @@ TEST(CvCommand, JsonTableWithTerrainHelping) {
             j["rows"]["dgmm_without_terrain"]["mean"].get<double>());
   EXPECT_GT(j["rows"]["em_bic_with_terrain"]["mean"].get<double>(),
             j["rows"]["em_bic_without_terrain"]["mean"].get<double>());
+  // The paired terrain change is the difference of the rows.
+  for (const std::string family : {"dgmm", "em_bic"}) {
+    const double with = j["rows"][family + "_with_terrain"]["mean"], without = j["rows"][family + "_without_terrain"]["mean"];
+    EXPECT_NEAR(j["terrain_change"][family]["mean"].get<double>(), with - without, 1e-6 * std::abs(without)) << family;
+    EXPECT_GT(j["terrain_change"][family]["paired_standard_error"].get<double>(), 0) << family;
+  }
   EXPECT_TRUE(r.err.empty()) << "--quiet silences progress: " << r.err;
   // Without --quiet and without a terminal: one line for the stage, no carriage returns.
   const RunResult loud = RunDgmm({"cv", set, "--k", "0.5", "--folds", "4", "--repeats", "2", "--json"});
@@ -56,6 +62,7 @@ TEST(CvCommand, TextTableAndThreadIndependence) {
   EXPECT_NE(text.out.find("DGMM without terrain"), std::string::npos);
   EXPECT_NE(text.out.find("DGMM with terrain"), std::string::npos);
   EXPECT_EQ(text.out.find("EM-BIC"), std::string::npos);
+  EXPECT_NE(text.out.find("conditioning on terrain changes DGMM by +"), std::string::npos) << text.out;
   std::vector<std::string> args = {"cv", set, "--folds", "3", "--repeats", "2", "--json"};
   args.insert(args.end(), {"--threads", "1"});
   const auto one = nlohmann::json::parse(RunDgmm(args).out);

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <map>
 #include <set>
+#include <tuple>
 
 #include "tests/tune/synthetic.h"
 #include "util/error.h"
@@ -143,6 +144,15 @@ TEST(CrossValidate, TerrainHelpsWhenXDependsOnTerrain) {
             cv.dgmm_without_terrain.mean + 3 * cv.dgmm_without_terrain.standard_error);
   EXPECT_GT(cv.em_with_terrain.mean,
             cv.em_without_terrain.mean + 3 * cv.em_without_terrain.standard_error);
+  // The change is the difference of the rows, its standard error that of the paired differences.
+  for (const auto& [change, with, without] :
+       {std::tuple{cv.dgmm_terrain_change, cv.dgmm_with_terrain, cv.dgmm_without_terrain},
+        std::tuple{cv.em_terrain_change, cv.em_with_terrain, cv.em_without_terrain}}) {
+    ASSERT_TRUE(change.evaluated);
+    EXPECT_NEAR(change.mean, with.mean - without.mean, 1e-6 * std::abs(without.mean));
+    EXPECT_GT(change.standard_error, 0);
+    EXPECT_GT(change.mean, 3 * change.standard_error);
+  }
 }
 
 TEST(CrossValidate, TerrainDoesNotHelpWhenXIgnoresTerrain) {
@@ -154,6 +164,9 @@ TEST(CrossValidate, TerrainDoesNotHelpWhenXIgnoresTerrain) {
             cv.dgmm_without_terrain.mean + cv.dgmm_without_terrain.standard_error);
   EXPECT_LT(cv.em_with_terrain.mean,
             cv.em_without_terrain.mean + cv.em_without_terrain.standard_error);
+  // Nor does the paired comparison, more sensitive, find a gain of two of its standard errors.
+  EXPECT_LT(cv.dgmm_terrain_change.mean, 2 * cv.dgmm_terrain_change.standard_error);
+  EXPECT_LT(cv.em_terrain_change.mean, 2 * cv.em_terrain_change.standard_error);
 }
 
 TEST(CrossValidate, FewerSamplesThanFoldsAndSingletonCommands) {
@@ -201,6 +214,7 @@ TEST(CrossValidate, WithoutTerrainInTheSetSkipsTheTerrainRows) {
   EXPECT_TRUE(cv.dgmm_without_terrain.evaluated);
   EXPECT_FALSE(cv.dgmm_with_terrain.evaluated);
   EXPECT_FALSE(cv.em_with_terrain.evaluated);
+  EXPECT_FALSE(cv.dgmm_terrain_change.evaluated);
 }
 
 TEST(CrossValidate, RejectsBadOptionsAndEmptySets) {
