@@ -3,7 +3,7 @@
 
 Usage: rough_ground.py [--dgmm EXE] [--config C.json] [--seeds 101,102] [--placements 664]
                        [--bootstrap 1000] [--workdir DIR] [--json-out OUT.json]
-                       [--from-json IN.json[,IN2.json...]] [--write-doc]
+                       [--from-json IN.json[,IN2.json...] [--add-terrain-change]] [--write-doc]
 About 35 minutes per seed at --placements 664 on one core (the bootstrap test dominates); seeds
 can run as separate processes and be merged with --from-json A.json,B.json --write-doc.
 
@@ -73,8 +73,11 @@ def multimodal_given_z(path, bootstrap, seed):
   return {"labels": labels, "p": p, "multimodal": [bool(r) for r in reject]}
 
 
-def cv_rows(a, path, flags, extra):
+def cv_rows(a, path, flags, extra, change=None):
+  """The cv rows by key and the omitted ones; `change` (a dict) receives the paired terrain changes."""
   cv = run_json([a.dgmm, "--quiet", "cv", path, "--json", "--seed", "1"] + flags + extra)
+  if change is not None:
+    change.update(cv.get("terrain_change", {}))
   return {k: {"mean": v["mean"], "se": v["standard_error"], "components": v["mean_components"],
               "per_repeat": v["per_repeat"]} for k, v in cv["rows"].items()}, cv.get("omitted_rows", {})
 
@@ -94,12 +97,25 @@ def one_seed(a, seed, workdir):
   flags = ["--k", repr(tune["k"]), "--init-scale", repr(tune["init_scale"]), "--prior-count", repr(tune["prior_count"])]
   one = ["--k", "1000", "--init-scale", repr(tune["init_scale"]), "--prior-count", repr(tune["prior_count"])]
   res = {"seed": seed, "samples": summary["samples"], "falls": summary["falls"], "test": test, "tune": tune}
-  res["tuned"], omitted = cv_rows(a, path, flags, ["--em-max-components", "5"])
+  res["terrain_change"] = {}
+  res["tuned"], omitted = cv_rows(a, path, flags, ["--em-max-components", "5"], res["terrain_change"])
   res["one_gaussian"], _ = cv_rows(a, path, one, ["--no-em"])
   res["em_k1"], _ = cv_rows(a, path, flags, ["--em-max-components", "1"])
   res["omitted"] = omitted
   res["components"] = per_command_components(a, path, flags, test["labels"])
   return res
+
+
+def add_terrain_change(a, r, workdir):
+  """Table I's paired terrain change for a seed of an earlier run: its set recorded again, `dgmm cv`
+  at the recorded tuned settings; the rows must come out as recorded (the same set, the same folds)."""
+  path, _ = simulate(a, r["seed"], workdir)
+  r["terrain_change"] = {}
+  rows, _ = cv_rows(a, path, r["tune"]["flags"], ["--em-max-components", "5"], r["terrain_change"])
+  for key, row in rows.items():
+    if abs(row["mean"] - r["tuned"][key]["mean"]) > 1e-6 * abs(row["mean"]):
+      sys.exit(f"seed {r['seed']}: {key} is {row['mean']} now, {r['tuned'][key]['mean']} when recorded: not the same set")
+  return r
 
 
 def paired(x, y):
@@ -158,9 +174,13 @@ def report(res):
     for family in ("dgmm", "em_bic"):
       w, wo = rows.get(f"{family}_with_terrain"), rows.get(f"{family}_without_terrain")
       if w and wo:
+        change = r.get("terrain_change", {}).get(family)
+        paired_text = (f", {change['mean'] / change['paired_standard_error']:+.1f} paired standard errors "
+                       f"({change['paired_standard_error']:.0f} nats)" if change else "")
         lines.append(f"- seed {r['seed']}, {family.replace('_', '-').upper()}: conditioning on terrain changes the "
                      f"held-out log-likelihood by {w['mean'] - wo['mean']:+.0f} nats, "
-                     f"{(w['mean'] - wo['mean']) / max(w['se'], wo['se']):+.1f} standard errors")
+                     f"{(w['mean'] - wo['mean']) / max(w['se'], wo['se']):+.1f} standard errors of the rows"
+                     f"{paired_text}")
   return "\n".join(lines) + "\n"
 
 
@@ -175,6 +195,8 @@ def parse_args():
   p.add_argument("--json-out")
   p.add_argument("--from-json")
   p.add_argument("--write-doc", action="store_true")
+  p.add_argument("--add-terrain-change", action="store_true",
+                 help="with --from-json: record each seed's set again and add Table I's paired terrain change")
   return p.parse_args()
 
 
@@ -183,6 +205,11 @@ def main():
   if a.from_json:  # one JSON, or several (one per seed run) merged in order
     parts = [json.load(open(p)) for p in a.from_json.split(",")]
     res = dict(parts[0], seeds=[r for p in parts for r in p["seeds"]])
+    if a.add_terrain_change:
+      a.placements, a.config = res["placements"], os.path.join(ROOT, res["config"])
+      workdir = a.workdir or tempfile.mkdtemp(prefix="dgmm-rough-")
+      os.makedirs(workdir, exist_ok=True)
+      res["seeds"] = [add_terrain_change(a, r, workdir) for r in res["seeds"]]
   else:
     workdir = a.workdir or tempfile.mkdtemp(prefix="dgmm-rough-")
     os.makedirs(workdir, exist_ok=True)
@@ -204,8 +231,12 @@ def main():
            "walk on or stall). The report seeds were run once before at 332 placements, where EM's full "
            "covariance in d = 8 could not be fitted in some training folds (the DGMM then gained 4.8 and "
            "5.1 standard errors over one Gaussian per command); the placements were doubled for EM, "
-           "nothing else changed. Standard errors are `dgmm cv`'s (sqrt(n) × sd of the per-sample held-out "
-           "log-likelihood), not paired. EM here is unregularised maximum likelihood with K chosen by BIC "
+           "nothing else changed. Standard errors of the rows are `dgmm cv`'s (sqrt(n) × sd of the per-sample "
+           "held-out log-likelihood); a change from conditioning on terrain is also given in paired standard "
+           "errors (sqrt(n) × sd of the per-sample differences with and without terrain: both rows score the "
+           "same held-out samples with the same folds), which `dgmm cv` prints since 2026-11-26 and which were "
+           "added to the seeds' recorded results by recording their sets again (`--from-json "
+           "docs/figures/rough_ground.json --add-terrain-change`; the rows came out as recorded). EM here is unregularised maximum likelihood with K chosen by BIC "
            "(or fixed at 1); the DGMM's covariances carry its prior, which is what held-out data reward "
            "when a command's outcomes split into a wide walking mode and a tight stalled one.\n\n" + text)
     tmp = os.path.join(ROOT, f"rough-ground-{os.getpid()}.md")
