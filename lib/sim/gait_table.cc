@@ -70,14 +70,18 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
     t = FromTable({{0.25, 0.0}, {0.75, 0.5}}, 0.75, legs, pattern, source);
   } else if (pattern == "tripod") {
     t = FromTable({{0.0, 0.5, 0.0}, {0.5, 0.0, 0.5}}, 0.5, legs, pattern, source);
-  } else if (pattern == "tetrapod") {  // three pairs, one swinging at a time
-    t = FromTable({{0.0, 1.0 / 3, 2.0 / 3}, {2.0 / 3, 0.0, 1.0 / 3}}, 2.0 / 3, legs, pattern, source);
+  } else if (pattern == "tetrapod") {  // three pairs, one swinging at a time, back to front
+    t = FromTable({{0.0, 2.0 / 3, 1.0 / 3}, {1.0 / 3, 0.0, 2.0 / 3}}, 2.0 / 3, legs, pattern, source);
   } else if (pattern == "wave") {  // back to front, left side then right
     t = FromTable({{2.0 / 6, 1.0 / 6, 0.0}, {5.0 / 6, 4.0 / 6, 3.0 / 6}}, 5.0 / 6, legs, pattern, source);
   } else {  // alternating_tetrapod
     t = FromTable({{0.0, 0.5, 0.0, 0.5}, {0.5, 0.0, 0.5, 0.0}}, 0.5, legs, pattern, source);
   }
   if (gait.duty_factor > 0) t.duty = gait.duty_factor;
+  t.phase_backward = t.phase;
+  if (pattern != "custom") {
+    for (double& p : t.phase_backward) p = p > 0 ? 1.0 - p : 0.0;
+  }
   return t;
 }
 

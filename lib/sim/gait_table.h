@@ -18,12 +18,18 @@ struct LegPlace {
 
 struct GaitTiming {
   std::vector<double> phase;  // per leg, in [0, 1)
+  // Per leg, for commands that walk backwards: the named patterns' order of swings reversed in
+  // time, (1 - phase) mod 1, so that the wave of swings runs from the trailing legs to the leading
+  // ones whichever way the robot walks (identical to `phase` for tripod, trot and the alternating
+  // tetrapod; user phases are kept as given).
+  std::vector<double> phase_backward;
   double duty = 0.5;          // share of the cycle each foot is on the ground
 };
 
 // The pattern's timing for these legs: trot / crawl need 4 legs, tripod / tetrapod / wave 6,
 // alternating_tetrapod 8, each half on either side; auto picks trot, tripod or the alternating
-// tetrapod by the leg count; custom takes gait.phases (one per leg). Throws InputError
+// tetrapod by the leg count; custom takes gait.phases (one per leg). The tetrapod and the wave
+// swing each side's legs from back to front when walking forwards. Throws InputError
 // "<source>: robot.gait.pattern: ..." when the pattern needs another number of legs.
 GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>& legs, const std::string& source);
 

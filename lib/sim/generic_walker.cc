@@ -137,7 +137,8 @@ RunOutcome GenericWalker::Stand(double seconds) {
 
 // Foot targets of the generic gait at time t of a command, through inverse kinematics to joint
 // targets: each foot travels d_i = duty (stride (long, lat) + turn_rad turn z x p_i) per stance,
-// so the torso moves stride per cycle and turns turn_rad per cycle; a ramp of a tenth of a cycle at
+// so the torso moves stride per cycle and turns turn_rad per cycle (backward commands swing the
+// legs in the reversed order, GaitTiming::phase_backward); a ramp of a tenth of a cycle at
 // either end of the command starts and ends the pattern at the stance; the stance leans with
 // gravity (robot.gait.lean).
 void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration) {
@@ -159,7 +160,7 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
     const Eigen::Vector2d p = leg.stance_m.head<2>();
     const Eigen::Vector2d d = duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) +
                                       config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
-    const double u = t / period - robot_.timing.phase[i];
+    const double u = t / period - (c.x() < 0 ? robot_.timing.phase_backward[i] : robot_.timing.phase[i]);
     targets[i] = robot_.robot_in_torso * (leg.stance_m + lean + envelope * FootOffset(u, duty, d, robot_.step_height_m));
   }
   SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);

@@ -3,6 +3,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 namespace dgmm::sim {
 namespace {
 
@@ -16,7 +19,36 @@ TEST(GaitTable, TripodAlternatesAlongEachSideAndAcross) {
   g.pattern = "tripod";
   const GaitTiming t = ResolveGait(g, Hexapod(), "test");
   EXPECT_EQ(t.phase, (std::vector<double>{0, 0.5, 0, 0.5, 0, 0.5}));
+  EXPECT_EQ(t.phase_backward, t.phase);  // symmetric in time: the same backwards, bit for bit
   EXPECT_DOUBLE_EQ(t.duty, 0.5);
+}
+
+// Within one cycle starting at `from`, the order in which the legs `which` start their swing
+// (a leg lifts at u = duty, i.e. at time phase + duty).
+std::vector<int> SwingOrder(const std::vector<double>& phase, double duty, const std::vector<int>& which) {
+  std::vector<int> order = which;
+  auto lift = [&](int i) { double v = phase[i] + duty; return v - std::floor(v); };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return lift(a) < lift(b); });
+  while (order.front() != which.back()) std::rotate(order.begin(), order.begin() + 1, order.end());
+  return order;
+}
+
+TEST(GaitTable, TetrapodAndWaveSwingBackToFrontAndReverseForBackwardCommands) {
+  for (const char* pattern : {"tetrapod", "wave"}) {
+    GaitDescription g;
+    g.pattern = pattern;
+    const GaitTiming t = ResolveGait(g, Hexapod(), "test");
+    // Left legs 0 (front), 1, 2 (rear); right legs 3 (front), 4, 5 (rear): forwards rear first.
+    EXPECT_EQ(SwingOrder(t.phase, t.duty, {0, 1, 2}), (std::vector<int>{2, 1, 0})) << pattern;
+    EXPECT_EQ(SwingOrder(t.phase, t.duty, {3, 4, 5}), (std::vector<int>{5, 4, 3})) << pattern;
+    // Backwards the front legs trail: they swing first.
+    EXPECT_EQ(SwingOrder(t.phase_backward, t.duty, {2, 1, 0}), (std::vector<int>{0, 1, 2})) << pattern;
+    EXPECT_EQ(SwingOrder(t.phase_backward, t.duty, {5, 4, 3}), (std::vector<int>{3, 4, 5})) << pattern;
+  }
+  GaitDescription custom;
+  custom.pattern = "custom";
+  custom.phases = {0, 0.1, 0.2, 0.3, 0.4, 0.5};
+  EXPECT_EQ(ResolveGait(custom, Hexapod(), "test").phase_backward, custom.phases);  // as given
 }
 
 TEST(GaitTable, LegsAreOrderedByPositionNotByListOrder) {
