@@ -201,7 +201,15 @@ void WarnOffTheField(const predict::Prediction& p, const sim::TerrainDescription
 
 // The persistence of deviations estimated from the episodes of `path`, one line per pose dimension.
 predict::StepPersistence PersistenceFrom(const MotionModel& model, const std::string& path) {
-  const predict::PersistenceSummary s = predict::EstimatePersistence(model, ReadSampleSet(path));
+  const predict::PersistenceSummary s = predict::EstimatePersistence(model, ReadSampleSet(path), {}, path);
+  // On the sets a model was learnt from the RMS is 0.4 to 1 (its covariances carry a prior).
+  if (s.residual_rms.maxCoeff() > 2.5) {
+    std::fprintf(stderr,
+                 "dgmm: warning: predict: %s: its deviations from the model reach %.2g times the model's own "
+                 "spread (RMS of standardised residuals, largest pose dimension; at most about 1 on the set the "
+                 "model was learnt from): the persistence estimated from it describes another robot or ground\n",
+                 path.c_str(), s.residual_rms.maxCoeff());
+  }
   std::printf("persistence from %s (%d episodes; %d pairs of consecutive steps; %d first steps): corr(step t, t + l) "
               "= a phi^l; the first command's spread from standing relative to the model's\n",
               path.c_str(), s.episodes, s.pairs[0], s.first_steps);

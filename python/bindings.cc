@@ -257,6 +257,7 @@ void BindFitAndPredict(py::module_& m) {
           out["decay"] = s.persistence.decay;
           out["first_scale"] = s.persistence.first_scale;
           out["first_steps"] = s.first_steps;
+          out["residual_rms"] = s.residual_rms;
           out["lag_correlation"] = s.lag_correlation;
           out["pairs"] = s.pairs;
           out["episodes"] = s.episodes;

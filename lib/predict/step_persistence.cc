@@ -42,7 +42,7 @@ std::vector<int> CommandIds(const MotionModel& model, const SampleSet& set) {
 }
 
 // eps_i = L_k^-1 (x_i - mu_k) under the most responsible component k of p(x | c_i, z_i): pose_dim x n.
-Eigen::MatrixXd StandardisedResiduals(const MotionModel& model, const SampleSet& set) {
+Eigen::MatrixXd StandardisedResiduals(const MotionModel& model, const SampleSet& set, const std::string& source) {
   const std::vector<int> ids = CommandIds(model, set);
   Eigen::MatrixXd eps(model.pose_dim, set.size());
   for (int i = 0; i < set.size(); ++i) {
@@ -50,7 +50,7 @@ Eigen::MatrixXd StandardisedResiduals(const MotionModel& model, const SampleSet&
     if (id < 0 || !model.HasCommand(id)) {
       const int c = set.command[i];
       const std::string name = c < static_cast<int>(set.command_labels.size()) ? set.command_labels[c] : std::to_string(c);
-      throw MakeInputError("sample set", "command", "'" + name + "' is not in the model");
+      throw MakeInputError(source, "command", "'" + name + "' is not in the model");
     }
     const Eigen::VectorXd z = model.terrain_dim > 0 ? Eigen::VectorXd(set.z.row(i).transpose()) : Eigen::VectorXd();
     const Mixture p = model.RawPoseDistribution(id, z);
@@ -102,18 +102,19 @@ std::pair<double, double> FitDecay(const Eigen::VectorXd& rho) {
 
 }  // namespace
 
-PersistenceSummary EstimatePersistence(const MotionModel& model, const SampleSet& set, const PersistenceOptions& options) {
-  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
+PersistenceSummary EstimatePersistence(const MotionModel& model, const SampleSet& set, const PersistenceOptions& options,
+                                       const std::string& source) {
+  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError(source, "", e);
   if (!set.has_sequence()) {
-    throw MakeInputError("sample set", "episode", "persistence needs recorded episodes and steps (e.g. dgmm simulate --protocol trajectories)");
+    throw MakeInputError(source, "episode", "persistence needs recorded episodes and steps (e.g. dgmm simulate --protocol trajectories)");
   }
-  if (!set.transform.empty()) throw MakeInputError("sample set", "transform", "expected a raw (not standardised) set");
-  if (set.pose_dim() != model.pose_dim) throw MakeInputError("sample set", "x", "expected the model's pose dimensions");
+  if (!set.transform.empty()) throw MakeInputError(source, "transform", "expected a raw (not standardised) set");
+  if (set.pose_dim() != model.pose_dim) throw MakeInputError(source, "x", "expected the model's pose dimensions");
   if (model.terrain_dim > 0 && set.terrain_dim() != model.terrain_dim) {
-    throw MakeInputError("sample set", "z", "expected the model's " + std::to_string(model.terrain_dim) + " terrain dimensions");
+    throw MakeInputError(source, "z", "expected the model's " + std::to_string(model.terrain_dim) + " terrain dimensions");
   }
   if (options.max_lag < 1 || options.min_pairs < 2) throw MakeInputError("persistence", "options", "expected max_lag >= 1, min_pairs >= 2");
-  const Eigen::MatrixXd eps = StandardisedResiduals(model, set);
+  const Eigen::MatrixXd eps = StandardisedResiduals(model, set, source);
   std::map<std::pair<int, int>, int> row;  // (episode, step) -> sample
   std::map<int, int> steps_in;
   for (int i = 0; i < set.size(); ++i) row[{set.episode[i], set.step[i]}] = i, ++steps_in[set.episode[i]];
@@ -131,9 +132,10 @@ PersistenceSummary EstimatePersistence(const MotionModel& model, const SampleSet
     if (static_cast<int>(a.size()) >= options.min_pairs) out.lag_correlation.col(l - 1) = Correlation(eps, a, b);
   }
   if (out.pairs[0] < options.min_pairs) {
-    throw MakeInputError("sample set", "episode", "expected at least " + std::to_string(options.min_pairs) +
+    throw MakeInputError(source, "episode", "expected at least " + std::to_string(options.min_pairs) +
                                                       " pairs of consecutive steps, found " + std::to_string(out.pairs[0]));
   }
+  out.residual_rms = (eps.cwiseAbs2().rowwise().sum() / set.size()).cwiseSqrt();
   out.persistence.first_scale = Eigen::VectorXd::Ones(model.pose_dim);
   Eigen::VectorXd square_sum = Eigen::VectorXd::Zero(model.pose_dim);
   for (int i = 0; i < set.size(); ++i) {

@@ -11,6 +11,7 @@
 // command than the model's average over all steps: eps_1 is scaled by s, the RMS of the
 // standardised residuals of the episodes' first steps.
 #include <Eigen/Core>
+#include <string>
 
 #include "core/motion_model.h"
 #include "core/sample_set.h"
@@ -40,6 +41,9 @@ struct PersistenceSummary {
   Eigen::VectorXi pairs;            // pairs of steps per lag
   int episodes = 0;                 // episodes with at least two steps
   int first_steps = 0;              // samples that are the first step of their episode
+  // RMS of the standardised residuals per pose dimension over all samples: near 1 when the model
+  // describes the set; far from it, the set is not what the model was learnt from.
+  Eigen::VectorXd residual_rms;
 };
 
 // Residual of each sample standardised under the most responsible component of the model's
@@ -48,7 +52,9 @@ struct PersistenceSummary {
 // in closed form clamped to [0, 1]; s_d = sqrt(mean eps_d^2) over first steps (step 0), within
 // [0.1, 10]. The set must be raw (not standardised) and record episodes
 // and steps (e.g. `dgmm simulate --protocol trajectories`); InputError naming the part otherwise.
+// `source` names the set in errors (its file, say).
 PersistenceSummary EstimatePersistence(const MotionModel& model, const SampleSet& set,
-                                       const PersistenceOptions& options = {});
+                                       const PersistenceOptions& options = {},
+                                       const std::string& source = "sample set");
 
 }  // namespace dgmm::predict

@@ -72,6 +72,13 @@ TEST(PredictCommand, PersistenceIsEstimatedFromASetsEpisodes) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("persistence from " + set + " (78 episodes; 312 pairs"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("dyaw     a = "), std::string::npos) << r.out;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;  // the model's own set
+  // A set the model does not describe (the rough ground for a model of the plane) is warned about.
+  const RunResult other = RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--persistence",
+                                   SourcePath("datasets/rough_ground_1660.h5").string(), "--trajectories", "50"});
+  ASSERT_EQ(other.exit_code, 0) << other.err;
+  EXPECT_NE(other.err.find("describes another robot or ground"), std::string::npos) << other.err;
+  EXPECT_EQ(CountLines(other.err), 1) << other.err;
   std::ifstream in(out);
   EXPECT_EQ(nlohmann::json::parse(in)["persistence_from"], set);
   const std::string missing = (dir / "none.h5").string(), out2 = (dir / "q.json").string();

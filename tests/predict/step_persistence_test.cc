@@ -63,6 +63,7 @@ TEST(EstimatePersistence, RecoversTheShareAndDecayOfAKnownProcess) {
   EXPECT_EQ(s.episodes, 400);
   EXPECT_EQ(s.pairs[0], 400 * 9);
   EXPECT_NEAR(s.lag_correlation(2, 0), 0.35, 0.05);  // a phi
+  EXPECT_NEAR(s.residual_rms[0], 1.0, 0.05);  // the model describes the set
   EXPECT_NEAR(s.persistence.shared[2], 0.5, 0.1);
   EXPECT_NEAR(s.persistence.decay[2], 0.7, 0.1);
   for (int d = 0; d < 2; ++d) {
@@ -95,7 +96,12 @@ TEST(EstimatePersistence, NeedsEpisodesOfConsecutiveSteps) {
   SampleSet s = Episodes(40, 3, 1);
   s.episode.resize(0);
   s.step.resize(0);
-  EXPECT_THROW(EstimatePersistence(Forward(), s), InputError);
+  try {
+    EstimatePersistence(Forward(), s, {}, "walk.h5");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("walk.h5: episode:"), std::string::npos) << e.what();
+  }
   EXPECT_THROW(EstimatePersistence(Forward(), Episodes(10, 2, 1)), InputError);  // 10 pairs < 30
 }
 
