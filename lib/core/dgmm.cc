@@ -279,17 +279,18 @@ int Dgmm::ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt199
   // g_i is scaled by exp(1/2 min_j m_j^2) so that a sample far from every component still picks
   // the nearest one (the nearest gets g = 1; weights are counts >= 1, so nothing overflows).
   const int k = mixture_.size();
+  if (k == 1) return 0;  // nothing to draw
   log_choice_.resize(k);
   double m = kNegInf;
   for (int i = 0; i < k; ++i) {
     log_choice_[i] = -0.5 * mixture_.component(i).SquaredMahalanobis(x);
     m = std::max(m, log_choice_[i]);
   }
-  if (k == 1) return 0;  // nothing to draw
   double total = 0.0;
   for (int i = 0; i < k; ++i) {
+    // exp underflows to exactly 0 below -745.2: the call is skipped there (the same result).
     const double a = log_choice_[i] - m;
-    log_choice_[i] = mixture_.weight(i) * (a == 0.0 ? 1.0 : std::exp(a));
+    log_choice_[i] = a == 0.0 ? mixture_.weight(i) : a < -746.0 ? 0.0 : mixture_.weight(i) * std::exp(a);
     total += log_choice_[i];
   }
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
