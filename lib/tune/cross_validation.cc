@@ -298,6 +298,86 @@ void AddTerrainChange(const std::vector<double>& with, const std::vector<double>
 
 }  // namespace
 
+namespace {
+
+// Every (repeat, fold) task on the worker threads; results in task order (repeat-major).
+std::vector<FoldResult> RunFolds(const SampleSet& set, const std::vector<std::vector<int>>& fold_of, int folds,
+                                 const CvOptions& options, bool has_terrain, const std::array<bool, 2>& em_for) {
+  const int tasks = options.repeats * folds;
+  std::vector<FoldResult> results(tasks);
+  std::atomic<int> next{0}, done{0};
+  std::mutex mutex;
+  std::exception_ptr failure;
+  auto worker = [&] {
+    for (int t; (t = next.fetch_add(1)) < tasks;) {
+      try {
+        results[t] = RunFold(set, fold_of[t / folds], t / folds, t % folds, options, has_terrain, em_for);
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(mutex);
+        if (!failure) failure = std::current_exception();
+        next = tasks;
+      }
+      std::lock_guard<std::mutex> lock(mutex);
+      const int finished = ++done;
+      if (options.progress) options.progress(finished, tasks);
+    }
+  };
+  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  threads = std::clamp(threads, 1, tasks);
+  std::vector<std::thread> pool;
+  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
+  worker();
+  for (auto& thread : pool) thread.join();
+  if (failure) std::rethrow_exception(failure);
+  return results;
+}
+
+// The rows, their standard errors and the terrain changes from the fold results, reduced in task
+// order: the figures do not depend on the number of threads.
+void Reduce(const std::vector<FoldResult>& results, int repeats, int folds, CvSummary* summary) {
+  std::array<CvScore*, kVariants> scores = {&summary->dgmm_without_terrain, &summary->dgmm_with_terrain,
+                                            &summary->em_without_terrain, &summary->em_with_terrain};
+  double components_total[kVariants] = {0, 0, 0, 0};
+  int em_commands = 0, dgmm_commands = 0;
+  for (int v = 0; v < kVariants; ++v) scores[v]->per_fold = Eigen::MatrixXd::Zero(repeats, folds);
+  for (int r = 0; r < repeats; ++r) {
+    std::array<std::vector<double>, kVariants> all;
+    int unscored = 0;
+    for (int f = 0; f < folds; ++f) {
+      const FoldResult& fr = results[r * folds + f];
+      unscored += fr.unscored;
+      em_commands += fr.em_commands;
+      dgmm_commands += fr.dgmm_commands;
+      for (int v = 0; v < kVariants; ++v) {
+        scores[v]->per_fold(r, f) = std::accumulate(fr.per_sample[v].begin(), fr.per_sample[v].end(), 0.0);
+        all[v].insert(all[v].end(), fr.per_sample[v].begin(), fr.per_sample[v].end());
+        components_total[v] += fr.components[v];
+      }
+    }
+    summary->unscored_per_repeat = unscored;
+    AddTerrainChange(all[kDgmmWith], all[kDgmmWithout], repeats, &summary->dgmm_terrain_change);
+    AddTerrainChange(all[kEmWith], all[kEmWithout], repeats, &summary->em_terrain_change);
+    for (int v = 0; v < kVariants; ++v) {
+      if (all[v].empty()) continue;
+      scores[v]->evaluated = true;
+      scores[v]->per_repeat.push_back(scores[v]->per_fold.row(r).sum());
+      scores[v]->standard_error += std::sqrt(static_cast<double>(all[v].size())) * SampleSd(all[v]) / repeats;
+      summary->scored_per_repeat = static_cast<int>(all[v].size());
+    }
+  }
+  for (int v = 0; v < kVariants; ++v) {
+    CvScore& s = *scores[v];
+    if (!s.evaluated) continue;
+    s.mean = std::accumulate(s.per_repeat.begin(), s.per_repeat.end(), 0.0) / s.per_repeat.size();
+    s.sd = SampleSd(s.per_repeat);
+    s.mean_per_sample = summary->scored_per_repeat > 0 ? s.mean / summary->scored_per_repeat : 0;
+    const int commands = v >= kEmWithout ? em_commands : dgmm_commands;
+    if (commands > 0) s.mean_components = components_total[v] / commands;
+  }
+}
+
+}  // namespace
+
 CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "cross-validation", error);
@@ -312,99 +392,23 @@ CvSummary CrossValidate(const SampleSet& set, const CvOptions& options) {
   summary.has_terrain = set.terrain_dim() > 0;
   std::vector<int> distinct(set.command.data(), set.command.data() + set.size());
   std::sort(distinct.begin(), distinct.end());
-  summary.commands =
-      static_cast<int>(std::unique(distinct.begin(), distinct.end()) - distinct.begin());
+  summary.commands = static_cast<int>(std::unique(distinct.begin(), distinct.end()) - distinct.begin());
 
   // Fold assignments first (serially), then every (repeat, fold) task on the worker threads.
   const FoldPlan plan = ChooseFolds(set, options.folds, options.group_by_episode);
   summary.folds = plan.folds;
   summary.folds_by = plan.reason;
-  const bool by_episode = plan.by_episode;
   CvOptions planned = options;
   planned.folds = plan.folds;
   std::vector<std::vector<int>> fold_of(options.repeats);
   for (int r = 0; r < options.repeats; ++r) {
     std::mt19937_64 rng(DeriveSeed(options.seed, r, 0, 0));
-    fold_of[r] = by_episode ? EpisodeFolds(set.episode, planned.folds, rng)
-                            : StratifiedFolds(set.command, planned.folds, rng);
+    fold_of[r] = plan.by_episode ? EpisodeFolds(set.episode, planned.folds, rng)
+                                 : StratifiedFolds(set.command, planned.folds, rng);
   }
   const std::array<bool, 2> em_for = EmRowsToRun(set, fold_of, planned, &summary);
-  const int tasks = options.repeats * planned.folds;
-  std::vector<FoldResult> results(tasks);
-  std::atomic<int> next{0}, done{0};
-  std::mutex mutex;
-  std::exception_ptr failure;
-  auto worker = [&] {
-    for (int t; (t = next.fetch_add(1)) < tasks;) {
-      try {
-        results[t] = RunFold(set, fold_of[t / planned.folds], t / planned.folds, t % planned.folds,
-                             options, summary.has_terrain, em_for);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        next = tasks;
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      const int finished = ++done;
-      if (options.progress) options.progress(finished, tasks);
-    }
-  };
-  int threads =
-      options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::clamp(threads, 1, tasks);
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& thread : pool) thread.join();
-  if (failure) std::rethrow_exception(failure);
-
-  // Reduce in task order: the figures do not depend on the number of threads.
-  std::array<CvScore*, kVariants> scores = {&summary.dgmm_without_terrain,
-                                            &summary.dgmm_with_terrain, &summary.em_without_terrain,
-                                            &summary.em_with_terrain};
-  double components_total[kVariants] = {0, 0, 0, 0};
-  int em_commands = 0, dgmm_commands = 0;
-  for (int v = 0; v < kVariants; ++v) {
-    scores[v]->per_fold = Eigen::MatrixXd::Zero(options.repeats, planned.folds);
-  }
-  for (int r = 0; r < options.repeats; ++r) {
-    std::array<std::vector<double>, kVariants> all;
-    int unscored = 0;
-    for (int f = 0; f < planned.folds; ++f) {
-      const FoldResult& fr = results[r * planned.folds + f];
-      unscored += fr.unscored;
-      em_commands += fr.em_commands;
-      dgmm_commands += fr.dgmm_commands;
-      for (int v = 0; v < kVariants; ++v) {
-        scores[v]->per_fold(r, f) =
-            std::accumulate(fr.per_sample[v].begin(), fr.per_sample[v].end(), 0.0);
-        all[v].insert(all[v].end(), fr.per_sample[v].begin(), fr.per_sample[v].end());
-        components_total[v] += fr.components[v];
-      }
-    }
-    summary.unscored_per_repeat = unscored;
-    AddTerrainChange(all[kDgmmWith], all[kDgmmWithout], options.repeats, &summary.dgmm_terrain_change);
-    AddTerrainChange(all[kEmWith], all[kEmWithout], options.repeats, &summary.em_terrain_change);
-    for (int v = 0; v < kVariants; ++v) {
-      if (all[v].empty()) continue;
-      scores[v]->evaluated = true;
-      scores[v]->per_repeat.push_back(scores[v]->per_fold.row(r).sum());
-      scores[v]->standard_error +=
-          std::sqrt(static_cast<double>(all[v].size())) * SampleSd(all[v]) / options.repeats;
-      summary.scored_per_repeat = static_cast<int>(all[v].size());
-    }
-  }
-  for (int v = 0; v < kVariants; ++v) {
-    CvScore& s = *scores[v];
-    if (!s.evaluated) continue;
-    s.mean = std::accumulate(s.per_repeat.begin(), s.per_repeat.end(), 0.0) / s.per_repeat.size();
-    s.sd = SampleSd(s.per_repeat);
-    s.mean_per_sample = summary.scored_per_repeat > 0 ? s.mean / summary.scored_per_repeat : 0;
-    if (v >= kEmWithout && em_commands > 0) s.mean_components = components_total[v] / em_commands;
-    if (v < kEmWithout && dgmm_commands > 0) {
-      s.mean_components = components_total[v] / dgmm_commands;
-    }
-  }
+  const std::vector<FoldResult> results = RunFolds(set, fold_of, planned.folds, options, summary.has_terrain, em_for);
+  Reduce(results, options.repeats, planned.folds, &summary);
   summary.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return summary;
 }
