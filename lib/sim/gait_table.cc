@@ -74,6 +74,7 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
     t = FromTable({{0.0, 2.0 / 3, 1.0 / 3}, {1.0 / 3, 0.0, 2.0 / 3}}, 2.0 / 3, legs, pattern, source);
   } else if (pattern == "wave") {  // back to front, left side then right
     t = FromTable({{2.0 / 6, 1.0 / 6, 0.0}, {5.0 / 6, 4.0 / 6, 3.0 / 6}}, 5.0 / 6, legs, pattern, source);
+    t.side_sequential = true;
   } else {  // alternating_tetrapod
     t = FromTable({{0.0, 0.5, 0.0, 0.5}, {0.5, 0.0, 0.5, 0.0}}, 0.5, legs, pattern, source);
   }
@@ -83,6 +84,20 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
     for (double& p : t.phase_backward) p = p > 0 ? 1.0 - p : 0.0;
   }
   return t;
+}
+
+double LateralShift(const GaitTiming& timing, const std::vector<double>& phase, const std::vector<int>& sides,
+                    double lateral) {
+  if (!timing.side_sequential || lateral == 0) return 0;
+  int first = -1;
+  double earliest = 2;
+  for (std::size_t i = 0; i < phase.size(); ++i) {
+    double lift = phase[i] + timing.duty;
+    lift -= std::floor(lift);
+    if (lift < earliest) earliest = lift, first = static_cast<int>(i);
+  }
+  const int leading = lateral > 0 ? 1 : -1;
+  return first >= 0 && sides[first] == leading ? 0.5 : 0;
 }
 
 Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, double lift) {

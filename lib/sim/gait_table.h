@@ -24,7 +24,17 @@ struct GaitTiming {
   // tetrapod; user phases are kept as given).
   std::vector<double> phase_backward;
   double duty = 0.5;          // share of the cycle each foot is on the ground
+  // A pattern that swings one side's legs and then the other's (the wave): a command with a
+  // sideways part starts with the trailing side (LateralShift).
+  bool side_sequential = false;
 };
+
+// Phase shift (0 or 0.5 of a cycle) for a command with sideways part `lateral` (> 0: to the
+// left) of a side-sequential pattern whose legs (sides +1 left / -1 right) follow `phase`: half a
+// cycle when the first leg to lift after the command starts is on the leading side, so that the
+// trailing side lifts first. 0 for other patterns or no sideways part.
+double LateralShift(const GaitTiming& timing, const std::vector<double>& phase, const std::vector<int>& sides,
+                    double lateral);
 
 // The pattern's timing for these legs: trot / crawl need 4 legs, tripod / tetrapod / wave 6,
 // alternating_tetrapod 8, each half on either side; auto picks trot, tripod or the alternating

@@ -14,6 +14,7 @@ namespace dgmm::sim {
 GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Ground& ground, const std::string& source)
     : config_(config), model_(std::move(model)), ground_(&ground), source_(source) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
+  for (const LegChain& leg : robot_.legs) sides_.push_back(leg.side);
   ApplyExperiment(config, robot_, model_.get());
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
   control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
@@ -138,7 +139,8 @@ RunOutcome GenericWalker::Stand(double seconds) {
 // Foot targets of the generic gait at time t of a command, through inverse kinematics to joint
 // targets: each foot travels d_i = duty (stride (long, lat) + turn_rad turn z x p_i) per stance,
 // so the torso moves stride per cycle and turns turn_rad per cycle (backward commands swing the
-// legs in the reversed order, GaitTiming::phase_backward); a ramp of a tenth of a cycle at
+// legs in the reversed order, GaitTiming::phase_backward, and a side-sequential pattern starts a
+// sideways command with its trailing side, LateralShift); a ramp of a tenth of a cycle at
 // either end of the command starts and ends the pattern at the stance; the stance leans with
 // gravity (robot.gait.lean).
 void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration) {
@@ -154,13 +156,15 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   const Eigen::Vector3d g = Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() *
                             Eigen::Vector3d(model_->opt.gravity[0], model_->opt.gravity[1], model_->opt.gravity[2]).normalized();
   if (g.z() < -0.5) lean.head<2>() = config_.robot->gait.lean * robot_.stance_height_m * g.head<2>() / -g.z();
+  const std::vector<double>& phase = c.x() < 0 ? robot_.timing.phase_backward : robot_.timing.phase;
+  const double shift = LateralShift(robot_.timing, phase, sides_, c.y());
   std::vector<Eigen::Vector3d> targets(robot_.legs.size());
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
     const LegChain& leg = robot_.legs[i];
     const Eigen::Vector2d p = leg.stance_m.head<2>();
     const Eigen::Vector2d d = duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) +
                                       config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
-    const double u = t / period - (c.x() < 0 ? robot_.timing.phase_backward[i] : robot_.timing.phase[i]);
+    const double u = t / period - phase[i] - shift;
     targets[i] = robot_.robot_in_torso * (leg.stance_m + lean + envelope * FootOffset(u, duty, d, robot_.step_height_m));
   }
   SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);

@@ -52,6 +52,7 @@ class GenericWalker {
   MjModelPtr model_;
   MjDataPtr data_, scratch_;
   LeggedRobot robot_;
+  std::vector<int> sides_;          // each leg's side (+1 left, -1 right), for the gait's timing
   std::vector<Eigen::VectorXd> q_;  // each leg's joint targets
   Eigen::VectorXd u_;               // the signal sent now: leg targets (gait) or every actuator's (replay)
   ActuationLine line_;

@@ -64,6 +64,34 @@ TEST(GaitTable, LegsAreOrderedByPositionNotByListOrder) {
   EXPECT_NEAR(t.phase[2], 5.0 / 6, 1e-12);
 }
 
+// The wave swings one side and then the other: a sideways command starts with the trailing side.
+TEST(GaitTable, AWaveStartsASidewaysStepWithItsTrailingSide) {
+  const std::vector<int> sides = {1, 1, 1, -1, -1, -1};
+  GaitDescription g;
+  g.pattern = "wave";
+  const GaitTiming t = ResolveGait(g, Hexapod(), "test");
+  EXPECT_TRUE(t.side_sequential);
+  for (const auto* phase : {&t.phase, &t.phase_backward}) {
+    for (double lateral : {0.5, -0.5}) {
+      const double shift = LateralShift(t, *phase, sides, lateral);
+      // The first leg to lift after the start, with the shift, is on the trailing side.
+      int first = -1;
+      double earliest = 2;
+      for (int i = 0; i < 6; ++i) {
+        double lift = (*phase)[i] + shift + t.duty;
+        lift -= std::floor(lift);
+        if (lift < earliest) earliest = lift, first = i;
+      }
+      EXPECT_EQ(sides[first], lateral > 0 ? -1 : 1) << "lateral " << lateral;
+    }
+    EXPECT_EQ(LateralShift(t, *phase, sides, 0.0), 0.0);  // no sideways part
+  }
+  g.pattern = "tripod";
+  const GaitTiming tripod = ResolveGait(g, Hexapod(), "test");
+  EXPECT_EQ(LateralShift(tripod, tripod.phase, sides, 0.5), 0.0);  // sides alternate: unchanged
+  EXPECT_EQ(LateralShift(tripod, tripod.phase, sides, -0.5), 0.0);
+}
+
 TEST(GaitTable, TrotPairsDiagonalsAndAutoPicksByLegCount) {
   const std::vector<LegPlace> quad = {{1, 0.2}, {-1, 0.2}, {1, -0.2}, {-1, -0.2}};
   const GaitTiming t = ResolveGait(GaitDescription{}, quad, "test");  // auto: trot
