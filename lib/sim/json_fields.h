@@ -1,6 +1,6 @@
 #pragma once
 // Internal to dgmm_sim: strict reading of one JSON object's fields (nlohmann), shared by the
-// config blocks (robot_description.cc, terrain.cc). Errors are InputError
+// config's top level and its blocks (sim_config.cc, robot_description.cc, terrain.cc). Errors are InputError
 // "<source>: <path>.<key>: <problem>"; keys never asked for are reported by Done().
 #include <Eigen/Core>
 #include <cmath>
@@ -17,19 +17,45 @@ namespace dgmm::sim {
 // Reads one JSON object's fields; keys never asked for are reported as unknown.
 class JsonFields {
  public:
+  // path: the object's place in the file ("" for the file's top level).
   JsonFields(const nlohmann::json& object, std::string path, const std::string& source)
       : object_(object), path_(std::move(path)), source_(source) {
-    if (!object_.is_object()) Fail(path_, "expected a JSON object");
+    if (!object_.is_object()) Fail(path_.empty() ? "(root)" : path_, "expected a JSON object");
+  }
+  // The fields of the object under `key` (an empty object when absent).
+  JsonFields Child(const char* key) {
+    static const nlohmann::json kEmpty = nlohmann::json::object();
+    const nlohmann::json* v = Find(key);
+    return JsonFields(v ? *v : kEmpty, Field(key), source_);
   }
   const nlohmann::json* Find(const char* key) {
     used_.insert(key);
     const auto it = object_.find(key);
     return it == object_.end() ? nullptr : &*it;
   }
-  void String(const char* key, std::string* out) {
+  void String(const char* key, std::string* out, bool allow_empty = false) {
     if (const nlohmann::json* v = Find(key)) {
-      if (!v->is_string() || v->get<std::string>().empty()) Fail(Field(key), "expected a non-empty string");
+      if (!v->is_string()) Fail(Field(key), allow_empty ? "expected a string" : "expected a non-empty string");
+      if (!allow_empty && v->get<std::string>().empty()) Fail(Field(key), "expected a non-empty string");
       *out = v->get<std::string>();
+    }
+  }
+  // A number whose range the caller checks.
+  void Number(const char* key, double* out) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_number()) Fail(Field(key), "expected a number");
+      *out = v->get<double>();
+    }
+  }
+  // Exactly n numbers into an indexable array.
+  template <int n, typename Array>
+  void Numbers(const char* key, Array* out) {
+    if (const nlohmann::json* v = Find(key)) {
+      if (!v->is_array() || v->size() != n) Fail(Field(key), "expected an array of " + std::to_string(n) + " numbers");
+      for (int i = 0; i < n; ++i) {
+        if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of numbers");
+        (*out)[i] = (*v)[i].template get<double>();
+      }
     }
   }
   void Number(const char* key, double* out, double lo, double hi) {
@@ -69,7 +95,7 @@ class JsonFields {
       if (!used_.count(key)) Fail(Field(key.c_str()), "unknown key");
     }
   }
-  std::string Field(const char* key) const { return path_ + "." + key; }
+  std::string Field(const char* key) const { return path_.empty() ? key : path_ + "." + key; }
   [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
     throw MakeInputError(source_, field, problem);
   }

@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "sim/json_fields.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
 
@@ -15,69 +16,6 @@ namespace dgmm::sim {
 namespace {
 
 using nlohmann::json;
-
-// Reads fields of one JSON object, remembering which keys were used so leftovers are reported.
-class ObjectReader {
- public:
-  ObjectReader(const json& object, std::string path, const std::string& source)
-      : object_(object), path_(std::move(path)), source_(source) {
-    if (!object_.is_object()) Fail(path_.empty() ? "(root)" : path_, "expected a JSON object");
-  }
-
-  void Number(const char* key, double* value) {
-    const json* v = Find(key);
-    if (!v) return;
-    if (!v->is_number()) Fail(Field(key), "expected a number");
-    *value = v->get<double>();
-  }
-  void String(const char* key, std::string* value) {
-    const json* v = Find(key);
-    if (!v) return;
-    if (!v->is_string()) Fail(Field(key), "expected a string");
-    *value = v->get<std::string>();
-  }
-  template <int n, typename Array>
-  void Numbers(const char* key, Array* values) {
-    const json* v = Find(key);
-    if (!v) return;
-    if (!v->is_array() || v->size() != n) Fail(Field(key), "expected an array of " +
-                                                               std::to_string(n) + " numbers");
-    for (int i = 0; i < n; ++i) {
-      if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of numbers");
-      (*values)[i] = (*v)[i].template get<double>();
-    }
-  }
-  // Returns the sub-object reader (absent key: an empty object).
-  ObjectReader Child(const char* key) {
-    const json* v = Find(key);
-    static const json kEmpty = json::object();
-    return ObjectReader(v ? *v : kEmpty, Field(key), source_);
-  }
-  void CheckNoUnknownKeys() const {
-    for (const auto& [key, unused] : object_.items()) {
-      if (!used_.count(key)) Fail(Field(key.c_str()), "unknown key");
-    }
-  }
-
-  // The value of `key` (marked as used), or nullptr.
-  const json* Raw(const char* key) { return Find(key); }
-
- private:
-  const json* Find(const char* key) {
-    used_.insert(key);
-    auto it = object_.find(key);
-    return it == object_.end() ? nullptr : &*it;
-  }
-  std::string Field(const char* key) const { return path_.empty() ? key : path_ + "." + key; }
-  [[noreturn]] void Fail(const std::string& field, const std::string& problem) const {
-    throw MakeInputError(source_, field, problem);
-  }
-
-  const json& object_;
-  std::string path_;
-  const std::string& source_;
-  std::set<std::string> used_;
-};
 
 bool Check(bool ok, const std::string& message, std::string* error) {
   if (!ok && error) *error = message;
@@ -163,72 +101,72 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
     throw MakeInputError(source_name, "", "not valid JSON: " + what);
   }
   SimConfig c;
-  ObjectReader r(root, "", source_name);
+  JsonFields r(root, "", source_name);
   r.Number("slope_deg", &c.slope_deg);
   {
-    ObjectReader f = r.Child("friction");
+    JsonFields f = r.Child("friction");
     f.Number("sliding", &c.friction.sliding);
     f.Number("torsional", &c.friction.torsional);
     f.Number("rolling", &c.friction.rolling);
-    f.CheckNoUnknownKeys();
+    f.Done();
   }
   {
-    ObjectReader m = r.Child("masses");
+    JsonFields m = r.Child("masses");
     m.Number("torso_kg", &c.masses.torso_kg);
     m.Number("coxa_kg", &c.masses.coxa_kg);
     m.Number("femur_kg", &c.masses.femur_kg);
     m.Number("tibia_kg", &c.masses.tibia_kg);
-    m.CheckNoUnknownKeys();
+    m.Done();
   }
   {
-    ObjectReader p = r.Child("payload");
+    JsonFields p = r.Child("payload");
     p.Number("mass_kg", &c.payload.mass_kg);
     p.Numbers<3>("position_body_m", &c.payload.position_body_m);
-    p.CheckNoUnknownKeys();
+    p.Done();
   }
   {
-    ObjectReader a = r.Child("actuators");
+    JsonFields a = r.Child("actuators");
     a.Number("kp_nm_per_rad", &c.actuators.kp_nm_per_rad);
     a.Numbers<kNumLegs>("leg_gain", &c.actuators.leg_gain);
     a.Number("joint_damping_nms_per_rad", &c.actuators.joint_damping_nms_per_rad);
     a.Number("torque_limit_nm", &c.actuators.torque_limit_nm);
     a.Number("latency_s", &c.actuators.latency_s);
     a.Number("backlash_rad", &c.actuators.backlash_rad);
-    a.CheckNoUnknownKeys();
+    a.Done();
   }
   {
-    ObjectReader g = r.Child("gait");
+    JsonFields g = r.Child("gait");
     g.Number("period_s", &c.gait.period_s);
     g.Number("stride_m", &c.gait.stride_m);
     g.Number("turn_rad", &c.gait.turn_rad);
     g.Number("step_height_m", &c.gait.step_height_m);
     g.Number("stance_height_m", &c.gait.stance_height_m);
-    g.CheckNoUnknownKeys();
+    g.Done();
   }
   {
-    ObjectReader n = r.Child("noise");
+    JsonFields n = r.Child("noise");
     n.Number("tracker_position_sd_m", &c.noise.tracker_position_sd_m);
     n.Number("tracker_yaw_sd_rad", &c.noise.tracker_yaw_sd_rad);
     n.Number("tracker_roll_sd_rad", &c.noise.tracker_roll_sd_rad);
     n.Number("tracker_pitch_sd_rad", &c.noise.tracker_pitch_sd_rad);
     n.Number("imu_pitch_sd_rad", &c.noise.imu_pitch_sd_rad);
     n.Number("imu_roll_sd_rad", &c.noise.imu_roll_sd_rad);
-    n.CheckNoUnknownKeys();
+    n.Done();
   }
   r.Number("timestep_s", &c.timestep_s);
   r.Number("command_duration_s", &c.command_duration_s);
   r.Number("settle_duration_s", &c.settle_duration_s);
-  r.String("mjcf_path", &c.mjcf_path);
+  r.String("mjcf_path", &c.mjcf_path, /*allow_empty=*/true);
   {
-    ObjectReader n = r.Child("names");
-    n.String("torso_body", &c.names.torso_body);
-    n.String("floor_geom", &c.names.floor_geom);
-    n.String("actuator_prefix", &c.names.actuator_prefix);
-    n.CheckNoUnknownKeys();
+    JsonFields n = r.Child("names");
+    n.String("torso_body", &c.names.torso_body, /*allow_empty=*/true);
+    n.String("floor_geom", &c.names.floor_geom, /*allow_empty=*/true);
+    n.String("actuator_prefix", &c.names.actuator_prefix, /*allow_empty=*/true);
+    n.Done();
   }
-  if (const json* robot = r.Raw("robot")) c.robot = RobotDescriptionFromJson(robot->dump(), source_name);
-  if (const json* terrain = r.Raw("terrain")) c.terrain = TerrainFromJson(terrain->dump(), source_name);
-  r.CheckNoUnknownKeys();
+  if (const json* robot = r.Find("robot")) c.robot = RobotDescriptionFromJson(robot->dump(), source_name);
+  if (const json* terrain = r.Find("terrain")) c.terrain = TerrainFromJson(terrain->dump(), source_name);
+  r.Done();
   std::string error;
   if (!c.IsValid(&error)) throw MakeInputError(source_name, "", error);
   return c;
