@@ -7,7 +7,7 @@ Markdown table; a ratio is measured / commanded (1 = as commanded), cross-talk i
 off-axis travel relative to the commanded travel.
 
 Usage: scripts/walk_table.py [--build build] [--config datasets/robots/hexapod.json]
-                             [--patterns tripod,tetrapod,wave] [--slopes 0,10] [--seed 1]
+                             [--patterns tripod,tetrapod,wave] [--slopes 0,10] [--seed 1] [--mirrored]
 """
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -20,9 +20,18 @@ def record(dgmm, config, out, seed):
                     "-o", out], check=True, stdout=subprocess.DEVNULL)
 
 
-def rows_of(path, stride, turn, cycles):
+def load(path):
     f = h5py.File(path, "r")
-    values, command, x = f["commands/values"][:], f["command"][:], f["x"][:]
+    return f["commands/values"][:], f["command"][:], f["x"][:]
+
+
+def pooled(a, b):
+    """The samples of two recordings with the same command table."""
+    return a[0], np.concatenate([a[1], b[1]]), np.concatenate([a[2], b[2]])
+
+
+def rows_of(data, stride, turn, cycles):
+    values, command, x = data
     out = {}
     for c, v in enumerate(values):
         m = command == c
@@ -49,6 +58,9 @@ def main():
     ap.add_argument("--patterns", default="tripod,tetrapod,wave")
     ap.add_argument("--slopes", default="0,10")
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--mirrored", action="store_true",
+                    help="on a slope, pool the recordings at +slope and -slope: the paper protocol faces "
+                         "across the slope one way only, so without this a slide downhill shows as cross-talk")
     a = ap.parse_args()
     dgmm = os.path.join(a.build, "app", "dgmm")
     base = json.load(open(a.config))
@@ -68,20 +80,27 @@ def main():
             json.dump(cfg, open(path, "w"))
             out = os.path.join(tmp, f"{pattern}_{slope:g}.h5")
             record(dgmm, path, out, a.seed)
+            data = load(out)
+            if a.mirrored and slope != 0:  # the same placements with the plane tilted the other way
+                cfg["slope_deg"] = -slope
+                json.dump(cfg, open(path, "w"))
+                record(dgmm, path, out, a.seed)
+                data = pooled(data, load(out))
             # The leg reach the simulator derived from the model (set metadata).
             reach_attr = h5py.File(out, "r")["metadata"].attrs["robot_leg_reach_m"]
             reach = float(reach_attr.decode() if isinstance(reach_attr, bytes) else reach_attr)
             g = cfg["robot"]["gait"]
             stride = g.get("stride_m") or g["stride_reach"] * reach
             cycles = cfg["command_duration_s"] / g["period_s"]
-            rows = rows_of(out, stride, g["turn_rad"], cycles)
+            rows = rows_of(data, stride, g["turn_rad"], cycles)
             if header is None:
                 header = sorted(rows)
                 print("| slope | gait | " + " | ".join(header) + " | worst cross-talk |")
                 print("|---|---|" + "---|" * (len(header) + 1))
             # A command with no kept execution (every placement fell) shows as "fell".
             cells = " | ".join(f"{rows[k][0]:.2f}" if k in rows else "fell" for k in header)
-            print(f"| {slope:g} deg | {pattern} | {cells} | {max(r[1] for r in rows.values()):.2f} |")
+            where = f"+-{slope:g}" if a.mirrored and slope != 0 else f"{slope:g}"
+            print(f"| {where} deg | {pattern} | {cells} | {max(r[1] for r in rows.values()):.2f} |")
     return 0
 
 
