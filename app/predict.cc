@@ -1,6 +1,5 @@
 // `dgmm predict`: where a sequence of commands takes the robot, with how sure the model is: the
 // pose distribution after each command (lib/predict/predict.h), as JSON and a table.
-#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fmt/format.h>
@@ -120,13 +119,16 @@ std::vector<Eigen::VectorXd> ParseTerrain(const MotionModel& model, const std::s
   return z;
 }
 
-// The names --command-values gives (they are not read off the ground).
-std::vector<std::string> CommandValueNames(const std::string& command_values) {
+// The conditioning dimensions some step gives a value for (continuous command values with
+// --ground): they are not read off the ground.
+std::vector<std::string> GivenNames(const MotionModel& model, const std::vector<Eigen::VectorXd>& z) {
   std::vector<std::string> names;
-  for (const std::string& step : SplitOn(command_values, ';')) {
-    for (const std::string& item : SplitOn(step, ',')) {
-      const std::string name = item.substr(0, item.find('='));
-      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+  for (int d = 0; d < model.terrain_dim; ++d) {
+    for (const Eigen::VectorXd& step : z) {
+      if (step.size() > 0 && std::isfinite(step[d])) {
+        names.push_back(model.terrain_names[d]);
+        break;
+      }
     }
   }
   return names;
@@ -245,7 +247,7 @@ void Run(const PredictArgs& args) {
     if (!args.terrain.empty()) throw MakeInputError("--ground", "", "give either --terrain or --ground, not both");
     ground = sim::LoadSimConfig(args.ground);
     surface = GroundSurfaceOf(*ground);
-    options.ground = predict::GroundTerrain(model, surface, CommandValueNames(args.command_values));
+    options.ground = predict::GroundTerrain(model, surface, GivenNames(model, z));
   }
   const auto p = predict::Predict(model, Eigen::Vector3d(args.start[0], args.start[1], args.start[2]), steps, options);
   if (ground && ground->terrain) WarnOffTheField(p, *ground->terrain, args.ground);

@@ -262,6 +262,15 @@ MotionModel LearnMotionModel(const SampleSet& set, const MotionModelOptions& opt
   return learner.Finish();
 }
 
+int ModelCommandId(const MotionModel& model, const SampleSet& set, int index, const std::string& source) {
+  if (set.command_labels.empty() || model.command_labels.empty()) return index;
+  const std::string& label = set.command_labels[index];
+  for (const auto& [id, l] : model.command_labels) {
+    if (l == label) return id;
+  }
+  throw MakeInputError(source, "command", "unknown command '" + label + "' (model has: " + ListCommands(model) + ")");
+}
+
 Eigen::VectorXd ScoreSamples(const MotionModel& model, const SampleSet& set) {
   if (std::string e = set.Validate(); !e.empty()) throw MakeInputError("", "sample set", e);
   CheckSize("x", set.pose_dim(), model.pose_dim);
@@ -292,16 +301,6 @@ Eigen::VectorXd ScoreSamples(const MotionModel& model, const SampleSet& set) {
     }
     log_jacobian = model.transform.scale.head(model.pose_dim).array().log().sum();
   }
-  // Command index in the set -> command id in the model: by label when both have labels.
-  auto resolve = [&](int index) {
-    if (set.command_labels.empty() || model.command_labels.empty()) return index;
-    const std::string& label = set.command_labels[index];
-    for (const auto& [id, l] : model.command_labels) {
-      if (l == label) return id;
-    }
-    throw MakeInputError(
-        "", "command", "unknown command '" + label + "' (model has: " + ListCommands(model) + ")");
-  };
   // Per command: the mixture over y (or x) and, with terrain, its marginal over z, so that
   // log p(x | z) = log p(x || z) - log p(z) (eq. 15 without forming the conditional).
   struct Prepared {
@@ -312,7 +311,7 @@ Eigen::VectorXd ScoreSamples(const MotionModel& model, const SampleSet& set) {
   Eigen::VectorXd scores(set.size());
   Eigen::VectorXd y(dy);
   for (int i = 0; i < set.size(); ++i) {
-    const int id = resolve(set.command[i]);
+    const int id = ModelCommandId(model, set, set.command[i]);
     auto it = prepared.find(id);
     if (it == prepared.end()) {
       Prepared p;

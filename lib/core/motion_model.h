@@ -112,4 +112,9 @@ ScoreSummary ScoreSampleSet(const MotionModel& model, const SampleSet& set);
 // log p(x_i | c_i [, z_i]) of every sample, in the raw units of x, with the checks above.
 Eigen::VectorXd ScoreSamples(const MotionModel& model, const SampleSet& set);
 
+// The model's command id for command index `index` of `set`: by label when both have labels (an
+// unknown label is an InputError "<source>: command: unknown command ..." listing the model's),
+// else the index itself.
+int ModelCommandId(const MotionModel& model, const SampleSet& set, int index, const std::string& source = "");
+
 }  // namespace dgmm

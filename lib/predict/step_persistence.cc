@@ -24,34 +24,12 @@ bool StepPersistence::IsValid(std::string* error) const {
 
 namespace {
 
-// The model's command id of each of the set's command indices: by label when both have labels.
-std::vector<int> CommandIds(const MotionModel& model, const SampleSet& set) {
-  std::vector<int> ids;
-  const int n = set.command.size() > 0 ? set.command.maxCoeff() + 1 : 0;
-  for (int c = 0; c < n; ++c) {
-    int id = c;
-    if (!set.command_labels.empty() && !model.command_labels.empty()) {
-      id = -1;
-      for (const auto& [i, l] : model.command_labels) {
-        if (c < static_cast<int>(set.command_labels.size()) && l == set.command_labels[c]) id = i;
-      }
-    }
-    ids.push_back(id);
-  }
-  return ids;
-}
-
 // eps_i = L_k^-1 (x_i - mu_k) under the most responsible component k of p(x | c_i, z_i): pose_dim x n.
 Eigen::MatrixXd StandardisedResiduals(const MotionModel& model, const SampleSet& set, const std::string& source) {
-  const std::vector<int> ids = CommandIds(model, set);
   Eigen::MatrixXd eps(model.pose_dim, set.size());
   for (int i = 0; i < set.size(); ++i) {
-    const int id = ids[set.command[i]];
-    if (id < 0 || !model.HasCommand(id)) {
-      const int c = set.command[i];
-      const std::string name = c < static_cast<int>(set.command_labels.size()) ? set.command_labels[c] : std::to_string(c);
-      throw MakeInputError(source, "command", "'" + name + "' is not in the model");
-    }
+    const int id = ModelCommandId(model, set, set.command[i], source);
+    if (!model.HasCommand(id)) throw MakeInputError(source, "command", "command " + std::to_string(id) + " is not in the model");
     const Eigen::VectorXd z = model.terrain_dim > 0 ? Eigen::VectorXd(set.z.row(i).transpose()) : Eigen::VectorXd();
     const Mixture p = model.RawPoseDistribution(id, z);
     const Eigen::VectorXd x = set.x.row(i).transpose();
