@@ -31,6 +31,7 @@ namespace {
 struct Sim2RealArgs {
   std::string sim, real, out, sim_config, cache;
   int signature_placements = 78;
+  int signature_executions = 2;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
@@ -127,6 +128,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args) {
   o.locate.seed = args.seed;
   o.locate.locate.mmd.permutations = args.permutations;
   o.candidates.placements = args.signature_placements;
+  o.candidates.executions_per_placement = args.signature_executions;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -254,6 +256,10 @@ void Setup(CLI::App& root) {
   cmd->add_option("--signature-placements", args->signature_placements,
                   "placements per recording (paper protocol: >= 78 covers every command 3 times)")
       ->capture_default_str()->check(CLI::Range(3, 10000));
+  cmd->add_option("--signature-executions", args->signature_executions,
+                  "executions per placement of a signature recording (the paired shift has a first-execution "
+                  "term, so 2 identify it; 5 is the paper protocol's)")
+      ->capture_default_str()->check(CLI::Range(2, 100));
   cmd->add_option("--bootstrap", args->bootstrap, "bootstrap resamples of the selection (inclusion; 0: not computed)")
       ->capture_default_str()->check(CLI::Range(0, 1000));
   cmd->add_option("--permutations", args->permutations, "permutations per two-sample test")

@@ -24,12 +24,14 @@ family and plants tracker noise through the config; --draw-version 1 redraws the
 10000-10039 exactly as they were.
 
 Usage: scripts/sim2real_battery.py --seeds 1000-1009 [--jobs 2] [--build build] [--out DIR]
-       [--keep] [--smoke] [--generate-only] [--write-doc] [--draw-version {1,2}]
+       [--keep] [--smoke] [--generate-only] [--write-doc] [--draw-version {1,2,3}]
+       [--rerun] [--sim2real-args 'ARGS']
 """
 import argparse
 import concurrent.futures as cf
 import json
 import os
+import shlex
 import shutil
 import subprocess
 import sys
@@ -234,7 +236,7 @@ def analyse(args, pair):
     shutil.rmtree(out, ignore_errors=True)
     cmd = [args.dgmm, "sim2real", "--sim", sim_set(args, robot), "--real",
            os.path.join(pdir, "real.h5"), "--sim-config", config_path(robot), "-o", out,
-           "--no-figures"]
+           "--no-figures"] + shlex.split(args.sim2real_args)
     # The analysis's signature cache lives in OUT (a fresh OUT starts uncached).
     env = dict(os.environ, XDG_CACHE_HOME=os.path.join(args.out, "xdg-cache"))
     if args.stop_at and time.time() >= args.stop_at:
@@ -424,6 +426,8 @@ def main():
                     help="UTC time after which no analysis starts and running ones are stopped "
                          "(their pairs are listed as not analysed)")
     ap.add_argument("--rerun", action="store_true", help="rerun analyses already in OUT")
+    ap.add_argument("--sim2real-args", default="", metavar="'ARGS'",
+                    help="more options of every dgmm sim2real call, e.g. '--signature-executions 5'")
     ap.add_argument("--kinds", default=None, metavar="K[,K]",
                     help="keep only pairs of these kinds (null, single, two, out_of_library): "
                          "for development on one kind; a report runs every pair of its range")

@@ -1,5 +1,6 @@
 #include "app/wiring/mujoco_knob_simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -16,7 +17,10 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v5";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v6";
+// v6: a recording runs in chunks of this many placements, each with its own random stream, so
+// one recording can use several threads (sim::ProtocolOptions::chunk_placements).
+constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {
   switch (kind) {
@@ -42,7 +46,10 @@ sim2real::Knob FromSim(const sim::Knob& k) {
   const bool offset = k.kind == sim::KnobKind::kPayloadX || k.kind == sim::KnobKind::kPayloadY;
   if (!offset) out.physical_min = 0;
   if (k.kind == sim::KnobKind::kLegGain) out.leg = k.leg;
-  if (k.kind == sim::KnobKind::kSideGain) out.side = k.index == 0 ? "left" : "right";
+  if (k.kind == sim::KnobKind::kSideGain) {
+    out.side = k.index == 0 ? "left" : "right";
+    out.members = k.members;
+  }
   return out;
 }
 
@@ -78,11 +85,14 @@ std::vector<sim::KnobValue> MujocoKnobSimulator::ToSim(const std::vector<sim2rea
 }
 
 SampleSet MujocoKnobSimulator::Record(const sim2real::Recording& recording,
-                                      const std::vector<sim2real::KnobValue>& values, int /*threads*/) const {
+                                      const std::vector<sim2real::KnobValue>& values, int threads) const {
   sim::ProtocolOptions options;
+  options.chunk_placements = kChunkPlacements;
+  options.threads = std::max(1, threads);
   options.protocol = sim::ParseProtocol(recording.protocol);
   options.seed = recording.seed;
   options.placements = recording.placements;
+  if (recording.executions_per_placement > 0) options.executions_per_placement = recording.executions_per_placement;
   return sim::SimulateWithKnobs(config_, options, sim_knobs_, ToSim(values));
 }
 

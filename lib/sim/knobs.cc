@@ -116,9 +116,15 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
   const double mu = config.friction.sliding;
   knobs.push_back(MakeKnob(KnobKind::kFrictionSliding, -1, "floor.friction.sliding", "friction", "",
                            mu, 0.2 * mu, 2.0 * mu, {0.6 * mu, 1.5 * mu}));
-  const double tor = config.friction.torsional;
-  knobs.push_back(MakeKnob(KnobKind::kFrictionTorsional, -1, "floor.friction.torsional", "friction",
-                           "m", tor, 0.0, 20 * tor, {5 * tor}));
+  // Torsional friction acts only in contacts of condim >= 4 (a contact takes the larger of its
+  // geoms' condim): with every geom at 3 or less no contact uses it, and its probe would be inert.
+  int max_condim = 0;
+  for (int g = 0; g < m->ngeom; ++g) max_condim = std::max(max_condim, m->geom_condim[g]);
+  if (max_condim >= 4) {
+    const double tor = config.friction.torsional;
+    knobs.push_back(MakeKnob(KnobKind::kFrictionTorsional, -1, "floor.friction.torsional", "friction", "m", tor,
+                             0.0, 20 * tor, {5 * tor}));
+  }
   if (parts.floor_geom >= 0) {
     const double tc = m->geom_solref[mjNREF * parts.floor_geom + 0];
     const double dr = m->geom_solref[mjNREF * parts.floor_geom + 1];
@@ -154,7 +160,7 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
                              config.payload.position_body_m.y(), -2 * span.y(), 2 * span.y(), {2.0 / 3 * span.y()}));
   }
   // Legs: the torso's child subtrees that carry the leg actuators; the side from the root's y.
-  bool side_has[2] = {false, false};
+  std::vector<std::string> side_members[2];
   for (int leg = 0; leg < kNumLegs; ++leg) {
     const int act = parts.actuator[leg][0];
     const int joint = m->actuator_trnid[2 * act];
@@ -164,13 +170,14 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
     knobs.push_back(MakeKnob(KnobKind::kLegGain, leg, "actuators.leg" + std::to_string(leg) + ".gain",
                              "actuator_gain", "", g, 0.05 * g, 1.5 * g, {0.5 * g}));
     knobs.back().leg = "leg" + std::to_string(leg);
-    side_has[m->body_pos[3 * root + 1] > 0 ? 0 : 1] = true;
+    side_members[m->body_pos[3 * root + 1] > 0 ? 0 : 1].push_back(knobs.back().leg);
   }
   const char* side_name[2] = {"left", "right"};
   for (int s = 0; s < 2; ++s) {
-    if (!side_has[s]) continue;
+    if (side_members[s].empty()) continue;
     knobs.push_back(MakeKnob(KnobKind::kSideGain, s, std::string("actuators.") + side_name[s] + "_side.gain",
                              "actuator_gain", "", 1.0, 0.05, 1.5, {0.6}));
+    knobs.back().members = side_members[s];
   }
   knobs.push_back(MakeKnob(KnobKind::kKpScale, -1, "actuators.kp_scale", "actuator_gain", "", 1.0, 0.2, 2.5,
                            {0.6, 1.5}));

@@ -55,7 +55,7 @@ struct Knob {
   double lo = 0, hi = 0;     // physical range searched
   std::vector<double> probes;  // values simulated for the signature (one signature each)
   std::string leg;             // kLegGain: the leg's name ("leg3" for the built-in robot)
-  std::vector<std::string> members;  // kSideGain of a robot block's robot: the side's leg names
+  std::vector<std::string> members;  // kSideGain: the side's leg names (the `leg` of its kLegGain knobs)
 };
 
 struct KnobValue {

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <ctime>
 #include <map>
+#include <mutex>
 #include <random>
 #include <sstream>
 
@@ -13,6 +14,7 @@
 #include "sim/replay.h"
 #include "sim/simulator.h"
 #include "util/error.h"
+#include "util/parallel_for.h"
 
 namespace dgmm::sim {
 namespace {
@@ -161,6 +163,8 @@ bool ProtocolOptions::IsValid(std::string* error) const {
   if (placements < 0 || placements > 100000) return fail("placements: expected 0..100000");
   if (max_retries_per_placement < 0 || max_retries_per_placement > 100)
     return fail("max_retries_per_placement: expected 0..100");
+  if (chunk_placements < 0) return fail("chunk_placements: expected >= 0");
+  if (threads < 1) return fail("threads: expected >= 1");
   return true;
 }
 
@@ -267,25 +271,28 @@ Eigen::VectorXd SensedTerrain(const Simulator& sim, const std::vector<std::strin
   return v;
 }
 
-// Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
-// set (command table already filled), its metadata and the summary.
-void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std::vector<Placement>& plan,
-             std::mt19937_64& rng, const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit,
-             SampleSet* out) {
-  const auto wall_start = std::chrono::steady_clock::now();
-  const std::clock_t cpu_start = std::clock();
-  Simulator sim(config, edit);
-  CheckRecordingsCover(config, CommandsPlanned(plan, out->commands));
-  SampleSet& set = *out;
-  const int reps = options.executions_per_placement;
-
+// What one simulator recorded over a run of placements.
+struct PlanRun {
   Recorded rec;
+  SimSummary sum;                                    // counts only
+  std::map<int, long long> self_contact_by_command;  // steps in contact per command
+  std::string self_contact_pair;
+  double simulated_seconds = 0;
+  std::vector<std::string> scale_warnings;  // of the robot as simulated
+  double total_mass_kg = 0, leg_reach_m = 0;
+};
+
+// Runs placements [first, last) of `plan` on `sim`, drawing retries and sensor noise from `rng`.
+void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOptions& options,
+                   const std::vector<Placement>& plan, int first, int last, const Eigen::MatrixXd& commands,
+                   std::mt19937_64& rng, const std::function<void()>& placed, PlanRun* out) {
+  const int reps = options.executions_per_placement;
   const std::vector<std::string> sensed = config.terrain ? config.terrain->sensed : std::vector<std::string>();
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::normal_distribution<double> unit(0.0, 1.0);
-  SimSummary sum;
-  std::map<int, long long> self_contact_by_command;  // steps in contact per command
-  for (int p = 0; p < static_cast<int>(plan.size()); ++p) {
+  Recorded& rec = out->rec;
+  SimSummary& sum = out->sum;
+  for (int p = first; p < last; ++p) {
     Placement where = plan[p];
     bool kept = false;
     for (int attempt = 0; attempt <= options.max_retries_per_placement && !kept; ++attempt) {
@@ -299,7 +306,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       for (int r = 0; r < reps && !fell; ++r) {
         const int id = where.sequence.empty() ? where.command : where.sequence[r];
         const Eigen::Vector3d c =
-            where.values.empty() ? Eigen::Vector3d(set.commands.row(id).transpose()) : where.values[r];
+            where.values.empty() ? Eigen::Vector3d(commands.row(id).transpose()) : where.values[r];
         const Eigen::Vector2d z_true = sim.TruePitchRoll();
         const Eigen::VectorXd terrain = SensedTerrain(sim, sensed);
         Eigen::VectorXd z(2 + terrain.size());
@@ -312,7 +319,7 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
         fell = sim.RunCommand(c) != RunOutcome::kCompleted;
         ++sum.executions;
         if (sim.SelfContactSteps() > touched) ++sum.self_contact_executions;
-        self_contact_by_command[id] += sim.SelfContactSteps() - touched;
+        out->self_contact_by_command[id] += sim.SelfContactSteps() - touched;
         const Pose end = TrackerReading(sim.TorsoPose(), config.noise, rng);
         px.push_back(DeltaPoseBody(start, end));
       }
@@ -331,34 +338,110 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
       }
     }
     if (!kept) ++sum.abandoned_placements;
-    if (progress) progress(p + 1, static_cast<long long>(plan.size()));
+    if (placed) placed();
   }
-  FillSamples(rec, sensed, &set);
-  const int n = set.size();
+  out->simulated_seconds = sim.time_s();
+  out->self_contact_pair = sim.SelfContactPair();
+  out->scale_warnings = sim.ScaleWarnings();
+  out->total_mass_kg = sim.total_mass_kg();
+  out->leg_reach_m = sim.leg_reach_m();
+}
 
-  sum.samples = n;
-  sum.warnings = sim.ScaleWarnings();
-  if (sum.self_contact_executions > 0) {
-    const auto worst = std::max_element(self_contact_by_command.begin(), self_contact_by_command.end(),
-                                        [](const auto& a, const auto& b) { return a.second < b.second; });
-    sum.warnings.push_back(SelfContactWarning(sum, sim.SelfContactPair(), set.command_labels.at(worst->first)));
+// Appends `part` (a later run of placements) to `all`.
+void Append(PlanRun&& part, PlanRun* all) {
+  Recorded& r = all->rec;
+  Recorded& q = part.rec;
+  r.command.insert(r.command.end(), q.command.begin(), q.command.end());
+  r.episode.insert(r.episode.end(), q.episode.begin(), q.episode.end());
+  r.step.insert(r.step.end(), q.step.begin(), q.step.end());
+  r.xs.insert(r.xs.end(), q.xs.begin(), q.xs.end());
+  r.zs.insert(r.zs.end(), q.zs.begin(), q.zs.end());
+  r.values.insert(r.values.end(), q.values.begin(), q.values.end());
+  all->sum.executions += part.sum.executions;
+  all->sum.self_contact_executions += part.sum.self_contact_executions;
+  all->sum.falls += part.sum.falls;
+  all->sum.abandoned_placements += part.sum.abandoned_placements;
+  for (const auto& [command, steps] : part.self_contact_by_command) all->self_contact_by_command[command] += steps;
+  if (all->self_contact_pair.empty() && part.sum.self_contact_executions > 0) {
+    all->self_contact_pair = part.self_contact_pair;  // the first run with contacts names the pair
   }
-  sum.placements = static_cast<int>(plan.size());
-  sum.simulated_seconds = sim.time_s();
-  sum.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
-  sum.wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  auto& meta = set.metadata;
+  all->simulated_seconds += part.simulated_seconds;
+  all->scale_warnings = part.scale_warnings;
+  all->total_mass_kg = part.total_mass_kg;
+  all->leg_reach_m = part.leg_reach_m;
+}
+
+// The generator of chunk `chunk` of a chunked recording: its own stream, from the seed and the
+// chunk's index alone.
+std::mt19937_64 ChunkStream(std::uint64_t seed, int chunk) {
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    static_cast<std::uint32_t>(chunk), 0x63686b75u};
+  return std::mt19937_64(seq);
+}
+
+// Runs the whole plan: on one simulator with the plan's generator, or (chunk_placements > 0) in
+// fixed chunks, each on its own simulator and stream, on up to options.threads threads.
+PlanRun RunAll(const SimConfig& config, const ProtocolOptions& options, const std::vector<Placement>& plan,
+               const Eigen::MatrixXd& commands, std::mt19937_64& rng, const ProgressFn& progress,
+               const ModelEdit& edit) {
+  const int n = static_cast<int>(plan.size());
+  std::mutex mu;
+  long long done = 0;
+  const std::function<void()> placed = [&] {
+    if (!progress) return;
+    std::lock_guard<std::mutex> lock(mu);
+    progress(++done, n);
+  };
+  if (options.chunk_placements == 0) {
+    Simulator sim(config, edit);
+    PlanRun run;
+    RunPlacements(sim, config, options, plan, 0, n, commands, rng, placed, &run);
+    return run;
+  }
+  const int chunks = (n + options.chunk_placements - 1) / options.chunk_placements;
+  std::vector<PlanRun> parts(chunks);
+  ParallelFor(chunks, options.threads, [&](int c) {
+    Simulator sim(config, edit);
+    std::mt19937_64 stream = ChunkStream(options.seed, c);
+    const int first = c * options.chunk_placements;
+    RunPlacements(sim, config, options, plan, first, std::min(n, first + options.chunk_placements), commands,
+                  stream, placed, &parts[c]);
+  });
+  PlanRun all;
+  for (PlanRun& part : parts) Append(std::move(part), &all);
+  return all;
+}
+
+// The set's samples, summary and metadata from the run.
+void FinishRecording(const SimConfig& config, const ProtocolOptions& options, int placements, PlanRun&& run,
+                     SimSummary* sum, SampleSet* set) {
+  const std::vector<std::string> sensed = config.terrain ? config.terrain->sensed : std::vector<std::string>();
+  FillSamples(run.rec, sensed, set);
+  *sum = run.sum;
+  sum->samples = set->size();
+  sum->warnings = run.scale_warnings;
+  if (sum->self_contact_executions > 0) {
+    const auto worst =
+        std::max_element(run.self_contact_by_command.begin(), run.self_contact_by_command.end(),
+                         [](const auto& a, const auto& b) { return a.second < b.second; });
+    sum->warnings.push_back(SelfContactWarning(*sum, run.self_contact_pair, set->command_labels.at(worst->first)));
+  }
+  sum->placements = placements;
+  sum->simulated_seconds = run.simulated_seconds;
+  auto& meta = set->metadata;
   meta["generator"] = "dgmm simulate";
   meta["protocol"] = ProtocolName(options.protocol);
   meta["seed"] = std::to_string(options.seed);
-  meta["executions_per_placement"] = std::to_string(reps);
-  meta["placements"] = std::to_string(sum.placements);
-  meta["falls"] = std::to_string(sum.falls);
-  meta["abandoned_placements"] = std::to_string(sum.abandoned_placements);
-  meta["simulated_seconds"] = std::to_string(sum.simulated_seconds);
-  meta["robot_mass_kg"] = std::to_string(sim.total_mass_kg());
-  if (config.robot) meta["robot_leg_reach_m"] = std::to_string(sim.leg_reach_m());
+  meta["executions_per_placement"] = std::to_string(options.executions_per_placement);
+  if (options.chunk_placements > 0) {
+    meta["random_streams"] = "one per chunk of " + std::to_string(options.chunk_placements) + " placements";
+  }
+  meta["placements"] = std::to_string(sum->placements);
+  meta["falls"] = std::to_string(sum->falls);
+  meta["abandoned_placements"] = std::to_string(sum->abandoned_placements);
+  meta["simulated_seconds"] = std::to_string(sum->simulated_seconds);
+  meta["robot_mass_kg"] = std::to_string(run.total_mass_kg);
+  if (config.robot) meta["robot_leg_reach_m"] = std::to_string(run.leg_reach_m);
   meta["sim_config"] = SimConfigToJson(config);
   meta["x_frame"] = "torso body frame at the start of each execution (x forward, y left, z up); "
                     "angles ZYX Euler of the relative rotation";
@@ -368,11 +451,25 @@ void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std:
     meta["z_frame"] += "; foot_relief: sd of the feet's heights about their least-squares plane (m); "
                        "height_ahead: ground one leg reach ahead minus under the torso (m)";
   }
+}
+
+// Runs `plan` (placements of `options.executions_per_placement` executions each) and writes the
+// set (command table already filled), its metadata and the summary.
+void RunPlan(const SimConfig& config, const ProtocolOptions& options, const std::vector<Placement>& plan,
+             std::mt19937_64& rng, const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit,
+             SampleSet* out) {
+  const auto wall_start = std::chrono::steady_clock::now();
+  const std::clock_t cpu_start = std::clock();
+  CheckRecordingsCover(config, CommandsPlanned(plan, out->commands));
+  PlanRun run = RunAll(config, options, plan, out->commands, rng, progress, edit);
+  SimSummary sum;
+  FinishRecording(config, options, static_cast<int>(plan.size()), std::move(run), &sum, out);
+  sum.cpu_seconds = static_cast<double>(std::clock() - cpu_start) / CLOCKS_PER_SEC;
+  sum.wall_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   if (summary) *summary = sum;
 }
 
 }  // namespace
-
 
 SampleSet SimulateProtocol(const SimConfig& config, const ProtocolOptions& options,
                            const ProgressFn& progress, SimSummary* summary, const ModelEdit& edit) {

@@ -45,6 +45,12 @@ struct ProtocolOptions {
   int placements = 0;
   // A placement whose robot falls or flips is discarded and re-placed up to this many times.
   int max_retries_per_placement = 3;
+  // 0: every placement on one simulator, retries and sensor noise from the seed's one stream (how
+  // the shipped sets were made). > 0: the placements in fixed chunks of this many, each on its own
+  // simulator with its own stream (from the seed and the chunk's index), run on up to `threads`
+  // threads: the set depends on the chunk size, not on the thread count.
+  int chunk_placements = 0;
+  int threads = 1;
 
   bool IsValid(std::string* error) const;
 };

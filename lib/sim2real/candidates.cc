@@ -22,6 +22,7 @@ bool SameRecording(const SampleSet& a, const SampleSet& b) {
 Recording OwnRecording(const AnalysisInputs& in, const CandidateOptions& options) {
   Recording r = in.recording;
   r.placements = options.placements;
+  r.executions_per_placement = options.executions_per_placement;
   return r;
 }
 
@@ -151,34 +152,51 @@ void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vecto
   AddImuAndHeading(in, set);
 }
 
-// Is a side implicated: a side knob's candidate selected, or among the `side_top` best candidates
-// of a forward step with a positive held-out gain at z >= side_min_z (a weak leg shows first as
-// its side, often below the step's Bonferroni threshold while other effects stand in for it).
-bool SideImplicated(const CandidateSet& set, const FitProblem& fp, const Baseline& base,
-                    const CandidateOptions& options, std::string* why) {
+// The side knobs a first pass implicates: a side knob's candidate selected, or among the
+// `side_top` best candidates of a forward step with a positive held-out gain at z >= side_min_z (a
+// weak leg shows first as its side, often below the step's Bonferroni threshold while other
+// effects stand in for it). `why` says what implicated the first of them.
+std::vector<int> ImplicatedSides(const CandidateSet& set, const FitProblem& fp, const Baseline& base,
+                                 const CandidateOptions& options, std::string* why) {
   std::vector<int> rows(fp.n);
   for (int i = 0; i < fp.n; ++i) rows[i] = i;
   SelectionOptions quick = options.first_pass;
   quick.bootstrap_selection = 0;
   quick.backward = true;
   const SelectionResult sel = ForwardSelect(fp, rows, base.fold, quick);
-  for (int e : sel.selected) {
-    if (!set.candidates[e].side.empty()) {
-      *why = set.candidates[e].knob + " was selected in the first pass";
-      return true;
-    }
-  }
+  std::vector<int> sides;
+  auto implicate = [&](int e, const std::string& because) {
+    const KnobCandidate& c = set.candidates[e];
+    if (c.side.empty() || std::find(sides.begin(), sides.end(), c.knob_index) != sides.end()) return;
+    if (sides.empty()) *why = c.knob + because;
+    sides.push_back(c.knob_index);
+  };
+  for (int e : sel.selected) implicate(e, " was selected in the first pass");
   for (size_t s = 0; s < sel.steps.size(); ++s) {
     const auto& cands = sel.steps[s].candidates;
     for (size_t r = 0; r < cands.size() && static_cast<int>(r) < options.side_top; ++r) {
-      if (!set.candidates[cands[r].effect].side.empty() && cands[r].gain > 0 && cands[r].z >= options.side_min_z) {
-        *why = set.candidates[cands[r].effect].knob + Fmt(" ranked %.0f of the first pass's step %.0f", r + 1.0, s + 1.0) +
-               Fmt(" (held-out z %.1f)", cands[r].z);
-        return true;
+      if (cands[r].gain > 0 && cands[r].z >= options.side_min_z) {
+        implicate(cands[r].effect, Fmt(" ranked %.0f of the first pass's step %.0f", r + 1.0, s + 1.0) +
+                                       Fmt(" (held-out z %.1f)", cands[r].z));
       }
     }
   }
-  return false;
+  return sides;
+}
+
+// The per-leg knobs of the implicated sides (every leg when a side does not list its legs).
+std::vector<int> LegsOf(const std::vector<Knob>& knobs, const std::vector<int>& sides, const std::vector<int>& legs) {
+  std::vector<int> out;
+  for (int l : legs) {
+    for (int s : sides) {
+      const auto& members = knobs[s].members;
+      if (members.empty() || std::find(members.begin(), members.end(), knobs[l].leg) != members.end()) {
+        out.push_back(l);
+        break;
+      }
+    }
+  }
+  return out;
 }
 
 // Why the sides cannot gate the per-leg probes: a side probe toppled the robot (empty if none did).
@@ -196,8 +214,8 @@ std::string SideProbeToppled(const CandidateSet& set, const std::vector<Knob>& k
 }  // namespace
 
 bool CandidateOptions::IsValid(std::string* error) const {
-  if (placements < 0 || !(slope_ridge >= 0) || side_top < 1) {
-    if (error) *error = "placements >= 0, slope_ridge >= 0 and side_top >= 1";
+  if (placements < 0 || executions_per_placement < 0 || !(slope_ridge >= 0) || side_top < 1) {
+    if (error) *error = "placements >= 0, executions_per_placement >= 0, slope_ridge >= 0 and side_top >= 1";
     return false;
   }
   return recording.IsValid(error) && first_pass.IsValid(error);
@@ -245,6 +263,7 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
   }
   const bool gate = options.legs_only_when_implicated && any_side && !legs.empty();
   CandidateSet set;
+  set.recording = OwnRecording(in, options);
   std::vector<Probe> probes = RecordProbes(simulator, in, gate ? first : [&] {
     std::vector<int> all = first;
     all.insert(all.end(), legs.begin(), legs.end());
@@ -258,9 +277,15 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
     return set;
   }
   std::string why = SideProbeToppled(set, knobs);
-  if (why.empty() && !SideImplicated(set, MakeCandidateProblem(in, base, set), base, options, &why)) {
-    set.legs_note = "per-leg probes not recorded: no side knob is implicated by the first pass";
-    return set;
+  if (why.empty()) {
+    const std::vector<int> sides = ImplicatedSides(set, MakeCandidateProblem(in, base, set), base, options, &why);
+    if (sides.empty()) {
+      set.legs_note = "per-leg probes not recorded: no side knob is implicated by the first pass";
+      return set;
+    }
+    legs = LegsOf(knobs, sides, legs);
+    if (sides.size() > 1) why += "; and " + knobs[sides[1]].name;
+    if (sides.size() == 1 && !knobs[sides[0]].members.empty()) why += "; the legs of that side only";
   }
   std::vector<Probe> leg_probes = RecordProbes(simulator, in, legs, options, &set);
   probes.insert(probes.end(), std::make_move_iterator(leg_probes.begin()), std::make_move_iterator(leg_probes.end()));

@@ -5,10 +5,11 @@
 // candidate; plus the measurement effects no simulator models (tracker bias, tracker noise, IMU
 // pitch/roll bias, heading drift). A probe that changes nothing is inert, not a candidate.
 //
-// Per-leg probes cost one recording per leg and value: they are recorded only when a cheaper
-// first pass (every other knob) implicates a side, i.e. a side knob is selected or ranks among the
-// best `side_top` candidates of a forward step with held-out z >= side_min_z, or when the robot
-// has no side knobs at all.
+// Per-leg probes cost one recording per leg and value: they are recorded only for the legs of a
+// side a cheaper first pass (every other knob) implicates, i.e. whose side knob is selected or
+// ranks among the best `side_top` candidates of a forward step with held-out z >= side_min_z (both
+// sides' legs when both are), or for every leg when the robot has no side knobs at all or a side
+// probe toppled it.
 #include <string>
 #include <vector>
 
@@ -25,6 +26,10 @@ namespace dgmm::sim2real {
 
 struct CandidateOptions {
   int placements = 78;          // per recording (0: the protocol's own)
+  // Executions per placement of a signature recording (0: the protocol's own). The paired shift
+  // is fitted per command with a first-execution term, so two executions identify it; every
+  // placement (command x heading) is kept and the stand before it is shared by fewer executions.
+  int executions_per_placement = 2;
   double slope_ridge = 5.0;     // PairedShift's pull of each command's slopes to the pooled ones
   RecordingOptions recording;   // cache and threads
   bool legs_only_when_implicated = true;
@@ -52,6 +57,7 @@ struct CandidateSet {
   std::vector<ExternalCandidate> externals;
   std::vector<PairedShift> shifts;          // the probes' paired shifts (refinement appends)
   SampleSet nominal;                        // the nominal re-recording
+  Recording recording;                      // what every signature recording repeats
   int payload_knob[3] = {-1, -1, -1};       // mass, x, y knob indices
   int payload_shift[3] = {-1, -1, -1};      // their probes' shifts
   int tracker_knob = -1, tracker_shift = -1;  // the tracker-noise knob's spread probe

@@ -8,6 +8,7 @@
 
 #include "sim2real/simulation_cache.h"
 #include "util/error.h"
+#include "util/parallel_for.h"
 
 namespace dgmm::sim2real {
 

@@ -39,6 +39,7 @@ struct Knob {
   std::vector<double> probes;   // values simulated for its signature
   std::string leg;              // the leg's name for a per-leg knob, else ""
   std::string side;             // "left" or "right" for a per-side knob, else ""
+  std::vector<std::string> members;  // a per-side knob: the `leg` of every per-leg knob it scales
 };
 
 // A knob (index into KnobSimulator::knobs()) at a value in its unit.
@@ -52,6 +53,7 @@ struct Recording {
   std::string protocol;    // e.g. "paper", "paper-830"
   std::uint64_t seed = 0;
   int placements = 0;      // 0: the protocol's own number
+  int executions_per_placement = 0;  // 0: the protocol's own number (paper: 5)
 };
 
 // One command x terrain cell of a discriminating experiment.

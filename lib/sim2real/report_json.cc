@@ -97,7 +97,8 @@ json KnobsJson(const Analysis& a) {
           {"recordings", {{"signatures", set.recorded}, {"signatures_from_cache", set.from_cache},
                           {"signature_requests", set.requests}, {"refinement", r.recorded},
                           {"refinement_from_cache", r.from_cache}}},
-          {"placements_per_recording", a.inputs.recording.placements}};
+          {"placements_per_recording", set.recording.placements},
+          {"executions_per_placement", set.recording.executions_per_placement}};
 }
 
 json DriftJson(const EffectDrift& d, const char* change, const char* flag) {

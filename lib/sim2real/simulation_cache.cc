@@ -1,23 +1,20 @@
 #include "sim2real/simulation_cache.h"
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
-#include <exception>
 #include <filesystem>
-#include <mutex>
-#include <thread>
 
 #include "io/sample_set_io.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/parallel_for.h"
 
 namespace dgmm::sim2real {
 namespace {
 
 // v2: keyed by the simulator's fingerprint through the KnobSimulator interface.
-constexpr const char* kCacheVersion = "dgmm-knob-recording-v2";
+constexpr const char* kCacheVersion = "dgmm-knob-recording-v3";
 
 std::uint64_t Fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
   for (unsigned char c : s) {
@@ -56,7 +53,8 @@ std::string DefaultCacheDir() {
 std::string RecordingKey(const KnobSimulator& simulator, const Recording& recording,
                          const std::vector<KnobValue>& values) {
   std::string text = std::string(kCacheVersion) + "\n" + simulator.Fingerprint() + "\n" + recording.protocol +
-                     "\n" + std::to_string(recording.seed) + "\n" + std::to_string(recording.placements);
+                     "\n" + std::to_string(recording.seed) + "\n" + std::to_string(recording.placements) +
+                     "\n" + std::to_string(recording.executions_per_placement);
   for (const auto& v : values) {
     char buf[64];
     std::snprintf(buf, sizeof buf, "=%.17g", v.value);
@@ -70,28 +68,6 @@ std::string HashHex(const std::string& text) {
   std::snprintf(hex, sizeof hex, "%016llx%016llx", static_cast<unsigned long long>(Fnv1a(text)),
                 static_cast<unsigned long long>(Fnv1a(text, 0x9e3779b97f4a7c15ull)));
   return hex;
-}
-
-void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
-  std::atomic<int> next{0};
-  std::mutex mu;
-  std::exception_ptr failure;
-  auto worker = [&] {
-    for (int t = next++; t < n; t = next++) {
-      try {
-        f(t);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mu);
-        if (!failure) failure = std::current_exception();
-      }
-    }
-  };
-  const int k = std::max(1, std::min(threads, n));
-  std::vector<std::thread> pool;
-  for (int t = 1; t < k; ++t) pool.emplace_back(worker);
-  worker();
-  for (auto& t : pool) t.join();
-  if (failure) std::rethrow_exception(failure);
 }
 
 RecordingBatch RecordBatch(const KnobSimulator& simulator, const Recording& recording,
@@ -126,15 +102,17 @@ RecordingBatch RecordBatch(const KnobSimulator& simulator, const Recording& reco
     }
     todo.push_back(static_cast<int>(r));
   }
-  // Parallel over recordings when there are several; one recording gets every thread.
-  const int outer = std::min<int>(options.threads, static_cast<int>(todo.size()));
-  const int inner = std::max(1, options.threads / std::max(1, outer));
+  // Whole rounds of one recording per thread, then the last few share the threads (a recording
+  // splits over threads without changing its result, knob_simulator.h).
+  const int n = static_cast<int>(todo.size()), full = n / options.threads * options.threads, rest = n - full;
+  auto record = [&](int t, int threads) {
+    const int r = todo[t];
+    batch.sets[r] = simulator.Record(recording, requests[r], threads);
+    if (use_cache) WriteCacheEntry(batch.sets[r], paths[r]);
+  };
   try {
-    ParallelFor(static_cast<int>(todo.size()), outer, [&](int t) {
-      const int r = todo[t];
-      batch.sets[r] = simulator.Record(recording, requests[r], inner);
-      if (use_cache) WriteCacheEntry(batch.sets[r], paths[r]);
-    });
+    ParallelFor(full, options.threads, [&](int t) { record(t, 1); });
+    ParallelFor(rest, rest, [&](int t) { record(full + t, options.threads / rest); });
   } catch (const std::exception& e) {
     throw MakeInputError("simulator", "", std::string("re-simulation failed: ") + e.what());
   }

@@ -40,8 +40,4 @@ struct RecordingBatch {
 RecordingBatch RecordBatch(const KnobSimulator& simulator, const Recording& recording,
                            const std::vector<std::vector<KnobValue>>& requests, const RecordingOptions& options);
 
-// Runs f(0) .. f(n - 1) on up to `threads` threads; the first exception is rethrown after all
-// have finished.
-void ParallelFor(int n, int threads, const std::function<void(int)>& f);
-
 }  // namespace dgmm::sim2real

@@ -2,11 +2,9 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cassert>
 #include <chrono>
 #include <cmath>
-#include <exception>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -16,6 +14,7 @@
 #include <thread>
 
 #include "tune/fold_plan.h"
+#include "util/parallel_for.h"
 #include "util/error.h"
 
 namespace dgmm {
@@ -305,30 +304,15 @@ std::vector<FoldResult> RunFolds(const SampleSet& set, const std::vector<std::ve
                                  const CvOptions& options, bool has_terrain, const std::array<bool, 2>& em_for) {
   const int tasks = options.repeats * folds;
   std::vector<FoldResult> results(tasks);
-  std::atomic<int> next{0}, done{0};
   std::mutex mutex;
-  std::exception_ptr failure;
-  auto worker = [&] {
-    for (int t; (t = next.fetch_add(1)) < tasks;) {
-      try {
-        results[t] = RunFold(set, fold_of[t / folds], t / folds, t % folds, options, has_terrain, em_for);
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(mutex);
-        if (!failure) failure = std::current_exception();
-        next = tasks;
-      }
-      std::lock_guard<std::mutex> lock(mutex);
-      const int finished = ++done;
-      if (options.progress) options.progress(finished, tasks);
-    }
-  };
-  int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
-  threads = std::clamp(threads, 1, tasks);
-  std::vector<std::thread> pool;
-  for (int i = 1; i < threads; ++i) pool.emplace_back(worker);
-  worker();
-  for (auto& thread : pool) thread.join();
-  if (failure) std::rethrow_exception(failure);
+  int done = 0;
+  const int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+  ParallelFor(tasks, threads, [&](int t) {
+    results[t] = RunFold(set, fold_of[t / folds], t / folds, t % folds, options, has_terrain, em_for);
+    std::lock_guard<std::mutex> lock(mutex);
+    ++done;
+    if (options.progress) options.progress(done, tasks);
+  });
   return results;
 }
 

@@ -3,10 +3,14 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <set>
 
 #include <mujoco/mujoco.h>
+#include <unistd.h>
 
 #include "sim/mujoco_model.h"
 #include "sim/protocol.h"
@@ -42,6 +46,28 @@ TEST(Knobs, BuiltInRobotHasEveryFamilyAndBothSides) {
     EXPECT_TRUE(names.count(n)) << n;
   }
   EXPECT_EQ(knobs.back().kind, KnobKind::kTrackerNoiseScale);  // appended last
+}
+
+// Torsional friction acts only in contacts of condim >= 4: the built-in robot's condim-3 contacts
+// never use it, so it is no knob; the same robot with condim-4 feet has it.
+TEST(Knobs, TorsionalFrictionIsAKnobOnlyWhereAContactUsesIt) {
+  auto has_torsional = [](const SimConfig& c) {
+    for (const Knob& k : EnumerateKnobs(c)) {
+      if (k.kind == KnobKind::kFrictionTorsional) return true;
+    }
+    return false;
+  };
+  EXPECT_FALSE(has_torsional(SimConfig{}));
+  std::ifstream in(std::string(DGMM_SOURCE_DIR) + "/datasets/robots/scorpion.xml");
+  std::string xml((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string three = "condim=\"3\"";
+  for (size_t at = xml.find(three); at != std::string::npos; at = xml.find(three, at)) xml.replace(at, three.size(), "condim=\"4\"");
+  const auto path = std::filesystem::temp_directory_path() / ("dgmm_condim4_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  SimConfig c;
+  c.mjcf_path = path.string();
+  EXPECT_TRUE(has_torsional(c));
+  std::filesystem::remove(path);
 }
 
 // The solimp knobs start from the compiled model (MuJoCo's default 0.9 0.95 0.001 0.5 2 for the

@@ -68,6 +68,27 @@ TEST(ProtocolTest, SameSeedSameSetOtherSeedOtherSet) {
   EXPECT_NE(a.x, c.x);
 }
 
+TEST(ProtocolTest, AChunkedRecordingDoesNotDependOnTheThreadCount) {
+  ProtocolOptions o = Short(7);
+  o.placements = 5;
+  o.executions_per_placement = 2;
+  o.chunk_placements = 2;
+  const SampleSet one = SimulateProtocol(SimConfig{}, o);
+  o.threads = 3;
+  const SampleSet three = SimulateProtocol(SimConfig{}, o);
+  EXPECT_EQ(one.x, three.x);
+  EXPECT_EQ(one.z, three.z);
+  EXPECT_EQ(one.episode, three.episode);
+  EXPECT_EQ(three.metadata.at("random_streams"), "one per chunk of 2 placements");
+  // The same plan as one stream (placements and commands); the chunks' own streams change the noise.
+  o.chunk_placements = 0;
+  const SampleSet single = SimulateProtocol(SimConfig{}, o);
+  EXPECT_EQ(single.command, one.command);
+  EXPECT_EQ(single.episode, one.episode);
+  EXPECT_EQ(single.metadata.count("random_streams"), 0u);
+  EXPECT_NE(single.z, one.z);
+}
+
 TEST(ProtocolTest, FullPaperPlanDrawsEveryCommandThreeTimes) {
   // Plan check without physics cost: one execution of a very short gait per placement.
   SimConfig fast;
@@ -165,6 +186,12 @@ TEST(ProtocolTest, ParsesNamesAndRejectsBadOptions) {
   ProtocolOptions o;
   o.executions_per_placement = 0;
   EXPECT_THROW(SimulateProtocol(SimConfig{}, o), InputError);
+  ProtocolOptions chunks;
+  chunks.chunk_placements = -1;
+  EXPECT_THROW(SimulateProtocol(SimConfig{}, chunks), InputError);
+  ProtocolOptions threads;
+  threads.threads = 0;
+  EXPECT_THROW(SimulateProtocol(SimConfig{}, threads), InputError);
   SimConfig bad;
   bad.timestep_s = -1;
   EXPECT_THROW(SimulateProtocol(bad, ProtocolOptions{}), InputError);

@@ -105,10 +105,15 @@ FakeSimulator::FakeSimulator() {
             MakeKnob("floor.friction.torsional", "friction", 0.01, 0, 0.1, {0.05})};
   knobs_[kPayloadX].physical_min = knobs_[kPayloadY].physical_min = -INFINITY;
   knobs_[kLeftGain].side = "left", knobs_[kRightGain].side = "right";
+  knobs_[kLeftGain].members = {"leg0", "leg1"}, knobs_[kRightGain].members = {"leg2", "leg3"};
   for (int leg = 0; leg < 4; ++leg) knobs_[kLeg0Gain + leg].leg = "leg" + std::to_string(leg);
 }
 
-SampleSet FakeSimulator::Record(const Recording& recording, const std::vector<KnobValue>& values, int) const {
+SampleSet FakeSimulator::Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const {
+  {
+    std::lock_guard<std::mutex> lock(mu_);
+    threads_seen_.push_back(threads);
+  }
   return RecordWith(recording, values, FakeExtras{});
 }
 

@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,11 @@ class FakeSimulator : public KnobSimulator {
   // A recording with extras (the planted real set), `seed` its common random numbers.
   SampleSet RecordWith(const Recording& recording, const std::vector<KnobValue>& values, const FakeExtras& extras) const;
   int records() const { return records_; }
+  // The `threads` of every Record call so far, in call order.
+  std::vector<int> threads_seen() const {
+    std::lock_guard<std::mutex> lock(mu_);
+    return threads_seen_;
+  }
   // Friction values below this topple the robot: the recording keeps one placement only.
   double topples_below_friction = 0;
   double topples_below_side_gain = 0;  // likewise for either side's gain
@@ -64,6 +70,8 @@ class FakeSimulator : public KnobSimulator {
  private:
   std::vector<Knob> knobs_;
   mutable std::atomic<int> records_{0}, cells_{0};
+  mutable std::mutex mu_;
+  mutable std::vector<int> threads_seen_;
 };
 
 }  // namespace dgmm::sim2real::test

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <unistd.h>
 
@@ -38,6 +39,7 @@ TEST(SimulationCache, KeyFollowsValuesAndRecording) {
   EXPECT_NE(RecordingKey(fake, recording, {{test::kFriction, 0.6}}), RecordingKey(fake, recording, {{test::kFriction, 0.7}}));
   EXPECT_NE(RecordingKey(fake, recording, {}), RecordingKey(fake, Recording{"paper", 8, 6}, {}));
   EXPECT_NE(RecordingKey(fake, recording, {}), RecordingKey(fake, Recording{"paper", 7, 7}, {}));
+  EXPECT_NE(RecordingKey(fake, recording, {}), RecordingKey(fake, Recording{"paper", 7, 6, 2}, {}));
   EXPECT_EQ(RecordingKey(fake, recording, {{test::kFriction, 0.6}}), RecordingKey(fake, recording, {{test::kFriction, 0.6}}));
 }
 
@@ -51,6 +53,18 @@ TEST(SimulationCache, BatchDoesNotDependOnTheThreadCount) {
   const RecordingBatch a = RecordBatch(fake, {"paper", 3, 0}, requests, one);
   const RecordingBatch b = RecordBatch(fake, {"paper", 3, 0}, requests, four);
   for (size_t r = 0; r < requests.size(); ++r) EXPECT_EQ(a.sets[r].x, b.sets[r].x) << r;
+}
+
+TEST(SimulationCache, TheLastRecordingsShareTheThreads) {
+  const test::FakeSimulator fake;
+  std::vector<std::vector<KnobValue>> requests(5);
+  RecordingOptions options;
+  options.cache_dir = "-";
+  options.threads = 2;
+  RecordBatch(fake, {"paper", 3, 6}, requests, options);
+  std::vector<int> seen = fake.threads_seen();
+  std::sort(seen.begin(), seen.end());
+  EXPECT_EQ(seen, (std::vector<int>{1, 1, 1, 1, 2}));  // two rounds of one each, then one on both
 }
 
 TEST(SimulationCache, AFailedRecordingIsAnInputError) {
