@@ -116,10 +116,12 @@ std::vector<Knob> EnumerateKnobs(const SimConfig& config) {
   const double mu = config.friction.sliding;
   knobs.push_back(MakeKnob(KnobKind::kFrictionSliding, -1, "floor.friction.sliding", "friction", "",
                            mu, 0.2 * mu, 2.0 * mu, {0.6 * mu, 1.5 * mu}));
-  // Torsional friction acts only in contacts of condim >= 4 (a contact takes the larger of its
-  // geoms' condim): with every geom at 3 or less no contact uses it, and its probe would be inert.
+  // Torsional friction acts only in contacts of condim >= 4 (a contact takes its geoms' condim, or
+  // an explicit <pair>'s): with every geom and pair at 3 or less no contact uses it, and its probe
+  // would be inert.
   int max_condim = 0;
   for (int g = 0; g < m->ngeom; ++g) max_condim = std::max(max_condim, m->geom_condim[g]);
+  for (int p = 0; p < m->npair; ++p) max_condim = std::max(max_condim, m->pair_dim[p]);
   if (max_condim >= 4) {
     const double tor = config.friction.torsional;
     knobs.push_back(MakeKnob(KnobKind::kFrictionTorsional, -1, "floor.friction.torsional", "friction", "m", tor,

@@ -1,7 +1,7 @@
 #pragma once
 // Recordings of the simulator at knob values (knob_simulator.h), read from an on-disk cache or
 // recorded, several in parallel. The cache key is the simulator's Fingerprint(), the recording
-// (protocol, seed, placements) and the knob values by name: equal keys give equal sets.
+// (protocol, seed, placements, executions) and the knob values by name: equal keys give equal sets.
 #include <functional>
 #include <string>
 #include <vector>
