@@ -51,9 +51,10 @@ class JsonFields {
   template <int n, typename Array>
   void Numbers(const char* key, Array* out) {
     if (const nlohmann::json* v = Find(key)) {
-      if (!v->is_array() || v->size() != n) Fail(Field(key), "expected an array of " + std::to_string(n) + " numbers");
+      const std::string expected = "expected an array of " + std::to_string(n) + " numbers";
+      if (!v->is_array() || v->size() != n) Fail(Field(key), expected);
       for (int i = 0; i < n; ++i) {
-        if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of numbers");
+        if (!(*v)[i].is_number()) Fail(Field(key), expected);
         (*out)[i] = (*v)[i].template get<double>();
       }
     }
@@ -81,15 +82,7 @@ class JsonFields {
       }
     }
   }
-  void Vector3(const char* key, Eigen::Vector3d* out) {
-    if (const nlohmann::json* v = Find(key)) {
-      if (!v->is_array() || v->size() != 3) Fail(Field(key), "expected an array of 3 numbers");
-      for (int i = 0; i < 3; ++i) {
-        if (!(*v)[i].is_number()) Fail(Field(key), "expected an array of 3 numbers");
-        (*out)[i] = (*v)[i].get<double>();
-      }
-    }
-  }
+  void Vector3(const char* key, Eigen::Vector3d* out) { Numbers<3>(key, out); }
   void Done() const {
     for (const auto& [key, unused] : object_.items()) {
       if (!used_.count(key)) Fail(Field(key.c_str()), "unknown key");

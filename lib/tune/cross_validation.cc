@@ -14,8 +14,8 @@
 #include <thread>
 
 #include "tune/fold_plan.h"
-#include "util/parallel_for.h"
 #include "util/error.h"
+#include "util/parallel_for.h"
 
 namespace dgmm {
 namespace {
