@@ -30,8 +30,8 @@ namespace {
 
 struct Sim2RealArgs {
   std::string sim, real, out, sim_config, cache;
-  int signature_placements = 78;
-  int signature_executions = 5;
+  int signature_placements = sim2real::CandidateOptions{}.placements;  // the library's defaults
+  int signature_executions = sim2real::CandidateOptions{}.executions_per_placement;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;

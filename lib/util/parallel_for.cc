@@ -12,14 +12,16 @@ namespace dgmm {
 void ParallelFor(int n, int threads, const std::function<void(int)>& f) {
   std::atomic<int> next{0};
   std::mutex mu;
+  std::atomic<bool> failed{false};
   std::exception_ptr failure;
   auto worker = [&] {
-    for (int t = next++; t < n; t = next++) {
+    for (int t = next++; t < n && !failed; t = next++) {
       try {
         f(t);
       } catch (...) {
         std::lock_guard<std::mutex> lock(mu);
         if (!failure) failure = std::current_exception();
+        failed = true;
       }
     }
   };

@@ -6,8 +6,9 @@
 
 namespace dgmm {
 
-// Runs f(0) .. f(n - 1) on up to `threads` threads (the caller's among them); the first exception
-// is rethrown after every thread has finished.
+// Runs f(0) .. f(n - 1) on up to `threads` threads (the caller's among them). Once a task has
+// thrown, no further task is started; the first exception is rethrown after the running tasks
+// have finished.
 void ParallelFor(int n, int threads, const std::function<void(int)>& f);
 
 }  // namespace dgmm
