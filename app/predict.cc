@@ -15,6 +15,7 @@
 #include "io/sample_set_io.h"
 #include "predict/ground_terrain.h"
 #include "predict/predict.h"
+#include "predict/region_calibration.h"
 #include "render/display.h"
 #include "sim/sim_config.h"
 #include "render/trajectory_fan.h"
@@ -25,7 +26,7 @@ namespace dgmm::app {
 namespace {
 
 struct PredictArgs {
-  std::string model, commands, terrain, command_values, output, pose_dims, figure, ground, persistence;
+  std::string model, commands, terrain, command_values, output, pose_dims, figure, ground, persistence, calibrate;
   std::vector<double> start{0, 0, 0};
   bool walking = false;
   int trajectories = 1000;
@@ -134,6 +135,16 @@ std::vector<std::string> GivenNames(const MotionModel& model, const std::vector<
   return names;
 }
 
+// A step's planar regions: share and r2 of {p : (p - m)^T C^-1 (p - m) <= r2}, m and C the mean and
+// covariance of x, y.
+nlohmann::json Regions(const predict::StepPrediction& s) {
+  nlohmann::json out = nlohmann::json::array();
+  for (std::size_t l = 0; l < s.region_levels.size(); ++l) {
+    out.push_back({{"share", s.region_levels[l]}, {"r2", s.region_r2[l]}});
+  }
+  return out;
+}
+
 nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, const predict::Prediction& p,
                       const PredictArgs& args) {
   nlohmann::json steps = nlohmann::json::array();
@@ -144,22 +155,25 @@ nlohmann::json ToJson(const MotionModel& model, const std::vector<int>& ids, con
     steps.push_back({{"step", k + 1},
                      {"command", model.command_labels.at(ids[k])},
                      {"mean", {s.mean[0], s.mean[1], s.mean[2], s.mean[3]}},
-                     {"covariance", cov}});
+                     {"covariance", cov},
+                     {"regions", Regions(s)}});
   }
   return {{"model", args.model}, {"pose", {"x_m", "y_m", "z_m", "yaw_rad"}}, {"spatial", p.spatial},
           {"start", args.start}, {"trajectories", args.trajectories}, {"seed", args.seed},
           {"terrain", args.terrain}, {"command_values", args.command_values}, {"persistence_from", args.persistence},
-          {"steps", steps}};
+          {"calibrated_from", args.calibrate}, {"steps", steps}};
 }
 
 // The trajectory fan (render/trajectory_fan.h) of the prediction, written to args.figure.
 void WriteFigure(const predict::Prediction& p, const PredictArgs& args,
                  const std::function<double(double, double)>& ground_height) {
   std::vector<Eigen::MatrixX2d> steps;
-  for (const auto& s : p.steps) steps.push_back(s.poses.leftCols(2));
+  std::vector<std::vector<double>> r2;
+  for (const auto& s : p.steps) steps.push_back(s.poses.leftCols(2)), r2.push_back(s.region_r2);
   const std::string title = "Where " + std::to_string(p.steps.size()) + " commands take the robot (" +
-                            std::to_string(args.trajectories) + " trajectories): 50% (white) and 90% (orange) regions";
-  HeatMapSpec fan = TrajectoryFan(steps, Eigen::Vector2d(args.start[0], args.start[1]), title);
+                            std::to_string(args.trajectories) + " trajectories): 50% (white) and 90% (orange) regions" +
+                            (args.calibrate.empty() ? "" : ", calibrated");
+  HeatMapSpec fan = TrajectoryFan(steps, Eigen::Vector2d(args.start[0], args.start[1]), title, r2);
   if (ground_height) fan.contours.push_back(GroundContours(fan.background.range, ground_height));
   RenderHeatMap(fan, args.figure);
 }
@@ -223,6 +237,20 @@ predict::StepPersistence PersistenceFrom(const MotionModel& model, const std::st
   return s.persistence;
 }
 
+// The regions' factors from the held-out episodes of `path`, printed one line per horizon.
+predict::RegionCalibration CalibrationFrom(const MotionModel& model, const std::string& path,
+                                           const predict::PredictOptions& options) {
+  predict::CalibrationOptions calibration;
+  calibration.trajectories = options.trajectories;
+  const predict::RegionCalibration c = predict::CalibrateRegions(model, ReadSampleSet(path), options, calibration, path);
+  std::printf("regions calibrated on %s: r2 of the 50%% and 90%% regions times (held-out episodes)\n", path.c_str());
+  for (Eigen::Index k = 0; k < c.factor.rows(); ++k) {
+    std::printf("  after %2ld commands  x%.2f  x%.2f  (%d episodes)\n", static_cast<long>(k + 1), c.factor(k, 0),
+                c.factor(k, 1), c.episodes[k]);
+  }
+  return c;
+}
+
 void Run(const PredictArgs& args) {
   if (!args.figure.empty()) RequireDisplay();  // before any work or output
   for (const std::string& out : {args.output, args.figure}) {
@@ -241,6 +269,13 @@ void Run(const PredictArgs& args) {
   options.pose_dims = SplitOn(args.pose_dims, ',');
   if (!args.persistence.empty()) options.persistence = PersistenceFrom(model, args.persistence);
   options.from_rest = !args.walking;
+  if (!args.calibrate.empty()) {
+    options.calibration = CalibrationFrom(model, args.calibrate, options);
+    if (options.calibration.factor.rows() < static_cast<Eigen::Index>(ids.size())) {
+      std::fprintf(stderr, "dgmm: warning: predict: %s: its episodes calibrate %ld commands; later steps take the "
+                           "factors of the last\n", args.calibrate.c_str(), static_cast<long>(options.calibration.factor.rows()));
+    }
+  }
   std::optional<sim::SimConfig> ground;
   predict::GroundSurface surface;
   if (!args.ground.empty()) {
@@ -302,6 +337,13 @@ void Setup(CLI::App& root) {
                   "estimated from it and each trajectory's draws are correlated accordingly (default: every "
                   "command drawn independently, which under-states the spread after many commands when "
                   "deviations persist)");
+  cmd->add_option("--calibrate", args->calibrate,
+                  "sample set of held-out episodes the model did not learn from, recorded like the sequences to "
+                  "predict (e.g. dgmm simulate --protocol trajectories with another seed): each episode's commands "
+                  "are predicted on its recorded terrain with the same options, and the 50% and 90% regions of "
+                  "every step are widened (or narrowed) so that they hold those shares of the episodes' outcomes "
+                  "after as many commands (split conformal prediction; default: the regions hold those shares of "
+                  "the trajectories)");
   cmd->add_flag("--walking", args->walking,
                "the robot is already walking before the first command (with --persistence: the first command's "
                "spread is the model's, not that of a start from standing)");
@@ -315,7 +357,9 @@ void Setup(CLI::App& root) {
   cmd->add_option("--seed", args->seed, "random seed")->capture_default_str();
   cmd->add_option("--pose-dims", args->pose_dims,
                   "the model's pose-change names for dx,dy,dyaw[,dz,droll,dpitch] (default: those names)");
-  cmd->add_option("-o,--output", args->output, "JSON file with every step's mean and covariance");
+  cmd->add_option("-o,--output", args->output,
+                  "JSON file with every step's mean, covariance and regions (share, r2 of the ellipse "
+                  "(p - mean)^T C^-1 (p - mean) <= r2 in x, y)");
   cmd->callback([args] { Run(*args); });
 }
 

@@ -16,6 +16,7 @@
 #include "io/sample_set_io.h"
 #include "predict/ground_terrain.h"
 #include "predict/predict.h"
+#include "predict/region_calibration.h"
 #include "util/error.h"
 
 namespace py = pybind11;
@@ -167,6 +168,24 @@ void BindModel(py::module_& m) {
            "n draws of x from p(x | c[, z]), raw units (n x dx); same seed, same draws");
 }
 
+predict::StepPersistence PersistenceFromDict(const std::optional<py::dict>& d) {
+  predict::StepPersistence p;
+  if (!d) return p;
+  p.shared = (*d)["shared"].cast<Eigen::VectorXd>();
+  p.decay = (*d)["decay"].cast<Eigen::VectorXd>();
+  if (d->contains("first_scale")) p.first_scale = (*d)["first_scale"].cast<Eigen::VectorXd>();
+  return p;
+}
+
+predict::RegionCalibration CalibrationFromDict(const std::optional<py::dict>& d) {
+  predict::RegionCalibration c;
+  if (!d) return c;
+  c.levels = (*d)["levels"].cast<std::vector<double>>();
+  c.factor = (*d)["factor"].cast<Eigen::MatrixXd>();
+  if (d->contains("episodes")) c.episodes = (*d)["episodes"].cast<Eigen::VectorXi>();
+  return c;
+}
+
 void BindFitAndPredict(py::module_& m) {
   m.def("fit_dgmm", &FitDgmm, py::arg("set"), py::arg("k") = 0.7, py::arg("with_terrain") = true, py::arg("seed") = 1,
         py::arg("max_components") = 0, py::arg("variant") = "faithful", py::arg("covariance") = "prior",
@@ -192,7 +211,8 @@ void BindFitAndPredict(py::module_& m) {
   m.def("predict",
         [](const MotionModel& model, const std::vector<int>& commands, const std::optional<Eigen::MatrixXd>& terrain,
            const Eigen::Vector3d& start, int trajectories, std::uint64_t seed, const std::vector<std::string>& pose_dims,
-           std::optional<double> ground_slope_deg, const std::optional<py::dict>& persistence, bool walking) {
+           std::optional<double> ground_slope_deg, const std::optional<py::dict>& persistence, bool walking,
+           const std::optional<py::dict>& calibration) {
           std::vector<predict::Step> steps;
           for (std::size_t k = 0; k < commands.size(); ++k) {
             predict::Step s{commands[k], {}};
@@ -209,16 +229,13 @@ void BindFitAndPredict(py::module_& m) {
           o.pose_dims = pose_dims;
           if (ground_slope_deg) o.ground = predict::GroundTerrain(model, {*ground_slope_deg * M_PI / 180});
           o.from_rest = !walking;
-          if (persistence) {
-            o.persistence.shared = (*persistence)["shared"].cast<Eigen::VectorXd>();
-            o.persistence.decay = (*persistence)["decay"].cast<Eigen::VectorXd>();
-            if (persistence->contains("first_scale")) {
-              o.persistence.first_scale = (*persistence)["first_scale"].cast<Eigen::VectorXd>();
-            }
-          }
+          o.persistence = PersistenceFromDict(persistence);
+          o.calibration = CalibrationFromDict(calibration);
           const predict::Prediction p = predict::Predict(model, start, steps, o);
           const int n = static_cast<int>(p.steps.size());
-          py::array_t<double> poses({n, trajectories, 4}), mean({n, 4}), cov({n, 4, 4});
+          const int levels = n > 0 ? static_cast<int>(p.steps[0].region_levels.size()) : 0;
+          py::array_t<double> poses({n, trajectories, 4}), mean({n, 4}), cov({n, 4, 4}), r2({n, levels});
+          auto R = r2.mutable_unchecked<2>();
           auto P = poses.mutable_unchecked<3>();
           auto M = mean.mutable_unchecked<2>();
           auto C = cov.mutable_unchecked<3>();
@@ -230,23 +247,54 @@ void BindFitAndPredict(py::module_& m) {
               M(k, d) = p.steps[k].mean[d];
               for (int e = 0; e < 4; ++e) C(k, d, e) = p.steps[k].covariance(d, e);
             }
+            for (int l = 0; l < levels; ++l) R(k, l) = p.steps[k].region_r2[l];
           }
           py::dict out;
           out["poses"] = poses;
           out["mean"] = mean;
           out["covariance"] = cov;
+          out["region_levels"] = n > 0 ? p.steps[0].region_levels : o.region_levels;
+          out["region_r2"] = r2;
           return out;
         },
         py::arg("model"), py::arg("commands"), py::arg("terrain") = std::nullopt,
         py::arg("start") = Eigen::Vector3d::Zero(), py::arg("trajectories") = 1000, py::arg("seed") = 1,
         py::arg("pose_dims") = std::vector<std::string>{}, py::arg("ground_slope_deg") = std::nullopt,
-        py::arg("persistence") = std::nullopt, py::arg("walking") = false,
+        py::arg("persistence") = std::nullopt, py::arg("walking") = false, py::arg("calibration") = std::nullopt,
         "Where a command sequence takes the robot (as `dgmm predict`): poses (steps x trajectories x "
-        "[x, y, z, yaw]), their mean and covariance per step. pose_dims: the model's names for dx, dy, dyaw "
+        "[x, y, z, yaw]), their mean and covariance per step, and region_r2 (steps x region_levels): r2 of "
+        "the planar regions (p - mean)^T C^-1 (p - mean) <= r2 in x, y holding those shares (calibrated: "
+        "calibrate_regions' dict). pose_dims: the model's names for dx, dy, dyaw "
         "(planar composition) or dx, dy, dyaw, dz, droll, dpitch; default: SE(3) when the model has them all. "
         "ground_slope_deg: condition each trajectory on a plane's pitch and roll at its heading (as --ground). "
         "persistence: estimate_persistence's dict; correlates each trajectory's draws from step to step (as --persistence). "
         "walking: the robot walks before the first command (as --walking).");
+  m.def("calibrate_regions",
+        [](const MotionModel& model, const SampleSet& set, int trajectories, std::uint64_t seed,
+           const std::vector<std::string>& pose_dims, const std::optional<py::dict>& persistence, bool walking,
+           const std::vector<double>& levels, int min_episodes) {
+          predict::PredictOptions o;
+          o.seed = seed;
+          o.pose_dims = pose_dims;
+          o.persistence = PersistenceFromDict(persistence);
+          o.from_rest = !walking;
+          predict::CalibrationOptions c;
+          c.levels = levels;
+          c.trajectories = trajectories;
+          c.min_episodes = min_episodes;
+          const predict::RegionCalibration r = predict::CalibrateRegions(model, set, o, c);
+          py::dict out;
+          out["levels"] = r.levels;
+          out["factor"] = r.factor;
+          out["episodes"] = r.episodes;
+          return out;
+        },
+        py::arg("model"), py::arg("set"), py::arg("trajectories") = 1000, py::arg("seed") = 1,
+        py::arg("pose_dims") = std::vector<std::string>{}, py::arg("persistence") = std::nullopt,
+        py::arg("walking") = false, py::arg("levels") = std::vector<double>{0.5, 0.9}, py::arg("min_episodes") = 20,
+        "Factors on the regions' r2 per horizon (as predict --calibrate) from held-out episodes the model did not "
+        "learn from: dict of levels, factor (horizons x levels) and episodes per horizon; pass it to predict "
+        "as calibration=, with the same persistence and pose_dims.");
   m.def("estimate_persistence",
         [](const MotionModel& model, const SampleSet& set, int max_lag) {
           predict::PersistenceOptions o;

@@ -1,5 +1,6 @@
 #include "predict/predict.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -46,8 +47,25 @@ Eigen::Matrix3d Zyx(double yaw, double pitch, double roll) {
       .toRotationMatrix();
 }
 
-// Mean and covariance of the poses, yaw unwrapped about its circular mean.
-void Summarise(StepPrediction* s) {
+// (p - m)^T C^-1 (p - m) in (x, y) of each row of `points` under the step's mean and covariance.
+Eigen::VectorXd Distance2(const StepPrediction& s, const Eigen::MatrixX2d& points) {
+  Eigen::Matrix2d c = s.covariance.topLeftCorner<2, 2>();
+  c.diagonal().array() += 1e-12 * std::max(c.trace(), 1e-300);  // all trajectories equal: still factors
+  const Eigen::LLT<Eigen::Matrix2d> llt(c);
+  const Eigen::MatrixX2d centred = points.rowwise() - s.mean.head<2>().transpose();
+  return llt.matrixL().solve(centred.transpose()).colwise().squaredNorm().transpose();
+}
+
+// The q-quantile of v (nearest rank below).
+double Quantile(Eigen::VectorXd v, double q) {
+  const auto at = static_cast<Eigen::Index>(std::clamp(q, 0.0, 1.0) * static_cast<double>(v.size() - 1));
+  std::nth_element(v.data(), v.data() + at, v.data() + v.size());
+  return v[at];
+}
+
+// Mean and covariance of the poses, yaw unwrapped about its circular mean; the planar regions of
+// step `k`.
+void Summarise(const PredictOptions& options, int k, StepPrediction* s) {
   Eigen::MatrixXd& p = s->poses;
   const double c = p.col(3).array().cos().mean(), sn = p.col(3).array().sin().mean();
   const double centre = std::atan2(sn, c);
@@ -55,6 +73,28 @@ void Summarise(StepPrediction* s) {
   s->mean = p.colwise().mean().transpose();
   const Eigen::MatrixXd d = p.rowwise() - s->mean.transpose();
   s->covariance = d.transpose() * d / std::max<Eigen::Index>(1, p.rows() - 1);
+  const Eigen::VectorXd d2 = Distance2(*s, p.leftCols(2));
+  const RegionCalibration& cal = options.calibration;
+  s->region_levels = cal.empty() ? options.region_levels : cal.levels;
+  s->region_r2.clear();
+  for (std::size_t l = 0; l < s->region_levels.size(); ++l) {
+    const double factor = cal.empty() ? 1.0 : cal.Factor(k, static_cast<int>(l));
+    s->region_r2.push_back(factor * Quantile(d2, s->region_levels[l]));
+  }
+}
+
+// Advances a pose (rotation, position) by one pose change dx (the model's dimensions): the
+// translation in the robot's frame at the start of the command, then the rotation.
+void Advance(const Eigen::Ref<const Eigen::VectorXd>& dx, const std::vector<int>& idx, bool spatial,
+             Eigen::Matrix3d* rotation, Eigen::Vector3d* position) {
+  const Eigen::Vector3d t(dx[idx[0]], dx[idx[1]], spatial ? dx[idx[3]] : 0.0);
+  const Eigen::Matrix3d r = spatial ? Zyx(dx[idx[2]], dx[idx[5]], dx[idx[4]]) : Zyx(dx[idx[2]], 0, 0);
+  *position += *rotation * t;
+  *rotation = *rotation * r;
+}
+
+Eigen::RowVector4d PoseRow(const Eigen::Matrix3d& rotation, const Eigen::Vector3d& position) {
+  return {position.x(), position.y(), position.z(), std::atan2(rotation(1, 0), rotation(0, 0))};
 }
 
 }  // namespace
@@ -64,7 +104,26 @@ bool PredictOptions::IsValid(std::string* error) const {
     if (error) *error = "trajectories: expected 1 to 10^7";
     return false;
   }
+  for (double level : calibration.empty() ? region_levels : calibration.levels) {
+    if (!(level > 0 && level < 1)) {
+      if (error) *error = "region levels: expected shares in (0, 1)";
+      return false;
+    }
+  }
+  if (!calibration.empty() && (calibration.factor.cols() != static_cast<Eigen::Index>(calibration.levels.size()) ||
+                               !(calibration.factor.array() > 0).all() || !calibration.factor.allFinite())) {
+    if (error) *error = "calibration: expected a positive factor per horizon and level";
+    return false;
+  }
   return persistence.empty() || persistence.IsValid(error);
+}
+
+double RegionCalibration::Factor(int step, int level) const {
+  return factor(std::clamp<Eigen::Index>(step, 0, factor.rows() - 1), level);
+}
+
+double StepPrediction::RegionDistance2(const Eigen::Vector2d& p) const {
+  return Distance2(*this, p.transpose())[0];
 }
 
 namespace {
@@ -132,13 +191,9 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
   const std::vector<int> idx = PoseIndices(model, options, &out.spatial);
   const int n = options.trajectories;
   std::vector<Eigen::Matrix3d> rotation(n, Zyx(start.z(), 0, 0));
-  Eigen::MatrixXd position(n, 3);
-  position.col(0).setConstant(start.x());
-  position.col(1).setConstant(start.y());
-  position.col(2).setZero();
+  std::vector<Eigen::Vector3d> position(n, Eigen::Vector3d(start.x(), start.y(), 0.0));
   Eigen::MatrixXd before(n, 4);  // every trajectory's pose before the step: x, y, z, yaw
-  before.leftCols(3) = position;
-  before.col(3).setConstant(start.z());
+  before.rowwise() = Eigen::RowVector4d(start.x(), start.y(), 0.0, start.z());
   if (!options.persistence.empty() && options.persistence.shared.size() != model.pose_dim) {
     throw MakeInputError("predict", "persistence", "expected one value per pose dimension of the model (" +
                                                        std::to_string(model.pose_dim) + ")");
@@ -162,17 +217,29 @@ Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const
     StepPrediction s;
     s.poses.resize(n, 4);
     for (int i = 0; i < n; ++i) {
-      const Eigen::Vector3d t(dx(idx[0], i), dx(idx[1], i), out.spatial ? dx(idx[3], i) : 0.0);
-      const Eigen::Matrix3d r = out.spatial ? Zyx(dx(idx[2], i), dx(idx[5], i), dx(idx[4], i)) : Zyx(dx(idx[2], i), 0, 0);
-      position.row(i) += (rotation[i] * t).transpose();
-      rotation[i] = rotation[i] * r;
-      s.poses.row(i) << position(i, 0), position(i, 1), position(i, 2), std::atan2(rotation[i](1, 0), rotation[i](0, 0));
+      Advance(dx.col(i), idx, out.spatial, &rotation[i], &position[i]);
+      s.poses.row(i) = PoseRow(rotation[i], position[i]);
     }
     before = s.poses;
-    Summarise(&s);
+    Summarise(options, static_cast<int>(k), &s);
     out.steps.push_back(std::move(s));
   }
   return out;
+}
+
+Eigen::MatrixXd ComposePath(const MotionModel& model, const Eigen::Vector3d& start, const Eigen::MatrixXd& x,
+                            const PredictOptions& options) {
+  if (x.cols() != model.pose_dim) throw MakeInputError("predict", "path", "expected the model's pose dimensions");
+  bool spatial = false;
+  const std::vector<int> idx = PoseIndices(model, options, &spatial);
+  Eigen::Matrix3d rotation = Zyx(start.z(), 0, 0);
+  Eigen::Vector3d position(start.x(), start.y(), 0.0);
+  Eigen::MatrixXd poses(x.rows(), 4);
+  for (Eigen::Index k = 0; k < x.rows(); ++k) {
+    Advance(x.row(k).transpose(), idx, spatial, &rotation, &position);
+    poses.row(k) = PoseRow(rotation, position);
+  }
+  return poses;
 }
 
 }  // namespace dgmm::predict

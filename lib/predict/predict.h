@@ -14,6 +14,18 @@
 
 namespace dgmm::predict {
 
+// How much the planar regions of a prediction are widened so that they hold their shares of
+// outcomes on episodes the model did not learn from (region_calibration.h); empty: not widened.
+struct RegionCalibration {
+  std::vector<double> levels;  // the regions' shares, e.g. 0.5 and 0.9
+  // horizons x levels: the factor on r^2 after k + 1 commands (1: the trajectories' own quantile);
+  // steps beyond the last horizon take its factor.
+  Eigen::MatrixXd factor;
+  Eigen::VectorXi episodes;  // per horizon: the calibration episodes that reached it
+  bool empty() const { return factor.size() == 0; }
+  double Factor(int step, int level) const;  // step counts from 0
+};
+
 struct PredictOptions {
   int trajectories = 1000;
   std::uint64_t seed = 1;
@@ -30,6 +42,10 @@ struct PredictOptions {
   // The robot stands before the first command (persistence.first_scale applies); false: it is
   // already walking.
   bool from_rest = true;
+  // Shares of the planar regions reported per step (StepPrediction::region_r2); with a calibration
+  // its levels are used and its factors applied.
+  std::vector<double> region_levels{0.5, 0.9};
+  RegionCalibration calibration;
   bool IsValid(std::string* error) const;
 };
 
@@ -48,6 +64,13 @@ struct StepPrediction {
   Eigen::MatrixXd poses;      // trajectories x 4
   Eigen::Vector4d mean = Eigen::Vector4d::Zero();
   Eigen::Matrix4d covariance = Eigen::Matrix4d::Zero();
+  // Planar regions {p : (p - m)^T C^-1 (p - m) <= r2} in (x, y), m and C the trajectories' mean and
+  // covariance there: per level, r2 = the level-quantile of the trajectories' own squared
+  // Mahalanobis distances, times the calibration's factor.
+  std::vector<double> region_levels;
+  std::vector<double> region_r2;
+  // (p - m)^T C^-1 (p - m) of a point p = (x, y) (RegionDistance2 < r2: inside).
+  double RegionDistance2(const Eigen::Vector2d& p) const;
 };
 
 struct Prediction {
@@ -61,5 +84,10 @@ struct Prediction {
 // know, a terrain of the wrong size).
 Prediction Predict(const MotionModel& model, const Eigen::Vector3d& start, const std::vector<Step>& steps,
                    const PredictOptions& options);
+
+// The path of recorded pose changes (rows of x, raw units, the model's pose dimensions) composed
+// from `start` as Predict composes its draws: poses x, y, z, yaw after each row (rows x 4).
+Eigen::MatrixXd ComposePath(const MotionModel& model, const Eigen::Vector3d& start, const Eigen::MatrixXd& x,
+                            const PredictOptions& options);
 
 }  // namespace dgmm::predict

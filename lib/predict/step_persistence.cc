@@ -4,6 +4,7 @@
 #include <limits>
 #include <map>
 
+#include "predict/episode_set.h"
 #include "util/error.h"
 
 namespace dgmm::predict {
@@ -82,15 +83,7 @@ std::pair<double, double> FitDecay(const Eigen::VectorXd& rho) {
 
 PersistenceSummary EstimatePersistence(const MotionModel& model, const SampleSet& set, const PersistenceOptions& options,
                                        const std::string& source) {
-  if (std::string e = set.Validate(); !e.empty()) throw MakeInputError(source, "", e);
-  if (!set.has_sequence()) {
-    throw MakeInputError(source, "episode", "persistence needs recorded episodes and steps (e.g. dgmm simulate --protocol trajectories)");
-  }
-  if (!set.transform.empty()) throw MakeInputError(source, "transform", "expected a raw (not standardised) set");
-  if (set.pose_dim() != model.pose_dim) throw MakeInputError(source, "x", "expected the model's pose dimensions");
-  if (model.terrain_dim > 0 && set.terrain_dim() != model.terrain_dim) {
-    throw MakeInputError(source, "z", "expected the model's " + std::to_string(model.terrain_dim) + " terrain dimensions");
-  }
+  CheckEpisodeSet(model, set, source, "persistence");
   if (options.max_lag < 1 || options.min_pairs < 2) throw MakeInputError("persistence", "options", "expected max_lag >= 1, min_pairs >= 2");
   const Eigen::MatrixXd eps = StandardisedResiduals(model, set, source);
   std::map<std::pair<int, int>, int> row;  // (episode, step) -> sample

@@ -32,30 +32,55 @@ PlotRange FanRange(const std::vector<Eigen::MatrixX2d>& steps, const Eigen::Vect
 
 }  // namespace
 
-Eigen::MatrixX2d RegionEllipse(const Eigen::MatrixX2d& points, double share, int segments) {
-  const Eigen::RowVector2d mean = points.colwise().mean();
-  const Eigen::MatrixX2d centred = points.rowwise() - mean;
+namespace {
+
+// Mean, covariance factor and squared Mahalanobis distances of 2-D points (rows).
+struct PointSpread {
+  Eigen::RowVector2d mean;
+  Eigen::Matrix2d l;
+  std::vector<double> d2;
+};
+
+PointSpread SpreadOf(const Eigen::MatrixX2d& points) {
+  PointSpread s;
+  s.mean = points.colwise().mean();
+  const Eigen::MatrixX2d centred = points.rowwise() - s.mean;
   Eigen::Matrix2d cov = centred.transpose() * centred / std::max<double>(1, points.rows() - 1);
   // Relative jitter (all points equal: a unit-free tiny circle) so that a fan of one point or
   // on a line still factors.
   const double scale = cov.trace() > 0 ? cov.trace() : 1.0;
   cov.diagonal().array() += 1e-12 * scale;
   const Eigen::LLT<Eigen::Matrix2d> llt(cov);
-  const Eigen::Matrix2d l = llt.matrixL();
+  s.l = llt.matrixL();
   const Eigen::MatrixX2d u = llt.matrixL().solve(centred.transpose()).transpose();
-  std::vector<double> d2(u.rows());
-  for (Eigen::Index i = 0; i < u.rows(); ++i) d2[i] = u.row(i).squaredNorm();
-  const double r = std::sqrt(Quantile(d2, share));
+  s.d2.resize(u.rows());
+  for (Eigen::Index i = 0; i < u.rows(); ++i) s.d2[i] = u.row(i).squaredNorm();
+  return s;
+}
+
+Eigen::MatrixX2d Ellipse(const PointSpread& s, double r2, int segments) {
+  const double r = std::sqrt(std::max(r2, 0.0));
   Eigen::MatrixX2d ellipse(segments + 1, 2);
   for (int k = 0; k <= segments; ++k) {
     const double t = 2 * M_PI * k / segments;
-    ellipse.row(k) = mean + (r * l * Eigen::Vector2d(std::cos(t), std::sin(t))).transpose();
+    ellipse.row(k) = s.mean + (r * s.l * Eigen::Vector2d(std::cos(t), std::sin(t))).transpose();
   }
   return ellipse;
 }
 
+}  // namespace
+
+Eigen::MatrixX2d RegionEllipse(const Eigen::MatrixX2d& points, double share, int segments) {
+  const PointSpread s = SpreadOf(points);
+  return Ellipse(s, Quantile(s.d2, share), segments);
+}
+
+Eigen::MatrixX2d RegionEllipseWithRadius2(const Eigen::MatrixX2d& points, double r2, int segments) {
+  return Ellipse(SpreadOf(points), r2, segments);
+}
+
 HeatMapSpec TrajectoryFan(const std::vector<Eigen::MatrixX2d>& steps, const Eigen::Vector2d& start,
-                          const std::string& title) {
+                          const std::string& title, const std::vector<std::vector<double>>& region_r2) {
   HeatMapSpec spec;
   const PlotRange range = FanRange(steps, start);
   constexpr int kCells = 150;
@@ -79,8 +104,11 @@ HeatMapSpec TrajectoryFan(const std::vector<Eigen::MatrixX2d>& steps, const Eige
   for (std::size_t k = 0; k < steps.size(); ++k) {
     means.row(k) = steps[k].colwise().mean();
     path.row(k + 1) = means.row(k);
-    spec.curves.push_back({RegionEllipse(steps[k], 0.5), {255, 255, 255}, 1.5f});
-    spec.curves.push_back({RegionEllipse(steps[k], 0.9), {255, 150, 40}, 1.5f});
+    const bool given = k < region_r2.size() && region_r2[k].size() == 2;
+    spec.curves.push_back({given ? RegionEllipseWithRadius2(steps[k], region_r2[k][0]) : RegionEllipse(steps[k], 0.5),
+                           {255, 255, 255}, 1.5f});
+    spec.curves.push_back({given ? RegionEllipseWithRadius2(steps[k], region_r2[k][1]) : RegionEllipse(steps[k], 0.9),
+                           {255, 150, 40}, 1.5f});
   }
   spec.curves.push_back({path, {80, 220, 255}, 2.0f});
   spec.points = means;

@@ -7,9 +7,9 @@ Low level (the C++ library, module ``dgmm._dgmm``): ``SampleSet``, ``MotionModel
 """
 import numpy as np
 
-from ._dgmm import InputError, MotionModel, SampleSet, estimate_persistence, fit_dgmm, fit_em, predict
+from ._dgmm import InputError, MotionModel, SampleSet, calibrate_regions, estimate_persistence, fit_dgmm, fit_em, predict
 
-__all__ = ["DGMM", "EMMixture", "InputError", "MotionModel", "SampleSet", "estimate_persistence", "fit_dgmm", "fit_em", "predict", "as_set"]
+__all__ = ["DGMM", "EMMixture", "InputError", "MotionModel", "SampleSet", "calibrate_regions", "estimate_persistence", "fit_dgmm", "fit_em", "predict", "as_set"]
 
 
 def as_set(X, commands=None, Z=None):

@@ -1,6 +1,7 @@
 // `dgmm predict` end to end on a model fitted from a shipped set.
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -83,6 +84,50 @@ TEST(PredictCommand, PersistenceIsEstimatedFromASetsEpisodes) {
   EXPECT_EQ(nlohmann::json::parse(in)["persistence_from"], set);
   const std::string missing = (dir / "none.h5").string(), out2 = (dir / "q.json").string();
   const RunResult bad = RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--persistence", missing, "-o", out2});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_EQ(CountLines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("none.h5"), std::string::npos) << bad.err;
+  EXPECT_FALSE(std::filesystem::exists(out2));
+}
+
+// --calibrate widens each step's regions by the factor its held-out episodes give (printed per
+// horizon and applied to the JSON's r2); steps beyond the episodes' length take the last factor with
+// a warning; a missing set is one line and writes nothing.
+TEST(PredictCommand, RegionsAreCalibratedOnHeldOutEpisodes) {
+  const auto dir = MakeTempDir("predict_calibrate");
+  const std::string set = SourcePath("datasets/scorpion_sim_390.h5").string();
+  const std::string model = (dir / "m.h5").string(), plain = (dir / "p.json").string(), cal = (dir / "c.json").string();
+  ASSERT_EQ(RunDgmm({"--quiet", "fit", set, "-o", model}).exit_code, 0);
+  const std::vector<std::string> predict = {"predict", model, "--commands", "+0.5,0,0*6", "--terrain", "pitch=0.1,roll=0",
+                                            "--trajectories", "300"};
+  std::vector<std::string> with = predict, without = predict;
+  with.insert(with.end(), {"--calibrate", set, "-o", cal});
+  without.insert(without.end(), {"-o", plain});
+  ASSERT_EQ(RunDgmm(without).exit_code, 0);
+  const RunResult r = RunDgmm(with);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("regions calibrated on " + set), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("after  5 commands"), std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find("after  6 commands"), std::string::npos) << r.out;  // its episodes have 5 steps
+  EXPECT_NE(r.err.find("calibrate 5 commands"), std::string::npos) << r.err;
+  EXPECT_EQ(CountLines(r.err), 1) << r.err;
+  std::ifstream ip(plain), ic(cal);
+  const auto jp = nlohmann::json::parse(ip), jc = nlohmann::json::parse(ic);
+  EXPECT_EQ(jc["calibrated_from"], set);
+  for (int k = 0; k < 6; ++k) {
+    ASSERT_EQ(jc["steps"][k]["regions"].size(), 2u);
+    EXPECT_EQ(jc["steps"][k]["regions"][1]["share"], 0.9);
+    EXPECT_EQ(jc["steps"][k]["mean"], jp["steps"][k]["mean"]) << "the same trajectories";
+    const double ratio = double(jc["steps"][k]["regions"][1]["r2"]) / double(jp["steps"][k]["regions"][1]["r2"]);
+    char printed[64], factor[32];
+    std::snprintf(printed, sizeof printed, "after %2d commands", std::min(k + 1, 5));
+    std::snprintf(factor, sizeof factor, "x%.2f  (", ratio);
+    const auto at = r.out.find(printed);
+    ASSERT_NE(at, std::string::npos) << printed;
+    EXPECT_NE(r.out.substr(at, 60).find(factor), std::string::npos) << r.out.substr(at, 60) << " " << factor;
+  }
+  const std::string missing = (dir / "none.h5").string(), out2 = (dir / "q.json").string();
+  const RunResult bad = RunDgmm({"predict", model, "--commands", "+0.5,0,0", "--calibrate", missing, "-o", out2});
   EXPECT_NE(bad.exit_code, 0);
   EXPECT_EQ(CountLines(bad.err), 1) << bad.err;
   EXPECT_NE(bad.err.find("none.h5"), std::string::npos) << bad.err;

@@ -120,6 +120,26 @@ def test_persistence_matches_the_command_line_and_widens_only_later_steps(tmp_pa
         dgmm.predict(est.model_, [forward], persistence={"shared": np.zeros(2), "decay": np.zeros(2)})
 
 
+def test_calibrated_regions_match_the_command_line(tmp_path):
+    s = dgmm.SampleSet.read(SHIPPED)
+    est = dgmm.DGMM(seed=1).fit(s)
+    cal = dgmm.calibrate_regions(est.model_, s, trajectories=300)
+    assert cal["levels"] == [0.5, 0.9] and cal["factor"].shape == (5, 2) and list(cal["episodes"]) == [78] * 5
+    # The command line prints the same factors (two decimals) per horizon.
+    est.save(tmp_path / "m.h5")
+    out = subprocess.run([CLI, "predict", str(tmp_path / "m.h5"), "--commands", "+0.5,0,0", "--calibrate", SHIPPED,
+                          "--trajectories", "300"], check=True, capture_output=True, text=True).stdout
+    for k, (f50, f90) in enumerate(cal["factor"]):
+        assert f"after {k + 1:2d} commands  x{f50:.2f}  x{f90:.2f}  (78 episodes)" in out
+    # Applied to predict's regions: r2 scaled by the factor, the trajectories unchanged.
+    forward = next(i for i, l in est.model_.command_labels.items() if l == "+0.5,0,0")
+    plain = dgmm.predict(est.model_, [forward] * 2, terrain=np.array([[0.0, 0.0]]), trajectories=500, seed=3)
+    wide = dgmm.predict(est.model_, [forward] * 2, terrain=np.array([[0.0, 0.0]]), trajectories=500, seed=3,
+                        calibration=cal)
+    assert np.array_equal(plain["poses"], wide["poses"])
+    np.testing.assert_allclose(wide["region_r2"] / plain["region_r2"], cal["factor"][:2], rtol=1e-12)
+
+
 def test_estimator_conventions():
     est = dgmm.DGMM(k=0.5)
     assert est.get_params()["k"] == 0.5
