@@ -1,14 +1,46 @@
 #include "core/dgmm.h"
 
 #include <algorithm>
+#include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 
 namespace dgmm {
 namespace {
 
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
+
+// 2^(j / 128), j = 0..127.
+const std::array<double, 128> kExp2Table = [] {
+  std::array<double, 128> t;
+  for (int j = 0; j < 128; ++j) t[j] = std::exp2(j / 128.0);
+  return t;
+}();
+
+// exp(a) for a <= 0 within 2 ulp of std::exp, inline and without errno, so that the K - 1 of a
+// component draw overlap (they are on its critical path): a = (128 k + j) ln 2 / 128 + r with
+// |r| <= ln 2 / 256, exp(a) = 2^k 2^(j / 128) e^r, e^r by its degree-5 Taylor polynomial (error
+// under r^6 / 720 < 1e-18) in a short chain (Estrin's scheme). 0 below -708 (exp(a) < 2^-1021).
+double ExpNonPositive(double a) {
+  if (!(a >= -708.0)) return 0.0;
+  constexpr double kInvLn2x128 = 184.66496523378731, kShift = 6755399441055744.0;  // 1.5 * 2^52
+  constexpr double kLn2Hi = 0.6931471803691238 / 128, kLn2Lo = 1.9082149292705877e-10 / 128;
+  const double shifted = a * kInvLn2x128 + kShift;  // 128 k + j in the low bits
+  const double n = shifted - kShift;
+  const double r = (a - n * kLn2Hi) - n * kLn2Lo;
+  std::int64_t bits;
+  std::memcpy(&bits, &shifted, sizeof bits);
+  const std::int64_t n_int = bits - 0x4338000000000000;  // 128 k + j, two's complement
+  const std::int64_t scale_bits = ((n_int >> 7) + 1023) << 52;  // 2^k
+  double scale;
+  std::memcpy(&scale, &scale_bits, sizeof scale);
+  const double r2 = r * r;
+  const double p = (1.0 + r) + r2 * ((0.5 + r * (1.0 / 6)) + r2 * (1.0 / 24 + r * (1.0 / 120)));
+  return kExp2Table[n_int & 127] * p * scale;
+}
 
 }  // namespace
 
@@ -214,10 +246,10 @@ void Dgmm::MergeInto(int i, const Eigen::Ref<const Eigen::VectorXd>& x) {
   const double w_next = w + 1.0;
   delta_scratch_ = x - s.mean;
   s.mean.noalias() += delta_scratch_ / w_next;
-  // M2 += e e^T with e = sqrt(w / w') delta: each entry e_r e_c, so the scatter stays bitwise
-  // symmetric (the products commute).
-  const double c = w / w_next;
-  update_scratch_ = std::sqrt(c) * delta_scratch_;
+  // M2 += e e^T with e = sqrt(c) delta, c = w / w': each entry e_r e_c, so the scatter stays
+  // bitwise symmetric (the products commute).
+  update_weight_ = w / w_next;
+  update_scratch_ = std::sqrt(update_weight_) * delta_scratch_;
   const double* e = update_scratch_.data();
   double* m2 = s.scatter.data();
   for (int col = 0; col < dim_; ++col) {
@@ -226,6 +258,7 @@ void Dgmm::MergeInto(int i, const Eigen::Ref<const Eigen::VectorXd>& x) {
   s.count += 1;
   mixture_.SetWeight(i, static_cast<double>(s.count));
   if (!RankOneRefresh(i)) RefreshComponent(i);
+  whitened_component_ = -1;  // its factor changed
 }
 
 bool Dgmm::RankOneRefresh(int i) {
@@ -247,8 +280,13 @@ bool Dgmm::RankOneRefresh(int i) {
   if (std::abs(b_new - alpha * b_old) > 1e-12 * std::max(b_new, alpha * b_old)) return false;
   const double floor = alpha * factor_floor_[i];
   if (floor * kFloorSag < options_.covariance_floor) return false;
-  update_scratch_ *= std::sqrt(a_new);  // sqrt(a_{n+1} c) delta
-  if (!mixture_.mutable_component(i).ScaleAndRankOneUpdate(s.mean, alpha, update_scratch_)) {
+  // a_{n+1} e e^T = rho delta delta^T with rho = a_{n+1} c; L^-1 delta from ChooseComponent when
+  // it has just computed it.
+  const double rho = a_new * update_weight_;
+  const double* l_inv_delta =
+      whitened_component_ == i ? &whitened_[static_cast<std::size_t>(i) * dim_] : nullptr;
+  if (!mixture_.mutable_component(i).ScaleAndRankOneUpdate(s.mean, alpha, delta_scratch_, rho,
+                                                           l_inv_delta)) {
     return false;
   }
   factor_floor_[i] = floor;
@@ -281,16 +319,18 @@ int Dgmm::ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt199
   const int k = mixture_.size();
   if (k == 1) return 0;  // nothing to draw
   log_choice_.resize(k);
+  whitened_.resize(static_cast<std::size_t>(k) * dim_);
+  Gaussian::WhitenEach(mixture_.components(), x, whitened_.data(), log_choice_.data());
   double m = kNegInf;
   for (int i = 0; i < k; ++i) {
-    log_choice_[i] = -0.5 * mixture_.component(i).SquaredMahalanobis(x);
+    log_choice_[i] *= -0.5;
     m = std::max(m, log_choice_[i]);
   }
   double total = 0.0;
   for (int i = 0; i < k; ++i) {
-    // exp underflows to exactly 0 below -745.2: the call is skipped there (the same result).
+    // The nearest (a = 0) needs no exp; a branch on it is faster than none (it is predicted).
     const double a = log_choice_[i] - m;
-    log_choice_[i] = a == 0.0 ? mixture_.weight(i) : a < -746.0 ? 0.0 : mixture_.weight(i) * std::exp(a);
+    log_choice_[i] = mixture_.weight(i) * (a == 0.0 ? 1.0 : ExpNonPositive(a));
     total += log_choice_[i];
   }
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
@@ -298,13 +338,13 @@ int Dgmm::ChooseComponent(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt199
   double cumulative = 0.0;
   for (int i = 0; i < k; ++i) {
     cumulative += log_choice_[i];
-    if (u < cumulative) return i;
+    if (u < cumulative) return whitened_component_ = i;
   }
   // u == total by round-off: the last component with non-zero probability.
   for (int i = k - 1; i >= 0; --i) {
-    if (log_choice_[i] > 0) return i;
+    if (log_choice_[i] > 0) return whitened_component_ = i;
   }
-  return k - 1;
+  return whitened_component_ = k - 1;
 }
 
 }  // namespace dgmm

@@ -78,9 +78,9 @@ class Dgmm {
   void FloorInto(const DgmmComponentStats& stats, Eigen::MatrixXd* cov) const;
   // Rebuilds mixture_ component i from stats_[i] with the floor (a new factorisation).
   void RefreshComponent(int i);
-  // After a merge into component i (count n -> n + 1, scatter += e e^T with e in
-  // update_scratch_): updates its factor by one rank-one step when the covariance rule allows it
-  // (core/dgmm.cc); false when component i needs RefreshComponent instead.
+  // After a merge into component i (count n -> n + 1, scatter += c delta delta^T with delta in
+  // delta_scratch_ and c in update_weight_): updates its factor by one rank-one step when the
+  // covariance rule allows it (core/dgmm.cc); false when component i needs RefreshComponent.
   bool RankOneRefresh(int i);
   // The covariance rule as cov = scatter_scale * M2 + prior_weight * S0 (+ floor) for `count`.
   void CovarianceCoefficients(std::int64_t count, double* scatter_scale,
@@ -102,8 +102,13 @@ class Dgmm {
   bool max_components_hit_ = false;
   std::vector<double> log_choice_;      // scratch for ChooseComponent
   Eigen::MatrixXd covariance_scratch_;  // scratch for RefreshComponent
-  Eigen::VectorXd delta_scratch_;       // scratch for MergeInto
-  Eigen::VectorXd update_scratch_;      // e = sqrt(w / w') delta from MergeInto
+  Eigen::VectorXd delta_scratch_;       // delta = x - mean from MergeInto
+  Eigen::VectorXd update_scratch_;      // e = sqrt(c) delta there
+  double update_weight_ = 0.0;          // c = w / w' there
+  // L_i^-1 (x - mean_i) of every component from ChooseComponent (component i at i * dim), which
+  // the merge's rank-one update reuses for whitened_component_ (-1: none valid).
+  std::vector<double> whitened_;
+  int whitened_component_ = -1;
   // Per component: the floor currently inside its factor (it shrinks with the rest of the
   // covariance between factorisations) and rank-one updates since its last factorisation.
   std::vector<double> factor_floor_;

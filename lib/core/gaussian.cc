@@ -2,6 +2,7 @@
 
 #include <cassert>
 #include <cmath>
+#include <mutex>
 #include <numbers>
 
 namespace dgmm {
@@ -46,67 +47,93 @@ Gaussian MakeWithJitter(Eigen::VectorXd mean, Eigen::MatrixXd covariance) {
   return Gaussian(std::move(mean), Eigen::MatrixXd::Identity(d, d) * scale);
 }
 
-// The two hot loops of the DGMM update, written once with the dimension as a template
-// parameter: for d <= kFixedDims the compiler unrolls them and keeps the work vector in registers
-// (0 means "dimension at run time"). `l` is the column-major factor, `inv_diag` its 1 / L_jj.
+// The hot loops of the DGMM update, written once with the dimension as a template parameter: for
+// d <= 12 the compiler unrolls them and keeps the work vectors in registers (0 means "dimension at
+// run time"). `l` is the column-major factor, `inv_diag` its 1 / L_jj.
 
-// m^2 = |L^-1 (x - mean)|^2 by forward substitution, column by column.
-template <int D>
-double ForwardSquaredNorm(int d, const double* l, const double* inv_diag, const double* x,
-                          const double* mean) {
+// z_n = L_n^-1 (x - mean_n) by forward substitution, column by column, for N factors at once (their
+// dependency chains are independent, so they overlap); m2[n] = |z_n|^2.
+template <int D, int N>
+void ForwardSubstitute(int d, const double* const* l, const double* const* inv_diag,
+                       const double* x, const double* const* mean, double* const* z, double* m2) {
   if constexpr (D > 0) d = D;
-  double u[D > 0 ? D : kMaxStackDims];
-  for (int i = 0; i < d; ++i) u[i] = x[i] - mean[i];
-  double m2 = 0.0;
+  double u[N][D > 0 ? D : kMaxStackDims];
+  double sum[N];
+#pragma GCC unroll 4
+  for (int n = 0; n < N; ++n) {
+    sum[n] = 0.0;
+    for (int i = 0; i < d; ++i) u[n][i] = x[i] - mean[n][i];
+  }
 #pragma GCC unroll 12
   for (int j = 0; j < d; ++j) {
-    const double uj = u[j] * inv_diag[j];
-    m2 += uj * uj;
-    const double* col = l + static_cast<std::ptrdiff_t>(j) * d;
+#pragma GCC unroll 4
+    for (int n = 0; n < N; ++n) {
+      const double zj = u[n][j] * inv_diag[n][j];
+      z[n][j] = zj;
+      sum[n] += zj * zj;
+      const double* col = l[n] + static_cast<std::ptrdiff_t>(j) * d;
 #pragma GCC unroll 12
-    for (int i = j + 1; i < d; ++i) u[i] -= col[i] * uj;
+      for (int i = j + 1; i < d; ++i) u[n][i] -= col[i] * zj;
+    }
   }
-  return m2;
+  for (int n = 0; n < N; ++n) m2[n] = sum[n];
 }
 
-// L' = sqrt(alpha) L M with M M^T = I + p p^T, p = L^-1 x, x = w / sqrt(alpha), so that
-// L' L'^T = alpha L L^T + w w^T. M is known in closed form (Gill, Golub, Murray & Saunders 1974):
+// L' L'^T = alpha L L^T + rho w w^T by L' = sqrt(alpha) L M with M M^T = I + p p^T,
+// p = sqrt(rho / alpha) L^-1 w. M is known in closed form (Gill, Golub, Murray & Saunders 1974):
 // with b_0 = 1, b_k = b_(k-1) + p_k^2, M_kk = sqrt(b_k / b_(k-1)) and
-// M_ik = p_i p_k / sqrt(b_k b_(k-1)) for i > k, so column k of L M is
-// L_:k M_kk + p_k / sqrt(b_k b_(k-1)) * (x - sum_(j <= k) L_:j p_j), and that bracket is the
-// residual of the forward substitution for p. One pass: the only dependency chain from column to
-// column is the substitution's multiply-add; the square roots and divisions run side by side.
-// Writes L' (lower, upper zeroed) and 1 / L'_kk; returns b_d = 1 + |p|^2 (det(I + p p^T)).
+// M_ik = p_i p_k / sqrt(b_k b_(k-1)) for i > k. Written with z = L^-1 w,
+// beta_k = alpha b_k = alpha + rho sum_(j <= k) z_j^2 (beta_-1 = alpha), s_k = sqrt(beta_k),
+// t_k = 1 / s_k and r = w - sum_(j <= k) L_:j z_j (the forward substitution's residual), column k
+// of L' is c_k (s_k L_:k + rho z_k t_k r) with c_k = sqrt(alpha) t_(k-1) (c_0 = 1): the first
+// column waits for no square root of alpha or rho. One pass; a column's square root and division
+// run beside the next columns' work. z: L^-1 w when the caller has it (then no column waits for
+// the previous one), else null and z_k = r_k / L_kk (a chain from column to column).
+// Writes L' (lower, upper zeroed) and 1 / L'_kk; returns beta_(d-1) = alpha det(I + p p^T).
 template <int D>
 double RankOneUpdate(int d, const double* l, double* l_new, const double* inv_diag,
-                     double* inv_diag_new, double alpha, const double* w) {
+                     double* inv_diag_new, double alpha, double rho, const double* w,
+                     const double* z) {
   if constexpr (D > 0) d = D;
   const double root_alpha = std::sqrt(alpha), inv_root_alpha = 1.0 / root_alpha;
-  double u[D > 0 ? D : kMaxStackDims];  // residual x - sum_(j <= k) L_:j p_j
+  double r[D > 0 ? D : kMaxStackDims];
 #pragma GCC unroll 12
-  for (int i = 0; i < d; ++i) u[i] = w[i] * inv_root_alpha;
-  double b_prev = 1.0, inv_root_b_prev = 1.0, root_b_prev = 1.0;
+  for (int i = 0; i < d; ++i) r[i] = w[i];
+  double beta = alpha, s_prev = root_alpha, t_prev = inv_root_alpha;
 #pragma GCC unroll 12
   for (int k = 0; k < d; ++k) {
     const double* col = l + static_cast<std::ptrdiff_t>(k) * d;
     double* col_new = l_new + static_cast<std::ptrdiff_t>(k) * d;
-    const double p = u[k] * inv_diag[k];
-    const double b = b_prev + p * p;
-    const double root_b = std::sqrt(b), inv_root_b = 1.0 / root_b;
-    const double m_kk = root_alpha * root_b * inv_root_b_prev;  // sqrt(alpha) M_kk
-    const double gamma = root_alpha * p * inv_root_b * inv_root_b_prev;
+    const double zk = z ? z[k] : r[k] * inv_diag[k];
+    beta += rho * zk * zk;
+    const double s = std::sqrt(beta), t = 1.0 / s;
+    const double c = k == 0 ? 1.0 : root_alpha * t_prev;  // c_k
+    const double m_kk = c * s, gamma = c * rho * zk * t;
 #pragma GCC unroll 12
     for (int i = 0; i < k; ++i) col_new[i] = 0.0;
     col_new[k] = col[k] * m_kk;
-    inv_diag_new[k] = inv_diag[k] * inv_root_alpha * root_b_prev * inv_root_b;
+    inv_diag_new[k] = inv_diag[k] * t * (k == 0 ? 1.0 : s_prev * inv_root_alpha);  // / c_k
 #pragma GCC unroll 12
     for (int i = k + 1; i < d; ++i) {
-      u[i] -= col[i] * p;
-      col_new[i] = col[i] * m_kk + gamma * u[i];
+      r[i] -= col[i] * zk;
+      col_new[i] = col[i] * m_kk + gamma * r[i];
     }
-    b_prev = b, inv_root_b_prev = inv_root_b, root_b_prev = root_b;
+    s_prev = s, t_prev = t;
   }
-  return b_prev;
+  return beta;
+}
+
+// ForwardSubstitute for one and for two factors, for DGMM_DISPATCH_DIM.
+template <int D>
+void ForwardSubstituteOne(int d, const double* l, const double* inv_diag, const double* x,
+                          const double* mean, double* z, double* m2) {
+  ForwardSubstitute<D, 1>(d, &l, &inv_diag, x, &mean, &z, m2);
+}
+template <int D>
+void ForwardSubstituteTwo(int d, const double* const* l, const double* const* inv_diag,
+                          const double* x, const double* const* mean, double* const* z,
+                          double* m2) {
+  ForwardSubstitute<D, 2>(d, l, inv_diag, x, mean, z, m2);
 }
 
 // Calls Kernel<D> for D = d when d <= kFixedDims, else Kernel<0>.
@@ -136,6 +163,53 @@ Gaussian::Gaussian(Eigen::VectorXd mean, Eigen::MatrixXd covariance) {
   assert(ok && "Gaussian: covariance must be symmetric positive definite");
 }
 
+Gaussian::Gaussian(const Gaussian& other)
+    : mean_(other.mean_),
+      covariance_(other.covariance()),
+      l_(other.l_),
+      log_det_(other.log_det_),
+      det_factor_(other.det_factor_),
+      inv_diag_(other.inv_diag_) {}
+
+Gaussian::Gaussian(Gaussian&& other) noexcept
+    : mean_(std::move(other.mean_)),
+      covariance_(std::move(other.covariance_)),
+      covariance_stale_(other.covariance_stale_.load(std::memory_order_relaxed)),
+      l_(std::move(other.l_)),
+      log_det_(other.log_det_),
+      det_factor_(other.det_factor_),
+      inv_diag_(std::move(other.inv_diag_)) {}
+
+Gaussian& Gaussian::operator=(const Gaussian& other) {
+  if (this != &other) *this = Gaussian(other);
+  return *this;
+}
+
+Gaussian& Gaussian::operator=(Gaussian&& other) noexcept {
+  mean_ = std::move(other.mean_);
+  covariance_ = std::move(other.covariance_);
+  covariance_stale_.store(other.covariance_stale_.load(std::memory_order_relaxed),
+                          std::memory_order_relaxed);
+  l_ = std::move(other.l_);
+  log_det_ = other.log_det_;
+  det_factor_ = other.det_factor_;
+  inv_diag_ = std::move(other.inv_diag_);
+  return *this;
+}
+
+void Gaussian::RestoreCovariance() const {
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (!covariance_stale_.load(std::memory_order_relaxed)) return;  // another thread did it
+  const int d = dim();
+  for (int j = 0; j < d; ++j) {  // c_ij = c_ji = sum_(k <= j) L_ik L_jk
+    for (int i = j; i < d; ++i) {
+      covariance_(i, j) = covariance_(j, i) = l_.row(i).head(j + 1).dot(l_.row(j).head(j + 1));
+    }
+  }
+  covariance_stale_.store(false, std::memory_order_release);
+}
+
 std::optional<Gaussian> Gaussian::Create(Eigen::VectorXd mean, Eigen::MatrixXd covariance) {
   Gaussian g;
   if (!g.Set(std::move(mean), std::move(covariance))) return std::nullopt;
@@ -148,8 +222,10 @@ bool Gaussian::Set(Eigen::VectorXd mean, Eigen::MatrixXd covariance) {
   if (!Factor(covariance, &l)) return false;
   mean_ = std::move(mean);
   covariance_ = std::move(covariance);
+  covariance_stale_.store(false, std::memory_order_relaxed);
   l_ = std::move(l);
   log_det_ = 2.0 * l_.diagonal().array().log().sum();
+  det_factor_ = 1.0;
   inv_diag_ = l_.diagonal().cwiseInverse();
   return true;
 }
@@ -171,43 +247,50 @@ bool Gaussian::SetInPlace(const Eigen::Ref<const Eigen::VectorXd>& mean,
   l_.swap(scratch_);
   mean_ = mean;
   covariance_ = covariance;
+  covariance_stale_.store(false, std::memory_order_relaxed);
   log_det_ = 2.0 * l_.diagonal().array().log().sum();
+  det_factor_ = 1.0;
   inv_diag_ = l_.diagonal().cwiseInverse();
   return true;
 }
 
 bool Gaussian::ScaleAndRankOneUpdate(const Eigen::Ref<const Eigen::VectorXd>& mean, double alpha,
-                                     const Eigen::Ref<const Eigen::VectorXd>& v) {
+                                     const Eigen::Ref<const Eigen::VectorXd>& v, double rho,
+                                     const double* l_inv_v) {
   const int d = dim();
   assert(mean.size() == d && v.size() == d);
-  if (!(alpha > 0.0) || !std::isfinite(alpha) || !v.allFinite() || !mean.allFinite() ||
-      v.innerStride() != 1) {
+  if (!(alpha > 0.0) || !std::isfinite(alpha) || !(rho >= 0.0) || !std::isfinite(rho) ||
+      !v.allFinite() || !mean.allFinite()) {
     return false;
   }
   if (d > kMaxStackDims) {  // rare: refactorise the updated covariance
-    Eigen::MatrixXd c = alpha * covariance_ + v * v.transpose();
+    const Eigen::MatrixXd vv = v * v.transpose();  // bitwise symmetric: v_i v_j = v_j v_i
+    const Eigen::MatrixXd c = alpha * covariance() + rho * vv;
     return SetInPlace(mean, c);
   }
   scratch_.resize(d, d);  // the new factor
   inv_diag_scratch_.resize(d);
-  const double b = DGMM_DISPATCH_DIM(d, RankOneUpdate, d, l_.data(), scratch_.data(),
-                                     inv_diag_.data(), inv_diag_scratch_.data(), alpha, v.data());
-  // det(alpha L L^T + w w^T) = alpha^d det(L L^T) (1 + |p|^2) (matrix determinant lemma).
-  double scale = b;  // alpha^d b, by multiplication (pow is slow)
-  for (int i = 0; i < d; ++i) scale *= alpha;
-  const double log_det = log_det_ + std::log(scale);
+  const double beta = DGMM_DISPATCH_DIM(d, RankOneUpdate, d, l_.data(), scratch_.data(),
+                                        inv_diag_.data(), inv_diag_scratch_.data(), alpha, rho,
+                                        v.data(), l_inv_v);
+  // det(alpha L L^T + rho v v^T) = alpha^d det(L L^T) (1 + |p|^2) (matrix determinant lemma); the
+  // factor is multiplied into det_factor_ and its log taken only when that leaves [1e-100, 1e100].
+  double scale = beta;  // alpha^d (1 + |p|^2) = alpha^(d-1) beta, by multiplication (pow is slow)
+  for (int i = 1; i < d; ++i) scale *= alpha;
+  double det_factor = det_factor_ * scale, log_det = log_det_;
+  if (!(det_factor > 1e-100 && det_factor < 1e100)) {
+    log_det += std::log(det_factor_) + std::log(scale);
+    det_factor = 1.0;
+  }
   // Finite inputs give a finite result unless something overflowed, which shows on the diagonal
   // (sum_k L'_ik^2 = covariance'_ii) or in log det.
   if (!std::isfinite(log_det) || !scratch_.diagonal().allFinite()) return false;
   l_.swap(scratch_);
   inv_diag_.swap(inv_diag_scratch_);
   mean_ = mean;
-  // alpha c_ij + v_i v_j is bitwise symmetric because c is: the products commute.
-  double* c = covariance_.data();
-  for (int col = 0; col < d; ++col) {
-    for (int row = 0; row < d; ++row, ++c) *c = alpha * *c + v[row] * v[col];
-  }
+  covariance_stale_.store(true, std::memory_order_relaxed);  // covariance() rebuilds it
   log_det_ = log_det;
+  det_factor_ = det_factor;
   return true;
 }
 
@@ -215,23 +298,54 @@ double Gaussian::SquaredMahalanobis(const Eigen::Ref<const Eigen::VectorXd>& x) 
   assert(x.size() == mean_.size());
   const int d = dim();
   if (d <= kMaxStackDims && x.innerStride() == 1) {
-    return DGMM_DISPATCH_DIM(d, ForwardSquaredNorm, d, l_.data(), inv_diag_.data(), x.data(),
-                             mean_.data());
+    double z[kMaxStackDims], m2;
+    DGMM_DISPATCH_DIM(d, ForwardSubstituteOne, d, l_.data(), inv_diag_.data(), x.data(),
+                      mean_.data(), z, &m2);
+    return m2;
   }
   Eigen::VectorXd u = x - mean_;
   l_.triangularView<Eigen::Lower>().solveInPlace(u);
   return u.squaredNorm();
 }
 
+void Gaussian::WhitenEach(const std::vector<Gaussian>& gaussians,
+                          const Eigen::Ref<const Eigen::VectorXd>& x, double* z, double* m2) {
+  const int k = static_cast<int>(gaussians.size()), d = static_cast<int>(x.size());
+  if (d > kMaxStackDims || x.innerStride() != 1) {
+    for (int i = 0; i < k; ++i) {
+      Eigen::Map<Eigen::VectorXd> zi(z + static_cast<std::ptrdiff_t>(i) * d, d);
+      zi = x - gaussians[i].mean_;
+      gaussians[i].l_.triangularView<Eigen::Lower>().solveInPlace(zi);
+      m2[i] = zi.squaredNorm();
+    }
+    return;
+  }
+  int i = 0;
+  for (; i + 2 <= k; i += 2) {  // two at a time: their substitutions overlap
+    const Gaussian &g0 = gaussians[i], &g1 = gaussians[i + 1];
+    const double* l[2] = {g0.l_.data(), g1.l_.data()};
+    const double* inv_diag[2] = {g0.inv_diag_.data(), g1.inv_diag_.data()};
+    const double* mean[2] = {g0.mean_.data(), g1.mean_.data()};
+    double* zs[2] = {z + static_cast<std::ptrdiff_t>(i) * d,
+                     z + static_cast<std::ptrdiff_t>(i + 1) * d};
+    DGMM_DISPATCH_DIM(d, ForwardSubstituteTwo, d, l, inv_diag, x.data(), mean, zs, m2 + i);
+  }
+  if (i < k) {
+    const Gaussian& g = gaussians[i];
+    DGMM_DISPATCH_DIM(d, ForwardSubstituteOne, d, g.l_.data(), g.inv_diag_.data(), x.data(),
+                      g.mean_.data(), z + static_cast<std::ptrdiff_t>(i) * d, m2 + i);
+  }
+}
+
 double Gaussian::LogDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const {
-  return -0.5 * (dim() * kLog2Pi + log_det_ + SquaredMahalanobis(x));
+  return -0.5 * (dim() * kLog2Pi + log_det() + SquaredMahalanobis(x));
 }
 
 Eigen::VectorXd Gaussian::LogDensity(const Eigen::Ref<const Eigen::MatrixXd>& X) const {
   assert(X.rows() == mean_.size());
   Eigen::MatrixXd u = X.colwise() - mean_;
   l_.triangularView<Eigen::Lower>().solveInPlace(u);
-  const double c = dim() * kLog2Pi + log_det_;
+  const double c = dim() * kLog2Pi + log_det();
   return (-0.5 * (u.colwise().squaredNorm().array() + c)).transpose();
 }
 
@@ -240,19 +354,21 @@ double Gaussian::ScaledDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const
 }
 
 Gaussian Gaussian::Marginal(const std::vector<int>& dims) const {
+  const Eigen::MatrixXd& c = covariance();
   const int k = static_cast<int>(dims.size());
   Eigen::VectorXd m(k);
   Eigen::MatrixXd s(k, k);
   for (int i = 0; i < k; ++i) {
     assert(dims[i] >= 0 && dims[i] < dim());
     m[i] = mean_[dims[i]];
-    for (int j = 0; j < k; ++j) s(i, j) = covariance_(dims[i], dims[j]);
+    for (int j = 0; j < k; ++j) s(i, j) = c(dims[i], dims[j]);
   }
   return MakeWithJitter(std::move(m), std::move(s));
 }
 
 Gaussian Gaussian::Conditional(const std::vector<int>& given_dims,
                                const Eigen::Ref<const Eigen::VectorXd>& values) const {
+  const Eigen::MatrixXd& c = covariance();
   assert(static_cast<int>(given_dims.size()) == values.size());
   const std::vector<int> a = ComplementDims(dim(), given_dims);
   const std::vector<int>& b = given_dims;
@@ -261,12 +377,12 @@ Gaussian Gaussian::Conditional(const std::vector<int>& given_dims,
   Eigen::MatrixXd s_aa(na, na), s_ab(na, nb), s_bb(nb, nb);
   for (int i = 0; i < na; ++i) {
     mean_a[i] = mean_[a[i]];
-    for (int j = 0; j < na; ++j) s_aa(i, j) = covariance_(a[i], a[j]);
-    for (int j = 0; j < nb; ++j) s_ab(i, j) = covariance_(a[i], b[j]);
+    for (int j = 0; j < na; ++j) s_aa(i, j) = c(a[i], a[j]);
+    for (int j = 0; j < nb; ++j) s_ab(i, j) = c(a[i], b[j]);
   }
   for (int i = 0; i < nb; ++i) {
     mean_b[i] = mean_[b[i]];
-    for (int j = 0; j < nb; ++j) s_bb(i, j) = covariance_(b[i], b[j]);
+    for (int j = 0; j < nb; ++j) s_bb(i, j) = c(b[i], b[j]);
   }
   if (nb == 0) return MakeWithJitter(std::move(mean_a), std::move(s_aa));
   const Eigen::LLT<Eigen::MatrixXd> llt_bb(s_bb);
@@ -279,7 +395,7 @@ Gaussian Gaussian::Conditional(const std::vector<int>& given_dims,
 
 Gaussian Gaussian::Affine(const Eigen::MatrixXd& A, const Eigen::VectorXd& b) const {
   assert(A.cols() == dim() && A.rows() == b.size());
-  return MakeWithJitter(A * mean_ + b, A * covariance_ * A.transpose());
+  return MakeWithJitter(A * mean_ + b, A * covariance() * A.transpose());
 }
 
 Eigen::VectorXd Gaussian::Sample(std::mt19937_64& rng) const {

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <string>
+#include <vector>
 
 #include "core_test_utils.h"
 
@@ -124,6 +126,57 @@ TEST(GaussianTest, ScaleAndRankOneUpdateEqualsRefactorisation) {
   }
 }
 
+// WhitenEach gives each Gaussian's L^-1 (x - mean) and m^2 (two at a time and the odd one alone,
+// unrolled sizes, the run-time-size loop and the Eigen path beyond the stack).
+TEST(GaussianTest, WhitenEachEqualsForwardSubstitution) {
+  std::mt19937_64 rng(13);
+  for (int d : {1, 3, 8, 13, 40}) {
+    for (int k : {1, 2, 5}) {
+      SCOPED_TRACE("d = " + std::to_string(d) + ", k = " + std::to_string(k));
+      std::vector<Gaussian> gaussians;
+      for (int i = 0; i < k; ++i) gaussians.emplace_back(RandomVector(d, rng), RandomSpd(d, rng));
+      const Eigen::VectorXd x = RandomVector(d, rng);
+      std::vector<double> z(static_cast<std::size_t>(k) * d), m2(k);
+      Gaussian::WhitenEach(gaussians, x, z.data(), m2.data());
+      for (int i = 0; i < k; ++i) {
+        const Gaussian& g = gaussians[i];
+        const Eigen::VectorXd want =
+            g.cholesky_l().triangularView<Eigen::Lower>().solve(x - g.mean());
+        const Eigen::Map<const Eigen::VectorXd> got(&z[static_cast<std::size_t>(i) * d], d);
+        EXPECT_LE((got - want).norm(), kTol * (1 + want.norm()));
+        EXPECT_NEAR(m2[i], g.SquaredMahalanobis(x), kTol * (1 + m2[i]));
+      }
+    }
+  }
+}
+
+// covariance <- alpha covariance + rho v v^T, with L^-1 v given or not; covariance() of the updated
+// Gaussian (rebuilt from the factor when read) and of its copies.
+TEST(GaussianTest, ScaleAndRankOneUpdateWithWeightAndGivenSolve) {
+  std::mt19937_64 rng(14);
+  for (int d : {1, 4, 8, 12, 20, 40}) {
+    SCOPED_TRACE("d = " + std::to_string(d));
+    const Eigen::MatrixXd s = RandomSpd(d, rng);
+    const Eigen::VectorXd mean = RandomVector(d, rng), v = RandomVector(d, rng);
+    const double alpha = 0.97, rho = 0.3;
+    const Gaussian want(mean, alpha * s + rho * v * v.transpose());
+    Gaussian given(RandomVector(d, rng), s);
+    Gaussian computed = given;
+    const Eigen::VectorXd l_inv_v = given.cholesky_l().triangularView<Eigen::Lower>().solve(v);
+    ASSERT_TRUE(given.ScaleAndRankOneUpdate(mean, alpha, v, rho, l_inv_v.data()));
+    ASSERT_TRUE(computed.ScaleAndRankOneUpdate(mean, alpha, v, rho));
+    for (const Gaussian* g : {&given, &computed}) {
+      const Gaussian copy = *g;
+      EXPECT_LE((g->cholesky_l() - want.cholesky_l()).norm(), kTol * want.cholesky_l().norm());
+      EXPECT_NEAR(g->log_det(), want.log_det(), kTol * std::max(1.0, std::abs(want.log_det())));
+      EXPECT_LE((copy.covariance() - want.covariance()).norm(), kTol * want.covariance().norm());
+      EXPECT_EQ(g->covariance(), copy.covariance());
+      EXPECT_EQ(g->covariance(), g->covariance().transpose());
+      EXPECT_EQ(g->mean(), mean);
+    }
+  }
+}
+
 TEST(GaussianTest, ScaleAndRankOneUpdateRefusesBadInput) {
   std::mt19937_64 rng(12);
   Gaussian g(RandomVector(3, rng), RandomSpd(3, rng));
@@ -134,6 +187,8 @@ TEST(GaussianTest, ScaleAndRankOneUpdateRefusesBadInput) {
   Eigen::VectorXd bad = v;
   bad[1] = std::numeric_limits<double>::infinity();
   EXPECT_FALSE(g.ScaleAndRankOneUpdate(g.mean(), 0.5, bad));
+  EXPECT_FALSE(g.ScaleAndRankOneUpdate(g.mean(), 0.5, v, -1.0));
+  EXPECT_FALSE(g.ScaleAndRankOneUpdate(g.mean(), 0.5, v, std::numeric_limits<double>::infinity()));
   EXPECT_EQ(g.covariance(), before.covariance());
   EXPECT_EQ(g.cholesky_l(), before.cholesky_l());
 }
