@@ -240,9 +240,7 @@ predict::StepPersistence PersistenceFrom(const MotionModel& model, const std::st
 // The regions' factors from the held-out episodes of `path`, printed one line per horizon.
 predict::RegionCalibration CalibrationFrom(const MotionModel& model, const std::string& path,
                                            const predict::PredictOptions& options) {
-  predict::CalibrationOptions calibration;
-  calibration.trajectories = options.trajectories;
-  const predict::RegionCalibration c = predict::CalibrateRegions(model, ReadSampleSet(path), options, calibration, path);
+  const predict::RegionCalibration c = predict::CalibrateRegions(model, ReadSampleSet(path), options, {}, path);
   std::printf("regions calibrated on %s: r2 of the 50%% and 90%% regions times (held-out episodes)\n", path.c_str());
   for (Eigen::Index k = 0; k < c.factor.rows(); ++k) {
     std::printf("  after %2ld commands  x%.2f  x%.2f  (%d episodes)\n", static_cast<long>(k + 1), c.factor(k, 0),

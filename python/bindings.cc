@@ -274,13 +274,13 @@ void BindFitAndPredict(py::module_& m) {
            const std::vector<std::string>& pose_dims, const std::optional<py::dict>& persistence, bool walking,
            const std::vector<double>& levels, int min_episodes) {
           predict::PredictOptions o;
+          o.trajectories = trajectories;
           o.seed = seed;
           o.pose_dims = pose_dims;
           o.persistence = PersistenceFromDict(persistence);
           o.from_rest = !walking;
+          o.region_levels = levels;
           predict::CalibrationOptions c;
-          c.levels = levels;
-          c.trajectories = trajectories;
           c.min_episodes = min_episodes;
           const predict::RegionCalibration r = predict::CalibrateRegions(model, set, o, c);
           py::dict out;

@@ -50,7 +50,7 @@ Eigen::Matrix3d Zyx(double yaw, double pitch, double roll) {
 // (p - m)^T C^-1 (p - m) in (x, y) of each row of `points` under the step's mean and covariance.
 Eigen::VectorXd Distance2(const StepPrediction& s, const Eigen::MatrixX2d& points) {
   Eigen::Matrix2d c = s.covariance.topLeftCorner<2, 2>();
-  c.diagonal().array() += 1e-12 * std::max(c.trace(), 1e-300);  // all trajectories equal: still factors
+  c.diagonal().array() += 1e-12 * (c.trace() > 0 ? c.trace() : 1.0);  // as the fan's: all equal still factors
   const Eigen::LLT<Eigen::Matrix2d> llt(c);
   const Eigen::MatrixX2d centred = points.rowwise() - s.mean.head<2>().transpose();
   return llt.matrixL().solve(centred.transpose()).colwise().squaredNorm().transpose();

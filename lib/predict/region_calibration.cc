@@ -57,23 +57,15 @@ double ConformalQuantile(std::vector<double> v, double level) {
 
 }  // namespace
 
-bool CalibrationOptions::IsValid(std::string* error) const {
-  const bool levels_ok = !levels.empty() && std::all_of(levels.begin(), levels.end(), [](double l) { return l > 0 && l < 1; });
-  if (!levels_ok || trajectories < 2 || min_episodes < 1) {
-    if (error) *error = "calibration: expected levels in (0, 1), trajectories >= 2 and min_episodes >= 1";
-    return false;
-  }
-  return true;
-}
-
 RegionCalibration CalibrateRegions(const MotionModel& model, const SampleSet& held_out, const PredictOptions& prediction,
                                    const CalibrationOptions& options, const std::string& source) {
-  if (std::string e; !options.IsValid(&e)) throw MakeInputError("calibration", "options", e);
-  CheckEpisodeSet(model, held_out, source, "calibration");
   PredictOptions o = prediction;
   o.calibration = {};
-  o.region_levels = options.levels;
-  o.trajectories = options.trajectories;
+  if (std::string e; !o.IsValid(&e)) throw MakeInputError("calibration", "options", e);
+  if (o.trajectories < 2 || options.min_episodes < 1) {
+    throw MakeInputError("calibration", "options", "expected trajectories >= 2 and min_episodes >= 1");
+  }
+  CheckEpisodeSet(model, held_out, source, "calibration");
   const std::vector<std::vector<int>> episodes = Episodes(held_out);
   std::vector<std::vector<std::vector<double>>> ratios;  // horizon -> level -> one per episode reaching it
   for (std::size_t e = 0; e < episodes.size(); ++e) {
@@ -85,12 +77,12 @@ RegionCalibration CalibrateRegions(const MotionModel& model, const SampleSet& he
     }
   }
   RegionCalibration out;
-  out.levels = options.levels;
+  out.levels = o.region_levels;
   for (std::size_t k = 0; k < ratios.size() && static_cast<int>(ratios[k][0].size()) >= options.min_episodes; ++k) {
-    out.factor.conservativeResize(k + 1, options.levels.size());
+    out.factor.conservativeResize(k + 1, out.levels.size());
     out.episodes.conservativeResize(k + 1);
     out.episodes[k] = static_cast<int>(ratios[k][0].size());
-    for (std::size_t l = 0; l < options.levels.size(); ++l) out.factor(k, l) = ConformalQuantile(ratios[k][l], options.levels[l]);
+    for (std::size_t l = 0; l < out.levels.size(); ++l) out.factor(k, l) = ConformalQuantile(ratios[k][l], out.levels[l]);
   }
   if (out.empty()) {
     throw MakeInputError(source, "episode", "expected at least " + std::to_string(options.min_episodes) +

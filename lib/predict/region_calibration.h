@@ -19,14 +19,11 @@
 namespace dgmm::predict {
 
 struct CalibrationOptions {
-  std::vector<double> levels{0.5, 0.9};
-  int trajectories = 1000;  // per held-out episode
-  int min_episodes = 20;    // a horizon reached by fewer episodes takes the previous horizon's factor
-  bool IsValid(std::string* error) const;
+  int min_episodes = 20;  // a horizon reached by fewer episodes takes the previous horizon's factor
 };
 
 // `prediction`: the options the calibrated predictions will use (persistence, pose dimensions,
-// seed; its own calibration is ignored). The set must be raw, record episodes and steps, and give
+// trajectories, seed, region_levels: the levels calibrated; its own calibration is ignored). The set must be raw, record episodes and steps, and give
 // the model's pose and terrain dimensions; each episode starts at its step 0 and runs to its
 // first missing step. InputError naming `source` and the part otherwise, or when no horizon is
 // reached by options.min_episodes episodes.

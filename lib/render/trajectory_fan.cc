@@ -30,10 +30,6 @@ PlotRange FanRange(const std::vector<Eigen::MatrixX2d>& steps, const Eigen::Vect
   return {cx - half, cx + half, cy - half, cy + half};  // square: distances read the same on both axes
 }
 
-}  // namespace
-
-namespace {
-
 // Mean, covariance factor and squared Mahalanobis distances of 2-D points (rows).
 struct PointSpread {
   Eigen::RowVector2d mean;
@@ -58,6 +54,7 @@ PointSpread SpreadOf(const Eigen::MatrixX2d& points) {
   return s;
 }
 
+// The ellipse {p : (p - mean)^T C^-1 (p - mean) = r2}, `segments` + 1 points, closed.
 Eigen::MatrixX2d Ellipse(const PointSpread& s, double r2, int segments) {
   const double r = std::sqrt(std::max(r2, 0.0));
   Eigen::MatrixX2d ellipse(segments + 1, 2);
@@ -73,10 +70,6 @@ Eigen::MatrixX2d Ellipse(const PointSpread& s, double r2, int segments) {
 Eigen::MatrixX2d RegionEllipse(const Eigen::MatrixX2d& points, double share, int segments) {
   const PointSpread s = SpreadOf(points);
   return Ellipse(s, Quantile(s.d2, share), segments);
-}
-
-Eigen::MatrixX2d RegionEllipseWithRadius2(const Eigen::MatrixX2d& points, double r2, int segments) {
-  return Ellipse(SpreadOf(points), r2, segments);
 }
 
 HeatMapSpec TrajectoryFan(const std::vector<Eigen::MatrixX2d>& steps, const Eigen::Vector2d& start,
@@ -104,11 +97,10 @@ HeatMapSpec TrajectoryFan(const std::vector<Eigen::MatrixX2d>& steps, const Eige
   for (std::size_t k = 0; k < steps.size(); ++k) {
     means.row(k) = steps[k].colwise().mean();
     path.row(k + 1) = means.row(k);
+    const PointSpread s = SpreadOf(steps[k]);  // one spread for both regions
     const bool given = k < region_r2.size() && region_r2[k].size() == 2;
-    spec.curves.push_back({given ? RegionEllipseWithRadius2(steps[k], region_r2[k][0]) : RegionEllipse(steps[k], 0.5),
-                           {255, 255, 255}, 1.5f});
-    spec.curves.push_back({given ? RegionEllipseWithRadius2(steps[k], region_r2[k][1]) : RegionEllipse(steps[k], 0.9),
-                           {255, 150, 40}, 1.5f});
+    spec.curves.push_back({Ellipse(s, given ? region_r2[k][0] : Quantile(s.d2, 0.5), 64), {255, 255, 255}, 1.5f});
+    spec.curves.push_back({Ellipse(s, given ? region_r2[k][1] : Quantile(s.d2, 0.9), 64), {255, 150, 40}, 1.5f});
   }
   spec.curves.push_back({path, {80, 220, 255}, 2.0f});
   spec.points = means;

@@ -15,8 +15,6 @@ namespace dgmm {
 // {p : (p - m)^T C^-1 (p - m) <= r^2}, m and C their mean and covariance, r^2 the share-quantile of
 // the points' own squared Mahalanobis distances; `segments` + 1 points, closed.
 Eigen::MatrixX2d RegionEllipse(const Eigen::MatrixX2d& points, double share, int segments = 64);
-// The same ellipse with r^2 given (a calibrated region, say).
-Eigen::MatrixX2d RegionEllipseWithRadius2(const Eigen::MatrixX2d& points, double r2, int segments = 64);
 
 // steps[k]: the (x, y) of every trajectory after command k + 1 (rows); start: (x, y) before;
 // region_r2[k] (if given): r^2 of step k's 50% and 90% regions (otherwise the points' own quantiles).

@@ -66,18 +66,16 @@ Eigen::Vector2d Coverage(const SampleSet& set, int steps, const PredictOptions& 
   return inside / episodes;
 }
 
-PredictOptions Options() {
+PredictOptions Options(int trajectories = 4000) {
   PredictOptions o;
-  o.trajectories = 4000;
+  o.trajectories = trajectories;
   o.seed = 3;
   return o;
 }
 
 TEST(CalibrateRegions, ATooNarrowModelsRegionsAreWidenedToHoldTheirShares) {
   const SampleSet held_out = Episodes(400, 5, 1.5, 1), fresh = Episodes(400, 5, 1.5, 2);
-  CalibrationOptions c;
-  c.trajectories = 500;
-  const RegionCalibration cal = CalibrateRegions(Walk(), held_out, Options(), c);
+  const RegionCalibration cal = CalibrateRegions(Walk(), held_out, Options(500));
   ASSERT_EQ(cal.factor.rows(), 5);
   ASSERT_EQ(cal.factor.cols(), 2);
   EXPECT_EQ(cal.episodes[4], 400);
@@ -92,9 +90,7 @@ TEST(CalibrateRegions, ATooNarrowModelsRegionsAreWidenedToHoldTheirShares) {
 }
 
 TEST(CalibrateRegions, ARightModelKeepsItsRegions) {
-  CalibrationOptions c;
-  c.trajectories = 500;
-  const RegionCalibration cal = CalibrateRegions(Walk(), Episodes(400, 5, 1.0, 5), Options(), c);
+  const RegionCalibration cal = CalibrateRegions(Walk(), Episodes(400, 5, 1.0, 5), Options(500));
   for (int k = 0; k < 5; ++k) {
     EXPECT_NEAR(cal.factor(k, 0), 1.0, 0.3) << k;
     EXPECT_NEAR(cal.factor(k, 1), 1.0, 0.3) << k;
@@ -104,13 +100,12 @@ TEST(CalibrateRegions, ARightModelKeepsItsRegions) {
 TEST(CalibrateRegions, ShortEpisodesCalibrateTheHorizonsTheyReach) {
   SampleSet set = Episodes(30, 4, 1.0, 7);
   CalibrationOptions c;
-  c.trajectories = 200;
   c.min_episodes = 30;
-  const RegionCalibration cal = CalibrateRegions(Walk(), set, Options(), c);
+  const RegionCalibration cal = CalibrateRegions(Walk(), set, Options(200), c);
   EXPECT_EQ(cal.factor.rows(), 4);
   EXPECT_EQ(cal.Factor(9, 1), cal.factor(3, 1)) << "later steps take the last horizon's factor";
   set.step[set.size() - 1] = 9;  // a gap: that episode reaches 3 steps only
-  EXPECT_EQ(CalibrateRegions(Walk(), set, Options(), c).factor.rows(), 3);
+  EXPECT_EQ(CalibrateRegions(Walk(), set, Options(200), c).factor.rows(), 3);
 }
 
 TEST(CalibrateRegions, ABadSetOrOptionsAreRefusedNamingThePart) {
@@ -125,9 +120,13 @@ TEST(CalibrateRegions, ABadSetOrOptionsAreRefusedNamingThePart) {
     EXPECT_NE(std::string(e.what()).find("episode"), std::string::npos) << e.what();
   }
   EXPECT_THROW(CalibrateRegions(Walk(), Episodes(5, 4, 1.0, 7), Options()), InputError) << "fewer than 20 episodes";
-  CalibrationOptions bad;
-  bad.levels = {0.5, 1.0};
-  EXPECT_THROW(CalibrateRegions(Walk(), Episodes(30, 4, 1.0, 7), Options(), bad), InputError);
+  PredictOptions bad_levels = Options(200);
+  bad_levels.region_levels = {0.5, 1.0};
+  EXPECT_THROW(CalibrateRegions(Walk(), Episodes(30, 4, 1.0, 7), bad_levels), InputError);
+  CalibrationOptions no_episodes_needed;
+  no_episodes_needed.min_episodes = 0;
+  EXPECT_THROW(CalibrateRegions(Walk(), Episodes(30, 4, 1.0, 7), Options(200), no_episodes_needed), InputError);
+  EXPECT_THROW(CalibrateRegions(Walk(), Episodes(30, 4, 1.0, 7), Options(1)), InputError) << "one trajectory has no spread";
   PredictOptions o = Options();
   o.calibration.levels = {0.5, 0.9};
   o.calibration.factor = Eigen::MatrixXd::Constant(3, 1, 1.0);  // one level's factors for two levels
