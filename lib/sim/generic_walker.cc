@@ -15,7 +15,7 @@ GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Gr
     : config_(config), model_(std::move(model)), ground_(&ground), source_(source) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
   for (const LegChain& leg : robot_.legs) sides_.push_back(leg.side);
-  ApplyExperiment(config, robot_, model_.get());
+  ApplyExperiment(config, robot_, model_.get(), source);
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
   control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
 }

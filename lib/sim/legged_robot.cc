@@ -3,6 +3,7 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <set>
 
 #include "sim/replay.h"
@@ -365,8 +366,30 @@ void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass, do
   m->body_mass[torso] = m0 + mass;
 }
 
-void ApplyExperiment(const SimConfig& config, const LeggedRobot& b, mjModel* m) {
+namespace {
+
+// The payload against the robot's own scale (the config's check is only for finite numbers).
+void CheckPayload(const PayloadConfig& p, const LeggedRobot& b, const mjModel* m, const std::string& source) {
+  double robot_kg = 0;
+  for (int i = 1; i < m->nbody; ++i) robot_kg += m->body_mass[i];
+  char what[160];
+  if (p.mass_kg > 10 * robot_kg) {
+    std::snprintf(what, sizeof what, "%.4g kg is over 10 times the robot's mass (%.4g kg)", p.mass_kg, robot_kg);
+    throw MakeInputError(source, "payload.mass_kg", what);
+  }
+  const double distance = p.position_body_m.norm();
+  if (p.mass_kg > 0 && distance > 2 * b.reach_m) {
+    std::snprintf(what, sizeof what, "%.4g m from the torso, expected within 2 leg reaches (%.4g m)", distance,
+                  2 * b.reach_m);
+    throw MakeInputError(source, "payload.position_body_m", what);
+  }
+}
+
+}  // namespace
+
+void ApplyExperiment(const SimConfig& config, const LeggedRobot& b, mjModel* m, const std::string& source) {
   const RobotDescription& r = *config.robot;
+  CheckPayload(config.payload, b, m, source);
   m->opt.timestep = config.timestep_s;
   const double g = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]).norm();
   const double slope = config.slope_deg * M_PI / 180;

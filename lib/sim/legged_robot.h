@@ -51,13 +51,15 @@ LeggedRobot BindRobot(const mjModel* model, const RobotDescription& robot, const
 // The model's own physics kept; only what the experiment sets: timestep and the slope (gravity
 // tilted, magnitude kept), per-leg gains (robot.leg_gain) on the leg's servos and a payload
 // (config.payload: mass on the torso at (forward, left, up) offsets). With
-// robot.overwrite_physics, config.friction replaces every geom's friction.
-void ApplyExperiment(const SimConfig& config, const LeggedRobot& bound, mjModel* model);
+// robot.overwrite_physics, config.friction replaces every geom's friction. Throws InputError
+// "<source>: payload.<field>: ..." for a payload over 10 times the robot's mass or further than
+// 2 leg reaches from the torso (relative bounds: a robot of any size).
+void ApplyExperiment(const SimConfig& config, const LeggedRobot& bound, mjModel* model, const std::string& source = "");
 
-// A compact payload (3 cm) rigidly added to body `torso` at `p_m` (body frame): the body's mass,
-// centre of mass and inertia (parallel axes, in its principal frame: an approximation when that
-// frame is rotated) updated.
-void AddPayload(mjModel* model, int torso, const Eigen::Vector3d& p_m, double mass_kg);
+// A compact ball (radius 0.1 leg reach) rigidly added to body `torso` at `p_m` (body frame): the
+// body's mass, centre of mass and inertia (parallel axes, in its principal frame: an approximation
+// when that frame is rotated) updated.
+void AddPayload(mjModel* model, int torso, const Eigen::Vector3d& p_m, double mass_kg, double reach_m);
 
 // Damped least squares on the foot's Jacobian restricted to the leg's joints, joint ranges
 // respected: moves `q` (the leg's joint values) towards placing the foot at `target_m` (torso

@@ -83,7 +83,8 @@ LogRecordSummary RecordLog(const SimConfig& config, const LogRecordOptions& opti
     if (session > 0) {
       clock_offset += options.gap_min_s + (options.gap_max_s - options.gap_min_s) * uniform(rng);
     }
-    const double x = 2 * uniform(rng) - 1, y = 2 * uniform(rng) - 1;
+    const double half = sim.placement_half_width_m();
+    const double x = half * (2 * uniform(rng) - 1), y = half * (2 * uniform(rng) - 1);
     const double heading = std::numbers::pi * (2 * uniform(rng) - 1);
     if (sim.Place(x, y, heading) != RunOutcome::kCompleted) {
       ++summary.falls;

@@ -27,7 +27,7 @@ struct Placement {
   std::vector<int> sequence;  // kTrajectories: the command of each execution (else `command` repeats)
   std::vector<Eigen::Vector3d> values;  // kContinuous: the command of each execution
   double heading_rad = 0;  // slope frame, 0 = facing uphill
-  double x_m = 0, y_m = 0;
+  double x_unit = 0, y_unit = 0;  // in [-1, 1]: times Simulator::placement_half_width_m()
 };
 
 std::string FormatLevel(double v) {
@@ -60,7 +60,7 @@ void FillCommandTable(SampleSet* set) {
 
 std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_commands,
                                       std::mt19937_64& rng) {
-  std::uniform_real_distribution<double> position(-1.0, 1.0);  // m, anywhere on the plane
+  std::uniform_real_distribution<double> position(-1.0, 1.0);  // times the placement half-width
   std::vector<int> order(num_commands);
   std::vector<Placement> plan;
   if (options.protocol == Protocol::kPaper) {
@@ -72,8 +72,8 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
       Placement p;
       p.command = order[(i / 3) % num_commands];
       p.heading_rad = HeadingFromTheta(thetas[i % 3]);
-      p.x_m = position(rng);
-      p.y_m = position(rng);
+      p.x_unit = position(rng);
+      p.y_unit = position(rng);
       plan.push_back(p);
     }
   } else if (options.protocol == Protocol::kContinuous) {
@@ -82,8 +82,8 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
     for (int i = 0; i < total; ++i) {
       Placement p;
       p.heading_rad = heading(rng);
-      p.x_m = position(rng);
-      p.y_m = position(rng);
+      p.x_unit = position(rng);
+      p.y_unit = position(rng);
       for (int r = 0; r < options.executions_per_placement; ++r) {
         p.values.emplace_back(level(rng), level(rng), level(rng));
       }
@@ -98,8 +98,8 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
       for (int r = 0; r < options.executions_per_placement; ++r) p.sequence.push_back(any(rng));
       p.command = p.sequence[0];
       p.heading_rad = heading(rng);
-      p.x_m = position(rng);
-      p.y_m = position(rng);
+      p.x_unit = position(rng);
+      p.y_unit = position(rng);
       plan.push_back(p);
     }
   } else {
@@ -113,8 +113,8 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
       Placement p;
       p.command = order[i % num_commands];
       p.heading_rad = heading(rng);
-      p.x_m = position(rng);
-      p.y_m = position(rng);
+      p.x_unit = position(rng);
+      p.y_unit = position(rng);
       plan.push_back(p);
     }
   }
@@ -297,10 +297,11 @@ void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOption
     bool kept = false;
     for (int attempt = 0; attempt <= options.max_retries_per_placement && !kept; ++attempt) {
       if (attempt > 0) {  // re-place somewhere else on the slope, same heading and command
-        where.x_m = position(rng);
-        where.y_m = position(rng);
+        where.x_unit = position(rng);
+        where.y_unit = position(rng);
       }
-      bool fell = sim.Place(where.x_m, where.y_m, where.heading_rad) != RunOutcome::kCompleted;
+      const double half = sim.placement_half_width_m();
+      bool fell = sim.Place(half * where.x_unit, half * where.y_unit, where.heading_rad) != RunOutcome::kCompleted;
       std::vector<Eigen::Matrix<double, 6, 1>> px;
       std::vector<Eigen::VectorXd> pz;
       for (int r = 0; r < reps && !fell; ++r) {
@@ -536,8 +537,8 @@ SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSumm
     Placement& p = plan[i];
     p.command = row;
     p.heading_rad = cell.headings_rad.empty() ? cell.heading_rad : cell.headings_rad[i];
-    p.x_m = where[i].x();
-    p.y_m = where[i].y();
+    p.x_unit = where[i].x();
+    p.y_unit = where[i].y();
   }
   RunPlan(config, options, plan, rng, {}, summary, edit, &set);
   set.metadata["protocol"] = "cell";
@@ -574,7 +575,8 @@ std::vector<double> HeadingsForTerrain(const SimConfig& config, const CellOption
   std::mt19937_64 rng(cell.seed);
   std::vector<double> out;
   for (const Eigen::Vector2d& at : CellPositions(cell.placements, rng)) {  // those SimulateCell draws
-    const double best = BestHeading(sim, at.x(), at.y(), pitch_rad, roll_rad, headings);
+    const double half = sim.placement_half_width_m();
+    const double best = BestHeading(sim, half * at.x(), half * at.y(), pitch_rad, roll_rad, headings);
     if (!std::isfinite(best)) throw MakeInputError("terrain", "", "the robot fell at every heading at a placement");
     out.push_back(best);
   }

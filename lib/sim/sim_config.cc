@@ -24,6 +24,15 @@ bool Check(bool ok, const std::string& message, std::string* error) {
 
 bool Finite(double v) { return std::isfinite(v); }
 
+// The built-in robot's payload in absolute bounds; a robot block's only finite here, then checked
+// against the robot's own mass and leg reach once it is compiled (legged_robot.cc CheckPayload).
+bool CheckPayload(const PayloadConfig& p, bool robot_block, std::string* error) {
+  const bool finite = Finite(p.mass_kg) && p.mass_kg >= 0 && p.position_body_m.allFinite();
+  if (robot_block) return Check(finite, "payload: expected a finite mass >= 0 kg and a finite position", error);
+  return Check(finite && p.mass_kg < 100 && p.position_body_m.cwiseAbs().maxCoeff() <= 1.0,
+               "payload: expected mass in [0, 100) kg and position within 1 m of the torso", error);
+}
+
 }  // namespace
 
 bool SimConfig::IsValid(std::string* error) const {
@@ -41,10 +50,9 @@ bool SimConfig::IsValid(std::string* error) const {
       !Check(Finite(m.torso_kg) && m.torso_kg > 0 && Finite(m.coxa_kg) && m.coxa_kg > 0 &&
                  Finite(m.femur_kg) && m.femur_kg > 0 && Finite(m.tibia_kg) && m.tibia_kg > 0,
              "masses: expected finite positive masses in kg", error) ||
-      !Check(Finite(payload.mass_kg) && payload.mass_kg >= 0 && payload.mass_kg < 100 &&
-                 payload.position_body_m.allFinite() &&
-                 payload.position_body_m.cwiseAbs().maxCoeff() <= 1.0,
-             "payload: expected mass in [0, 100) kg and position within 1 m of the torso", error) ||
+      !CheckPayload(payload, robot.has_value(), error) ||
+      !Check(Finite(placement_half_width_m) && placement_half_width_m >= 0,
+             "placement_half_width_m: expected a finite width >= 0 m (0: the default)", error) ||
       !Check(Finite(a.kp_nm_per_rad) && a.kp_nm_per_rad > 0 && Finite(a.torque_limit_nm) &&
                  a.torque_limit_nm > 0 && Finite(a.joint_damping_nms_per_rad) &&
                  a.joint_damping_nms_per_rad >= 0,
@@ -156,6 +164,7 @@ SimConfig SimConfigFromJson(const std::string& json_text, const std::string& sou
   r.Number("timestep_s", &c.timestep_s);
   r.Number("command_duration_s", &c.command_duration_s);
   r.Number("settle_duration_s", &c.settle_duration_s);
+  r.Number("placement_half_width_m", &c.placement_half_width_m);
   r.String("mjcf_path", &c.mjcf_path, /*allow_empty=*/true);
   {
     JsonFields n = r.Child("names");
@@ -229,6 +238,7 @@ std::string SimConfigToJson(const SimConfig& c) {
   j["command_duration_s"] = c.command_duration_s;
   j["settle_duration_s"] = c.settle_duration_s;
   j["mjcf_path"] = c.mjcf_path;
+  if (c.placement_half_width_m > 0) j["placement_half_width_m"] = c.placement_half_width_m;  // shipped sets' configs unchanged
   j["names"] = {{"torso_body", c.names.torso_body},
                 {"floor_geom", c.names.floor_geom},
                 {"actuator_prefix", c.names.actuator_prefix}};

@@ -90,6 +90,10 @@ struct SimConfig {
   double timestep_s = 0.002;          // MuJoCo integrator step
   double command_duration_s = 1.5;    // one execution of a command
   double settle_duration_s = 0.5;     // standing still after each placement before reading z
+  // Placements are drawn in [-w, w]^2 of the slope frame. 0: the default, 1 m for the built-in
+  // robot (its leg reach is 0.41 m) and 2.5 leg reaches for a robot block's robot; on a plane
+  // where the robot stands does not change its physics, on terrain it picks the patch of ground.
+  double placement_half_width_m = 0;
   std::string mjcf_path;              // empty: the built-in robot (datasets/robots/scorpion.xml)
   RobotNames names;
   // Any legged robot (robot_description.h): with it, the model's own physics is the nominal and

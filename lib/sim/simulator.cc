@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 
 #include "sim/actuation_line.h"
@@ -231,7 +232,17 @@ std::vector<std::string> Simulator::ScaleWarnings() const {
   } else {
     for (const LegGeometry& leg : impl_->parts.legs) foot = std::max(foot, leg.foot_radius_m);
   }
-  return TerrainScaleWarnings(*c.terrain, stance, foot);
+  std::vector<std::string> out = TerrainScaleWarnings(*c.terrain, stance, foot);
+  const double half = placement_half_width_m(), reach = leg_reach_m();
+  if (half + 2 * reach > c.terrain->half_size_m) {
+    char what[200];
+    std::snprintf(what, sizeof what,
+                  "placements reach %.3g m from the centre and the ground ends at %.3g m: less than 2 leg reaches "
+                  "(%.3g m) to walk before the edge (terrain.half_size_m, placement_half_width_m)",
+                  half, c.terrain->half_size_m, 2 * reach);
+    out.push_back(what);
+  }
+  return out;
 }
 
 long long Simulator::SelfContactSteps() const {
@@ -264,6 +275,12 @@ double Simulator::leg_reach_m() const {
   double reach = 0;
   for (const auto& leg : impl_->parts.legs) reach = std::max(reach, leg.coxa_out_m + leg.femur_m + leg.tibia_m);
   return reach;
+}
+
+double Simulator::placement_half_width_m() const {
+  const double given = impl_->config.placement_half_width_m;
+  if (given > 0) return given;
+  return impl_->walker ? 2.5 * leg_reach_m() : 1.0;  // the built-in robot: 2.4 of its 0.41 m reach
 }
 
 int Simulator::leg_count() const {

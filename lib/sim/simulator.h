@@ -79,6 +79,9 @@ class Simulator {
   // The longest leg's reach (m): hip to foot summed over the leg's links.
   double leg_reach_m() const;
   int leg_count() const;
+  // Placements are drawn in [-w, w]^2 (m): config.placement_half_width_m, or by default 1 m for
+  // the built-in robot and 2.5 leg reaches for a robot block's.
+  double placement_half_width_m() const;
   // The built-in robot's legs (a robot block's robot: all zero; see leg_reach_m()).
   const std::array<LegGeometry, kNumLegs>& legs() const;
   const SimConfig& config() const;

@@ -14,7 +14,7 @@ namespace dgmm::sim2real {
 namespace {
 
 // v2: keyed by the simulator's fingerprint through the KnobSimulator interface.
-constexpr const char* kCacheVersion = "dgmm-knob-recording-v3";
+constexpr const char* kCacheVersion = "dgmm-knob-recording-v4";  // v4: a robot block's placements span 2.5 leg reaches
 
 std::uint64_t Fnv1a(const std::string& s, std::uint64_t h = 1469598103934665603ull) {
   for (unsigned char c : s) {

@@ -153,6 +153,59 @@ TEST(LeggedRobot, APayloadMergesIntoTheTorsoAtTheRobotsScale) {
   }
 }
 
+// A payload is bounded by the robot's own scale, not by metres and kilograms fixed for one robot:
+// the hexapod (3.2 kg, reach 0.30 m) refuses 40 kg and an offset of 0.7 m; a 1.5 m offset is
+// accepted from a config without a robot block only up to 1 m.
+TEST(LeggedRobot, APayloadIsBoundedByTheRobotsMassAndReach) {
+  auto error_of = [](double kg, const Eigen::Vector3d& at) {
+    SimConfig c = Hexapod();
+    c.payload.mass_kg = kg;
+    c.payload.position_body_m = at;
+    try {
+      Simulator sim(c);
+    } catch (const std::exception& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error_of(3.0, Eigen::Vector3d(0.3, 0, 0)), "");
+  EXPECT_NE(error_of(40, Eigen::Vector3d::Zero()).find("payload.mass_kg: 40 kg is over 10 times the robot's mass"),
+            std::string::npos);
+  EXPECT_NE(error_of(1, Eigen::Vector3d(0.7, 0, 0)).find("payload.position_body_m: 0.7 m from the torso"),
+            std::string::npos);
+  SimConfig big = Hexapod();
+  big.payload.mass_kg = 150;  // over the built-in robot's fixed 100 kg, checked only against this robot
+  std::string error;
+  EXPECT_TRUE(big.IsValid(&error)) << error;
+  big.robot.reset();
+  EXPECT_FALSE(big.IsValid(&error));
+}
+
+// Placements span 2.5 leg reaches of a robot block's robot (1 m for the built-in one) unless the
+// config gives a width; on terrain, a width that leaves under 2 reaches to the edge is warned about.
+TEST(LeggedRobot, PlacementsSpanTheRobotsReach) {
+  SimConfig c = Hexapod();
+  {
+    Simulator sim(c);
+    EXPECT_NEAR(sim.placement_half_width_m(), 2.5 * sim.leg_reach_m(), 1e-12);
+  }
+  c.placement_half_width_m = 0.4;
+  EXPECT_DOUBLE_EQ(Simulator(c).placement_half_width_m(), 0.4);
+  c.terrain = TerrainDescription{};
+  c.terrain->half_size_m = 0.9;
+  bool warned = false;
+  for (const std::string& w : Simulator(c).ScaleWarnings()) warned |= w.find("placement_half_width_m") != std::string::npos;
+  EXPECT_TRUE(warned);
+  c.terrain->half_size_m = 1.2;
+  for (const std::string& w : Simulator(c).ScaleWarnings()) EXPECT_EQ(w.find("placement_half_width_m"), std::string::npos) << w;
+  SimConfig builtin;
+  EXPECT_DOUBLE_EQ(Simulator(builtin).placement_half_width_m(), 1.0);
+  builtin.placement_half_width_m = -1;
+  std::string error;
+  EXPECT_FALSE(builtin.IsValid(&error));
+  EXPECT_NE(error.find("placement_half_width_m"), std::string::npos);
+}
+
 TEST(LeggedRobot, FootExtentForCapsuleAndBoxFeet) {
   const SimConfig c = Hexapod();
   MjModelPtr m = LoadRobotModel(c);

@@ -28,7 +28,10 @@ TEST(SimConfigTest, JsonRoundTripKeepsEveryField) {
   c.noise.imu_roll_sd_rad = 0.02;
   c.mjcf_path = "/tmp/robot.xml";
   c.names.torso_body = "body";
+  c.placement_half_width_m = 0.75;
   const SimConfig back = SimConfigFromJson(SimConfigToJson(c), "test");
+  EXPECT_DOUBLE_EQ(back.placement_half_width_m, 0.75);
+  EXPECT_EQ(SimConfigToJson(SimConfig()).find("placement_half_width_m"), std::string::npos);  // shipped sets' configs
   EXPECT_EQ(SimConfigToJson(back), SimConfigToJson(c));
   EXPECT_DOUBLE_EQ(back.payload.position_body_m.y(), -0.1);
   EXPECT_DOUBLE_EQ(back.actuators.leg_gain[3], 0.4);
