@@ -56,5 +56,27 @@ TEST(PairedShift, RecoversAPlantedShiftLinearInTerrain) {
   EXPECT_NEAR(shift.log_variance_ratio()(1), 0.0, 1e-9);  // a pure shift leaves the spread alone
 }
 
+// Continuous commands are conditioning dimensions (z = pitch, roll, then the commanded velocity):
+// a knob whose effect grows with the commanded speed, e.g. slip, has a signature linear in it.
+TEST(PairedShift, IsLinearInContinuousCommandsCarriedInZ) {
+  SampleSet nominal = MakeSet(40, 2);
+  nominal.commands = Eigen::MatrixXd::Zero(1, 1);
+  nominal.command_labels = {"velocity"};
+  nominal.command.setZero();
+  nominal.z.conservativeResize(Eigen::NoChange, 3);
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> speed(-0.5, 0.5);
+  for (int i = 0; i < nominal.size(); ++i) nominal.z(i, 2) = speed(rng);
+  nominal.z_names = {"pitch", "roll", "cmd_long"};
+  SampleSet perturbed = nominal;
+  for (int i = 0; i < perturbed.size(); ++i) perturbed.x(i, 0) += -0.3 * perturbed.z(i, 2) + 0.02 * perturbed.z(i, 1);
+  const PairedShift shift = PairedShift::Fit(nominal, perturbed, nominal, 0.0);
+  for (double v : {-0.4, 0.0, 0.45}) {
+    const Eigen::Vector3d z(0.1, -0.2, v);
+    EXPECT_NEAR(shift.Shift(0, z, 0.0)(0), -0.3 * v + 0.02 * -0.2, 1e-6) << "command " << v;
+    EXPECT_NEAR(shift.Shift(0, z, 1.0)(1), 0.0, 1e-6);
+  }
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real
