@@ -120,6 +120,24 @@ TEST(Replay, TheMammalQuadrupedWalksItsRecordedTrot) {
   EXPECT_NEAR(std::atan2(turn(1, 0), turn(0, 0)) / (0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
 }
 
+TEST(Replay, TheMammalQuadrupedStandsAndTurnsAcrossTheSlope) {
+  // Facing across the 10 degree slope (the paper protocol's theta = 0), where the first replay
+  // (paws under the shoulders) rolled over downhill while standing and every turn fell.
+  SimConfig c = Mammal();
+  c.slope_deg = 10;
+  Simulator sim(c);
+  const double across = std::acos(-1.0) / 2;
+  ASSERT_EQ(sim.Place(0, 0, across), RunOutcome::kCompleted);
+  EXPECT_EQ(sim.RunCommand(Eigen::Vector3d::Zero()), RunOutcome::kCompleted) << "standing";
+  for (const double turn : {0.5, -0.5, 0.5}) {
+    const Pose before = sim.TorsoPose();
+    ASSERT_EQ(sim.RunCommand(Eigen::Vector3d(0, 0, turn)), RunOutcome::kCompleted) << "turn " << turn;
+    const Eigen::Matrix3d r = before.rotation.transpose() * sim.TorsoPose().rotation;
+    EXPECT_GT(std::atan2(r(1, 0), r(0, 0)) * turn, 0) << "turns the commanded way";
+  }
+  EXPECT_GT(sim.TorsoPose().rotation(2, 2), std::cos(20 * std::acos(-1.0) / 180)) << "upright within 20 degrees";
+}
+
 TEST(Replay, BadReplaysAreRefusedNamingThePart) {
   auto expect = [](const std::string& error, const std::string& part) {
     EXPECT_NE(error.find(part), std::string::npos) << "expected \"" << part << "\" in: " << error;
