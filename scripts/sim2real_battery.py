@@ -25,6 +25,7 @@ family and plants tracker noise through the config; --draw-version 1 redraws the
 
 Usage: scripts/sim2real_battery.py --seeds 1000-1009 [--jobs 2] [--build build] [--out DIR]
        [--keep] [--smoke] [--generate-only] [--write-doc] [--draw-version {1,2,3}]
+       [--protocol {paper,continuous}]
        [--rerun] [--sim2real-args 'ARGS']
 """
 import argparse
@@ -95,12 +96,13 @@ def absolute_config(robot, cfg):
 def sim_set(args, robot):
     """Path of the cached nominal sim set of `robot` (recorded on first use)."""
     placements = SMOKE_SIM_PLACEMENTS if args.smoke else SIM_PLACEMENTS
-    path = os.path.join(args.out, "cache", f"{robot}_sim_p{placements}.h5")
+    tag = "" if args.protocol == "paper" else f"_{args.protocol}"
+    path = os.path.join(args.out, "cache", f"{robot}_sim_p{placements}{tag}.h5")
     if not os.path.exists(path):
         os.makedirs(os.path.dirname(path), exist_ok=True)
         log(f"recording the nominal sim set of {robot} ({placements} placements)")
         t = time.time()
-        run([args.dgmm, "simulate", "--config", config_path(robot), "--protocol", "paper",
+        run([args.dgmm, "simulate", "--config", config_path(robot), "--protocol", args.protocol,
              "--placements", str(placements), "--seed", str(ROBOTS[robot]["sim_seed"]),
              "-o", path])
         log(f"  {robot} sim set: {time.time() - t:.0f} s wall")
@@ -199,7 +201,7 @@ def generate(args, pair, nominals):
     with open(cfg_path, "w") as f:
         json.dump(cfg, f, indent=2)
     tmp = real + ".tmp.h5"
-    cmd = [args.dgmm, "simulate", "--config", cfg_path, "--protocol", "paper",
+    cmd = [args.dgmm, "simulate", "--config", cfg_path, "--protocol", args.protocol,
            "--seed", str(pair["real_seed"]), "-o", tmp]
     if args.smoke:
         cmd += ["--placements", str(SMOKE_REAL_PLACEMENTS)]
@@ -207,7 +209,7 @@ def generate(args, pair, nominals):
     if any(e["config"] or e.get("mjcf") for e in pair["effects"]):
         run(cmd)
     else:  # nominal physics: one recording per (robot, seed), shared by data-level plants
-        cached = os.path.join(args.out, "cache", f"{robot}_real_{pair['real_seed']}_{args.smoke}.h5")
+        cached = os.path.join(args.out, "cache", f"{robot}_real_{pair['real_seed']}_{args.smoke}_{args.protocol}.h5")
         with LOCK:
             if not os.path.exists(cached):
                 run(cmd[:-1] + [cached + ".tmp.h5"])
@@ -435,6 +437,9 @@ def main():
                     default=draw.DEFAULT_DRAW_VERSION,
                     help="pair generator: 1 = seed ranges up to 10000-10039 as drawn then; 2 "
                          "(default) adds solimp and backlash, tracker noise through the config")
+    ap.add_argument("--protocol", default="paper", choices=["paper", "continuous"],
+                    help="of the sim and real sets: continuous draws each execution's velocity command "
+                         "at random (kept in z as cmd_long, cmd_lat, cmd_turn; issue #25)")
     ap.add_argument("--write-doc", action="store_true",
                     help="write the tables into docs/sim2real.md (section sim2real-battery)")
     args = ap.parse_args()
