@@ -62,6 +62,99 @@ bool LogRecordOptions::IsValid(std::string* error) const {
   return true;
 }
 
+namespace {
+
+// The pose and IMU streams of one session: each at its own rate and phase, stamped in log time
+// (sim time + clock offset), with the config's sensor noise, stamp jitter and pose dropouts.
+// `unit` is the recording's one normal distribution (it keeps a spare draw between calls).
+class SensorStreams {
+ public:
+  SensorStreams(CsvOut& pose, CsvOut& imu, const NoiseConfig& noise, const LogRecordOptions& options,
+                std::mt19937_64& rng, std::normal_distribution<double>& unit, double start_s, double clock_offset,
+                LogRecordSummary* summary)
+      : pose_(pose), imu_(imu), noise_(noise), options_(options), rng_(rng), unit_(unit), offset_(clock_offset),
+        summary_(summary) {
+    next_pose_ = start_s + uniform_(rng_) / options.pose_hz;
+    next_imu_ = start_s + uniform_(rng_) / options.imu_hz;
+  }
+  // Writes every row due by the simulator's time.
+  void Log(const Simulator& s) {
+    const double t = s.time_s();
+    while (t >= next_imu_) {
+      WriteImu(t, s.TruePitchRoll());
+      next_imu_ += 1.0 / options_.imu_hz;
+    }
+    while (t >= next_pose_) {
+      WritePose(t, s.TorsoPose());
+      next_pose_ += 1.0 / options_.pose_hz;
+    }
+  }
+
+ private:
+  void WriteImu(double t, const Eigen::Vector2d& pr) {
+    std::fprintf(imu_.get(), "%.0f,%.3f,%.3f\n", (t + offset_) * 1000.0,
+                 (pr[1] + noise_.imu_roll_sd_rad * unit_(rng_)) * kRadToDeg,
+                 (pr[0] + noise_.imu_pitch_sd_rad * unit_(rng_)) * kRadToDeg);
+    ++summary_->imu_rows;
+  }
+  void WritePose(double t, const Pose& p) {
+    const Eigen::Vector3d rpy = RollPitchYaw(p.rotation);
+    const double stamp = t + offset_ + 0.002 * (uniform_(rng_) - 0.5);  // stamp jitter
+    if (uniform_(rng_) < options_.dropout_probability) {
+      std::fprintf(pose_.get(), "%.4f,nan,nan,nan,nan,nan,nan\n", stamp);
+      ++summary_->dropouts;
+    } else {
+      double yaw = rpy[2] + noise_.tracker_yaw_sd_rad * unit_(rng_);
+      yaw = std::remainder(yaw, 2 * std::numbers::pi);
+      std::fprintf(pose_.get(), "%.4f,%.1f,%.1f,%.1f,%.3f,%.3f,%.3f\n", stamp,
+                   (p.position_m[0] + noise_.tracker_position_sd_m * unit_(rng_)) * 1000,
+                   (p.position_m[1] + noise_.tracker_position_sd_m * unit_(rng_)) * 1000,
+                   (p.position_m[2] + noise_.tracker_position_sd_m * unit_(rng_)) * 1000,
+                   (rpy[0] + noise_.tracker_roll_sd_rad * unit_(rng_)) * kRadToDeg,
+                   (rpy[1] + noise_.tracker_pitch_sd_rad * unit_(rng_)) * kRadToDeg, yaw * kRadToDeg);
+    }
+    ++summary_->pose_rows;
+  }
+
+  CsvOut& pose_;
+  CsvOut& imu_;
+  const NoiseConfig& noise_;
+  const LogRecordOptions& options_;
+  std::mt19937_64& rng_;
+  std::normal_distribution<double>& unit_;
+  double offset_;
+  LogRecordSummary* summary_;
+  double next_pose_ = 0, next_imu_ = 0;
+  std::uniform_real_distribution<double> uniform_{0.0, 1.0};
+};
+
+// Runs one mode for command_duration_s while the controller publishes it (when issued, then at
+// command_hz, with jitter) and the sensors log; false when the robot fell.
+bool RunMode(Simulator& sim, const Mode& mode, const LogRecordOptions& options, double duration_s,
+             double clock_offset, std::mt19937_64& rng, std::normal_distribution<double>& unit, CsvOut& commands,
+             SensorStreams& sensors, LogRecordSummary* summary) {
+  const Eigen::Vector3d command(mode.long_, mode.lat, mode.turn);
+  double next_command = sim.time_s();
+  const double command_end = next_command + duration_s;
+  auto log_command = [&](const Simulator& s) {
+    while (s.time_s() + 1e-9 >= next_command && next_command < command_end - 1e-6) {
+      std::fprintf(commands.get(), "%.4f,%s,%.3f,%.3f,%.3f\n", next_command + clock_offset, mode.name,
+                   mode.long_ + options.command_jitter * unit(rng), mode.lat + options.command_jitter * unit(rng),
+                   mode.turn + options.command_jitter * unit(rng));
+      ++summary->command_rows;
+      next_command += 1.0 / options.command_hz;
+    }
+  };
+  log_command(sim);
+  const RunOutcome outcome = sim.RunCommand(
+      command, [&](const Simulator& s) { log_command(s); sensors.Log(s); }, 1);
+  return outcome == RunOutcome::kCompleted;
+}
+
+}  // namespace
+
+// Per session: a gap on the log clock, a random placement, one idle cycle of sensors before the
+// first command, random modes, then "stop" published for two cycles.
 LogRecordSummary RecordLog(const SimConfig& config, const LogRecordOptions& options,
                            const std::string& folder,
                            const std::function<void(long long, long long)>& progress) {
@@ -76,7 +169,6 @@ LogRecordSummary RecordLog(const SimConfig& config, const LogRecordOptions& opti
   std::normal_distribution<double> unit(0.0, 1.0);
   std::uniform_real_distribution<double> uniform(0.0, 1.0);
   Simulator sim(config);
-  const NoiseConfig& noise = config.noise;
   LogRecordSummary summary;
   double clock_offset = options.start_time_s;  // log time = sim time + offset
   for (int session = 0; session < options.sessions; ++session) {
@@ -91,69 +183,19 @@ LogRecordSummary RecordLog(const SimConfig& config, const LogRecordOptions& opti
       continue;
     }
     const double session_start = sim.time_s();
-    // Next logging time of each stream (sim clock), each with its own phase.
-    double next_pose = session_start + uniform(rng) / options.pose_hz;
-    double next_imu = session_start + uniform(rng) / options.imu_hz;
-    auto log_sensors = [&](const Simulator& s) {
-      const double t = s.time_s();
-      while (t >= next_imu) {
-        const Eigen::Vector2d pr = s.TruePitchRoll();
-        std::fprintf(imu.get(), "%.0f,%.3f,%.3f\n", (t + clock_offset) * 1000.0,
-                     (pr[1] + noise.imu_roll_sd_rad * unit(rng)) * kRadToDeg,
-                     (pr[0] + noise.imu_pitch_sd_rad * unit(rng)) * kRadToDeg);
-        ++summary.imu_rows;
-        next_imu += 1.0 / options.imu_hz;
-      }
-      while (t >= next_pose) {
-        const Pose p = s.TorsoPose();
-        const Eigen::Vector3d rpy = RollPitchYaw(p.rotation);
-        const double stamp = t + clock_offset + 0.002 * (uniform(rng) - 0.5);  // stamp jitter
-        if (uniform(rng) < options.dropout_probability) {
-          std::fprintf(pose.get(), "%.4f,nan,nan,nan,nan,nan,nan\n", stamp);
-          ++summary.dropouts;
-        } else {
-          double yaw = rpy[2] + noise.tracker_yaw_sd_rad * unit(rng);
-          yaw = std::remainder(yaw, 2 * std::numbers::pi);
-          std::fprintf(pose.get(), "%.4f,%.1f,%.1f,%.1f,%.3f,%.3f,%.3f\n", stamp,
-                       (p.position_m[0] + noise.tracker_position_sd_m * unit(rng)) * 1000,
-                       (p.position_m[1] + noise.tracker_position_sd_m * unit(rng)) * 1000,
-                       (p.position_m[2] + noise.tracker_position_sd_m * unit(rng)) * 1000,
-                       (rpy[0] + noise.tracker_roll_sd_rad * unit(rng)) * kRadToDeg,
-                       (rpy[1] + noise.tracker_pitch_sd_rad * unit(rng)) * kRadToDeg, yaw * kRadToDeg);
-        }
-        ++summary.pose_rows;
-        next_pose += 1.0 / options.pose_hz;
-      }
-    };
-    log_sensors(sim);
-    // Sensors run for one idle cycle before the first command is published (no command rows),
-    // and the controller publishes "stop" for two cycles after the last command.
-    bool fell = sim.RunCommand(Eigen::Vector3d::Zero(), log_sensors, 1) != RunOutcome::kCompleted;
-    auto run = [&](const Mode& mode) {
-      const Eigen::Vector3d command(mode.long_, mode.lat, mode.turn);
-      double next_command = sim.time_s();
-      const double command_end = next_command + config.command_duration_s;
-      auto log_command = [&](const Simulator& s) {
-        // The controller publishes the command when issued, then at command_hz until the next.
-        while (s.time_s() + 1e-9 >= next_command && next_command < command_end - 1e-6) {
-          std::fprintf(commands.get(), "%.4f,%s,%.3f,%.3f,%.3f\n", next_command + clock_offset,
-                       mode.name, mode.long_ + options.command_jitter * unit(rng),
-                       mode.lat + options.command_jitter * unit(rng),
-                       mode.turn + options.command_jitter * unit(rng));
-          ++summary.command_rows;
-          next_command += 1.0 / options.command_hz;
-        }
-      };
-      log_command(sim);
-      const RunOutcome outcome = sim.RunCommand(
-          command, [&](const Simulator& s) { log_command(s); log_sensors(s); }, 1);
-      fell = outcome != RunOutcome::kCompleted;
-    };
-    for (int c = 0; c < options.commands_per_session && !fell; ++c) {
-      run(kModes[static_cast<int>(uniform(rng) * std::size(kModes)) % std::size(kModes)]);
+    SensorStreams sensors(pose, imu, config.noise, options, rng, unit, session_start, clock_offset, &summary);
+    sensors.Log(sim);
+    auto log = [&](const Simulator& s) { sensors.Log(s); };
+    bool ok = sim.RunCommand(Eigen::Vector3d::Zero(), log, 1) == RunOutcome::kCompleted;
+    const double duration = config.command_duration_s;
+    for (int c = 0; c < options.commands_per_session && ok; ++c) {
+      const Mode& mode = kModes[static_cast<int>(uniform(rng) * std::size(kModes)) % std::size(kModes)];
+      ok = RunMode(sim, mode, options, duration, clock_offset, rng, unit, commands, sensors, &summary);
     }
-    for (int k = 0; k < 2 && !fell; ++k) run(kStop);
-    if (fell) ++summary.falls;
+    for (int k = 0; k < 2 && ok; ++k) {
+      ok = RunMode(sim, kStop, options, duration, clock_offset, rng, unit, commands, sensors, &summary);
+    }
+    if (!ok) ++summary.falls;
     summary.simulated_seconds += sim.time_s() - session_start;
     ++summary.sessions;
     if (progress) progress(session + 1, options.sessions);
