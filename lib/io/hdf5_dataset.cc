@@ -117,9 +117,11 @@ std::vector<hsize_t> DatasetDims(hid_t loc, const std::string& name, const std::
   return DimsOf(d.get());
 }
 
-std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const std::string& path,
-                                  const std::string& field) {
-  const bool is_double = H5Tequal(spec.type, H5T_IEEE_F64LE) > 0;
+namespace {
+
+// The element type the schema expects.
+void CheckType(hid_t dataset, const DatasetSpec& spec, bool is_double, const std::string& path,
+               const std::string& field) {
   Datatype type(H5Dget_type(dataset));
   if (!type.valid() || H5Tequal(type.get(), spec.type) <= 0) {
     throw MakeInputError(path, field,
@@ -130,6 +132,12 @@ std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const 
                                   ? ", found strings"
                                   : ""));
   }
+}
+
+// The shape against the schema's rank and extents, with overflow-safe element count (returned in
+// *elements).
+std::vector<hsize_t> CheckShape(hid_t dataset, const DatasetSpec& spec, const std::string& path,
+                                const std::string& field, long double* elements) {
   Dataspace space(H5Dget_space(dataset));
   const int rank = space.valid() ? H5Sget_simple_extent_ndims(space.get()) : -1;
   if (rank < 0 || rank > 32) throw MakeInputError(path, field, "corrupt dataspace");
@@ -140,8 +148,7 @@ std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const 
                          "expected " + std::to_string(spec.extents.size()) +
                              " dimensions, found shape " + DimsText(dims));
   }
-  // Element count with overflow checks, and every extent against the schema.
-  long double elements = 1;
+  *elements = 1;
   for (int i = 0; i < rank; ++i) {
     if (spec.extents[i] >= 0 && dims[i] != static_cast<hsize_t>(spec.extents[i])) {
       throw MakeInputError(path, field,
@@ -153,17 +160,50 @@ std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const 
                            "shape " + DimsText(dims) + ": at most " +
                                std::to_string(spec.max_extent) + " per dimension expected");
     }
-    elements *= static_cast<long double>(dims[i]);
+    *elements *= static_cast<long double>(dims[i]);
   }
-  if (elements > static_cast<long double>(spec.max_elements)) {
+  if (*elements > static_cast<long double>(spec.max_elements)) {
     char declared[32];
-    std::snprintf(declared, sizeof declared, "%.3Lg", elements);
+    std::snprintf(declared, sizeof declared, "%.3Lg", *elements);
     throw MakeInputError(path, field,
                          "declares shape " + DimsText(dims) + " (" + declared +
                              " values); at most " + std::to_string(spec.max_elements) +
                              " expected");
   }
-  const hsize_t raw_bytes = static_cast<hsize_t>(elements) * (is_double ? 8 : 4);
+  return dims;
+}
+
+// Chunks of the dataset's rank and bounded size, and only the filters we read.
+void CheckChunks(hid_t dcpl, int rank, bool is_double, const std::string& path, const std::string& field) {
+  hsize_t chunk[32];
+  const int chunk_rank = H5Pget_chunk(dcpl, 32, chunk);
+  long double chunk_bytes = is_double ? 8 : 4;
+  for (int i = 0; i < chunk_rank; ++i) chunk_bytes *= static_cast<long double>(chunk[i]);
+  if (chunk_rank != rank || chunk_bytes <= 0 || chunk_bytes > static_cast<long double>(kMaxChunkBytes)) {
+    throw MakeInputError(path, field,
+                         "chunks of rank " + std::to_string(chunk_rank) + " and " +
+                             std::to_string(static_cast<unsigned long long>(chunk_bytes)) +
+                             " bytes; rank " + std::to_string(rank) + " and at most " +
+                             std::to_string(kMaxChunkBytes) + " bytes expected");
+  }
+  const int filters = H5Pget_nfilters(dcpl);
+  if (filters < 0 || filters > 8) throw MakeInputError(path, field, "corrupt filter pipeline");
+  for (int i = 0; i < filters; ++i) {
+    unsigned flags = 0;
+    size_t nelmts = 0;
+    H5Z_filter_t id = H5Pget_filter2(dcpl, i, &flags, &nelmts, nullptr, 0, nullptr, nullptr);
+    if (!KnownFilter(id)) {
+      throw MakeInputError(path, field,
+                           "uses HDF5 filter " + std::to_string(id) +
+                               "; expected only shuffle, deflate or fletcher32");
+    }
+  }
+}
+
+// Storage in the file, in a layout we read, holding at least what the shape declares (compressed
+// at most kMaxCompressionRatio : 1), so a few corrupt bytes cannot ask for gigabytes.
+void CheckStorage(hid_t dataset, int rank, hsize_t raw_bytes, bool is_double, const std::string& path,
+                  const std::string& field) {
   PropertyList dcpl(H5Dget_create_plist(dataset));
   if (!dcpl.valid()) throw MakeInputError(path, field, "corrupt dataset properties");
   if (H5Pget_external_count(dcpl.get()) != 0) {
@@ -171,35 +211,10 @@ std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const 
   }
   const H5D_layout_t layout = H5Pget_layout(dcpl.get());
   if (layout == H5D_CHUNKED) {
-    hsize_t chunk[32];
-    const int chunk_rank = H5Pget_chunk(dcpl.get(), 32, chunk);
-    long double chunk_bytes = is_double ? 8 : 4;
-    for (int i = 0; i < chunk_rank; ++i) chunk_bytes *= static_cast<long double>(chunk[i]);
-    if (chunk_rank != rank || chunk_bytes <= 0 ||
-        chunk_bytes > static_cast<long double>(kMaxChunkBytes)) {
-      throw MakeInputError(path, field,
-                           "chunks of rank " + std::to_string(chunk_rank) + " and " +
-                               std::to_string(static_cast<unsigned long long>(chunk_bytes)) +
-                               " bytes; rank " + std::to_string(rank) + " and at most " +
-                               std::to_string(kMaxChunkBytes) + " bytes expected");
-    }
-    const int filters = H5Pget_nfilters(dcpl.get());
-    if (filters < 0 || filters > 8) throw MakeInputError(path, field, "corrupt filter pipeline");
-    for (int i = 0; i < filters; ++i) {
-      unsigned flags = 0;
-      size_t nelmts = 0;
-      H5Z_filter_t id = H5Pget_filter2(dcpl.get(), i, &flags, &nelmts, nullptr, 0, nullptr, nullptr);
-      if (!KnownFilter(id)) {
-        throw MakeInputError(path, field,
-                             "uses HDF5 filter " + std::to_string(id) +
-                                 "; expected only shuffle, deflate or fletcher32");
-      }
-    }
+    CheckChunks(dcpl.get(), rank, is_double, path, field);
   } else if (layout != H5D_CONTIGUOUS && layout != H5D_COMPACT) {
     throw MakeInputError(path, field, "unsupported storage layout (virtual?)");
   }
-  // The bytes stored must be able to hold what the shape declares (compressed at most
-  // kMaxCompressionRatio : 1), so a few corrupt bytes cannot ask for gigabytes.
   const hsize_t stored = H5Dget_storage_size(dataset);
   const bool plausible =
       layout == H5D_CHUNKED
@@ -210,6 +225,18 @@ std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const 
                          "declares " + std::to_string(raw_bytes) + " bytes but stores " +
                              std::to_string(stored) + " (truncated or corrupt file)");
   }
+}
+
+}  // namespace
+
+std::vector<hsize_t> CheckDataset(hid_t dataset, const DatasetSpec& spec, const std::string& path,
+                                  const std::string& field) {
+  const bool is_double = H5Tequal(spec.type, H5T_IEEE_F64LE) > 0;
+  CheckType(dataset, spec, is_double, path, field);
+  long double elements = 1;
+  std::vector<hsize_t> dims = CheckShape(dataset, spec, path, field, &elements);
+  const hsize_t raw_bytes = static_cast<hsize_t>(elements) * (is_double ? 8 : 4);
+  CheckStorage(dataset, static_cast<int>(dims.size()), raw_bytes, is_double, path, field);
   return dims;
 }
 
