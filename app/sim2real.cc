@@ -38,6 +38,7 @@ struct Sim2RealArgs {
   int threads = 0;
   bool json = false;
   bool no_figures = false;
+  bool spread_signatures = false;
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -129,6 +130,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args) {
   o.locate.locate.mmd.permutations = args.permutations;
   o.candidates.placements = args.signature_placements;
   o.candidates.executions_per_placement = args.signature_executions;
+  o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -260,6 +262,9 @@ void Setup(CLI::App& root) {
                   "executions per placement of a signature recording (5: the paper protocol's; 2: 0.44 of the "
                   "time, but near-ties between knobs are decided less well, docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(2, 100));
+  cmd->add_flag("--spread-signatures", args->spread_signatures,
+               "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
+               "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");
   cmd->add_option("--bootstrap", args->bootstrap, "bootstrap resamples of the selection (inclusion; 0: not computed)")
       ->capture_default_str()->check(CLI::Range(0, 1000));
   cmd->add_option("--permutations", args->permutations, "permutations per two-sample test")

@@ -50,6 +50,17 @@ KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const
   return check;
 }
 
+// Residuals L_i^-1 (x_i - mean_i) re-whitened under the fitted spread: L_i^-1 S^-1 L_i w_i.
+Eigen::MatrixXd SpreadWhitened(const FitProblem& fp, const EffectFit& fit, const Eigen::MatrixXd& whitened) {
+  const Eigen::VectorXd inv = (-0.5 * fit.log_var).array().exp();
+  Eigen::MatrixXd out(whitened.rows(), whitened.cols());
+  for (int i = 0; i < fp.n; ++i) {
+    const Eigen::VectorXd raw = fp.chol[i] * whitened.row(i).transpose();
+    out.row(i) = fp.chol[i].triangularView<Eigen::Lower>().solve(inv.cwiseProduct(raw)).transpose();
+  }
+  return out;
+}
+
 // Residual structure and drift of each selected mean effect (drift.h, residual_structure.h).
 void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refinement& r, const AdequacyOptions& options,
                   Adequacy* out) {
@@ -82,6 +93,7 @@ void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refineme
   MarkDrifting(&out->total_drift, &drifts, options.drift);
   MarkDrifting(&out->total_step_variation, &step_drifts, options.drift);
   for (size_t q = 0; q < drifts.size(); ++q) out->drift_tests[q].drift = drifts[q], out->drift_tests[q].step_variation = step_drifts[q];
+  if (fit.log_var.size() == dx) resid = SpreadWhitened(fp, fit, resid);
   out->residuals = resid * std::exp(-fit.log_tau);
   std::vector<int> terrain_id(n, -1);
   if (in.real.terrain_dim() > 0 && base.terrain_centres.rows() > 0) terrain_id = base.real_terrain;

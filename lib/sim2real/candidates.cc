@@ -224,6 +224,9 @@ bool CandidateOptions::IsValid(std::string* error) const {
 void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, int k,
                          FitProblem* fp) {
   if (set.library[k].is_noise) return;
+  if (set.spread_signatures && set.candidates[k].simulated && !set.externals[k].shifts.empty()) {
+    fp->log_var[k] = set.shifts[set.externals[k].shifts[0]].log_variance_ratio();
+  }
   const Samples& real = in.real;
   for (int i = 0; i < real.size(); ++i) {
     SetDesign(fp, k, i,
@@ -264,6 +267,7 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
   const bool gate = options.legs_only_when_implicated && any_side && !legs.empty();
   CandidateSet set;
   set.recording = OwnRecording(in, options);
+  set.spread_signatures = options.spread_signatures;
   std::vector<Probe> probes = RecordProbes(simulator, in, gate ? first : [&] {
     std::vector<int> all = first;
     all.insert(all.end(), legs.begin(), legs.end());

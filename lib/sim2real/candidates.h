@@ -36,6 +36,10 @@ struct CandidateOptions {
   SelectionOptions first_pass;  // the selection that decides whether a side is implicated
   int side_top = 3;             // ... by a side knob among this many best candidates of a step
   double side_min_z = 1.0;      // ... with at least this held-out z
+  // Experimental: a knob's coefficient also scales the corrected covariance by its recording's
+  // log-variance ratio per axis (effect_fit.h), so a knob whose effect is mostly a wider spread (a
+  // weak leg the robot sags onto now and then) can be selected and refined. Off by default.
+  bool spread_signatures = false;
   bool IsValid(std::string* error) const;
 };
 
@@ -67,6 +71,7 @@ struct CandidateSet {
   // most placements at that value): not candidates, listed so the report can say so.
   std::vector<std::string> unwalkable_probes;
   bool legs_probed = false;
+  bool spread_signatures = false;           // CandidateOptions::spread_signatures, for the fit problems
   std::string legs_note;                    // why per-leg probes were or were not recorded
   int recorded = 0, from_cache = 0, requests = 0;
   double seconds = 0;

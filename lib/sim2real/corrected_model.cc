@@ -31,9 +31,10 @@ class Predictor {
     return p.mean + correction_->Shift(c, z, first ? 1.0 : 0.0, static_cast<int>(p.mean.size()));
   }
 
-  // tau^2 Sigma_c(z, f): the predictive covariance (with its inflation at z).
+  // tau^2 S Sigma_c(z, f) S: the predictive covariance (with its inflation at z).
   Eigen::MatrixXd Covariance(int c, const Eigen::VectorXd& z, bool first) const {
     const Prediction p = model_.Predict(c, z, first ? 1.0 : 0.0);
+    if (correction_ && correction_->log_var.size() > 0) return correction_->Covariance(p.chol * p.chol.transpose());
     return tau2_ * p.chol * p.chol.transpose();
   }
 

@@ -4,6 +4,13 @@
 
 namespace dgmm::sim2real {
 
+Eigen::MatrixXd Correction::Covariance(const Eigen::MatrixXd& sigma) const {
+  Eigen::MatrixXd out = std::exp(2 * log_tau) * sigma;
+  if (log_var.size() != sigma.rows()) return out;
+  const Eigen::VectorXd s = (0.5 * log_var).array().exp();
+  return s.asDiagonal() * out * s.asDiagonal();
+}
+
 Eigen::VectorXd Correction::Shift(int command, const Eigen::VectorXd& z, double first, int dx) const {
   return shift ? shift(command, z, first) : Eigen::VectorXd::Zero(dx);
 }
@@ -12,6 +19,7 @@ Correction MakeCorrection(const AnalysisInputs& in, const Baseline& base, const 
                           const EffectFit& fit) {
   Correction out;
   out.log_tau = fit.log_tau;
+  out.log_var = fit.log_var;
   struct Mean {
     ExternalCandidate external;
     Eigen::VectorXd theta;

@@ -1,8 +1,10 @@
 #pragma once
 // Maximum-likelihood fit of a set of effects to real data under the corrected sim model
-//   x_i ~ N(u_i + sum_e D_e,i theta_e, tau^2 Sigma_i)
+//   x_i ~ N(u_i + sum_e D_e,i theta_e, tau^2 S Sigma_i S),  S = diag(exp(s / 2)),
 // with Ceres (GradientProblem, L-BFGS) on the whitened form: with L_i L_i^T = Sigma_i,
-//   -log p = sum_i [ 1/2 tau^-2 |L_i^-1 (x_i - u_i) - L_i^-1 D_i theta|^2 + dx log tau ] + const.
+//   -log p = sum_i [ 1/2 tau^-2 |L_i^-1 S^-1 (x_i - u_i - D_i theta)|^2 + dx log tau + 1/2 sum s ] + const.
+// s = sum_e theta_e,0 v_e (per axis, clamped to +-max_log_ratio) for effects that carry a spread
+// signature v_e (a knob's simulated log-variance ratio, signatures.h); without any, S = I.
 #include <Eigen/Dense>
 #include <string>
 #include <vector>
@@ -24,6 +26,11 @@ struct FitProblem {
   std::vector<Eigen::MatrixXd> d;   // per library effect: (n dx) x p_e raw mean-shift designs
   std::vector<int> episode;         // for grouped folds and the bootstrap
   std::vector<int> command;
+  Eigen::MatrixXd raw;              // n x dx raw residuals x_i - u_i (= L_i r0_i)
+  // Per library effect: the log-variance ratio per axis that its first parameter scales (empty:
+  // the effect leaves the spread alone, the default for every effect).
+  std::vector<Eigen::VectorXd> log_var;
+  double max_log_ratio = 2.0;       // |s| per axis at most (no wild extrapolation)
 };
 
 // The designs start at zero: SetDesign fills each mean effect's rows.
@@ -37,6 +44,7 @@ struct EffectFit {
   std::vector<int> effects;
   std::vector<Eigen::VectorXd> theta;  // per entry of `effects` (the noise effect: log tau)
   double log_tau = 0;                  // 0 unless the noise effect is in the set
+  Eigen::VectorXd log_var;             // s (dx), empty unless a fitted effect carries a spread signature
   double train_log_likelihood = 0;     // total over the training rows
   bool converged = false;
   int iterations = 0;

@@ -56,7 +56,7 @@ void PlanarPrediction(const Analysis& a, int c, const Eigen::VectorXd& z, const 
   if (correction) {
     const int dx = static_cast<int>(m.size());
     m += first * correction->Shift(c, z, 1.0, dx) + (1 - first) * correction->Shift(c, z, 0.0, dx);
-    s *= std::exp(2 * correction->log_tau);
+    s = correction->Covariance(s);
   }
   const int i = a.inputs.layout.dx, j = a.inputs.layout.dy;
   *mean << m(i), m(j);

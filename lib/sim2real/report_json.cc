@@ -89,7 +89,7 @@ json KnobsJson(const Analysis& a) {
               {"gain", r.spread.gain}, {"se", r.spread.se}, {"z", r.spread.z}, {"tracker_needed", r.spread.tracker_needed},
               {"tracker_scale", Num(r.tracker_scale)}};
   }
-  return {{"candidates", cands}, {"selection_steps", StepsJson(a)}, {"removed_by_backward_pass", removed},
+  json out = {{"candidates", cands}, {"selection_steps", StepsJson(a)}, {"removed_by_backward_pass", removed},
           {"refinement", trace}, {"refined", refined}, {"family_inclusion", family},
           {"bootstrap_resamples", a.confidence.resamples}, {"inert_knobs", set.inert_knobs},
           {"unwalkable_probes", set.unwalkable_probes},
@@ -99,6 +99,10 @@ json KnobsJson(const Analysis& a) {
                           {"refinement_from_cache", r.from_cache}}},
           {"placements_per_recording", set.recording.placements},
           {"executions_per_placement", set.recording.executions_per_placement}};
+  if (set.spread_signatures) {  // --spread-signatures (experimental): the fitted per-axis log variance ratio
+    out["spread_signatures"] = {{"on", true}, {"fitted_log_variance_ratio", Vec(r.selection.fit.log_var)}};
+  }
+  return out;
 }
 
 json DriftJson(const EffectDrift& d, const char* change, const char* flag) {
