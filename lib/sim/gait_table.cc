@@ -111,4 +111,30 @@ Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, doub
   return Eigen::Vector3d(xy.x(), xy.y(), lift * std::sin(M_PI * s));
 }
 
+double ResolveSway(double sway, double duty) {
+  const double kDefaultSway = 0.1;  // a tenth of the way to the support polygon's centroid (its geometry)
+  const double kStaticDuty = 0.75;  // duty factor of a crawl: three of four feet down at every instant
+  if (sway >= 0) return sway;
+  return duty >= kStaticDuty - 1e-9 ? kDefaultSway : 0;
+}
+
+std::vector<Eigen::Vector2d> SwayTargets(const std::vector<Eigen::Vector2d>& stance, double share) {
+  const int n = static_cast<int>(stance.size());
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (const auto& p : stance) sum += p;
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& p : stance) {
+    // centroid of the others minus the centroid of all = (mean - p_i) / (n - 1)
+    out.push_back(n > 1 ? Eigen::Vector2d(share * (sum / n - p) / (n - 1)) : Eigen::Vector2d::Zero());
+  }
+  return out;
+}
+
+double SwingWeight(double u, double duty) {
+  const double swing = 1 - duty;
+  double delta = u - (1 + duty) / 2;  // from mid-swing, wrapped to [-0.5, 0.5)
+  delta -= std::floor(delta + 0.5);
+  return std::abs(delta) < swing ? 0.5 * (1 + std::cos(M_PI * delta / swing)) : 0;
+}
+
 }  // namespace dgmm::sim
