@@ -112,7 +112,7 @@ Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, doub
 }
 
 double ResolveSway(double sway, double duty) {
-  const double kDefaultSway = 0.1;  // a tenth of the way to the support polygon's centroid (its geometry)
+  const double kDefaultSway = 0.1;  // of the way to the other feet's centroid (relative to the stance polygon)
   const double kStaticDuty = 0.75;  // duty factor of a crawl: three of four feet down at every instant
   if (sway >= 0) return sway;
   return duty >= kStaticDuty - 1e-9 ? kDefaultSway : 0;

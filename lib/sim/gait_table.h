@@ -49,8 +49,8 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
 // relative to the torso per stance.
 Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, double lift);
 
-// The sway share a gait uses: `sway` when given (>= 0), else kDefaultSway for a statically stable
-// duty factor (>= 0.75: at most one leg of four in the air) and 0 below.
+// The sway share a gait uses: `sway` when given (>= 0); when negative, kDefaultSway for a
+// statically stable duty factor (>= 0.75: at most one leg of four in the air) and 0 below.
 double ResolveSway(double sway, double duty);
 
 // Each leg's sway target: `share` of the way from the centroid of all stance points to the

@@ -48,7 +48,7 @@ struct GaitDescription {
   double lean = 1.0;
   // Body sway of statically stable gaits: while a leg swings the torso moves `sway` of the way
   // towards the centroid of the other legs' stance points (blended from one swing to the next).
-  // -1: the default, 0.1 for a duty factor of 0.75 or more and 0 below (gait_table.h ResolveSway).
+  // Negative (-1): the default, 0.1 for a duty factor of 0.75 or more and 0 below (ResolveSway).
   double sway = -1;
 };
 
