@@ -56,6 +56,9 @@ double ResolveSway(double sway, double duty);
 // Each leg's sway target: `share` of the way from the centroid of all stance points to the
 // centroid of the other legs' (robot frame, horizontal): where the torso goes while that leg
 // swings. For a rectangle of four feet, share / 3 of the way from the centre to the opposite foot.
+// Scaled by the need: all of it when the centre lies on the edge of the other feet's polygon (the
+// rectangle), none from a margin of a quarter of the lifted foot's distance from the centre (a
+// hexapod lifting a middle foot), linearly in between.
 std::vector<Eigen::Vector2d> SwayTargets(const std::vector<Eigen::Vector2d>& stance, double share);
 
 // How much a leg at fraction u of its cycle weighs in the torso's sway: a raised cosine centred on
