@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "util/error.h"
@@ -109,6 +110,74 @@ Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, doub
   const double s = (u - duty) / (1 - duty);
   const Eigen::Vector2d xy = d * (-0.5 + 0.5 * (1 - std::cos(M_PI * s)));
   return Eigen::Vector3d(xy.x(), xy.y(), lift * std::sin(M_PI * s));
+}
+
+double ResolveSway(double sway, double duty) {
+  const double kDefaultSway = 0.1;  // of the way to the other feet's centroid (relative to the stance polygon)
+  const double kStaticDuty = 0.75;  // duty factor of a crawl: three of four feet down at every instant
+  if (sway >= 0) return sway;
+  return duty >= kStaticDuty - 1e-9 ? kDefaultSway : 0;
+}
+
+namespace {
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+// Convex hull of the points, counter-clockwise (Andrew's monotone chain).
+std::vector<Eigen::Vector2d> Hull(std::vector<Eigen::Vector2d> p) {
+  if (p.size() < 3) return p;
+  std::sort(p.begin(), p.end(), [](const auto& a, const auto& b) { return a.x() < b.x() || (a.x() == b.x() && a.y() < b.y()); });
+  std::vector<Eigen::Vector2d> h(2 * p.size());
+  std::size_t k = 0;
+  for (int pass = 0; pass < 2; ++pass, std::reverse(p.begin(), p.end())) {
+    const std::size_t start = k;
+    for (const auto& q : p) {
+      while (k >= start + 2 && Cross(h[k - 1] - h[k - 2], q - h[k - 2]) <= 0) --k;
+      h[k++] = q;
+    }
+    --k;  // the last point starts the other chain
+  }
+  h.resize(k);
+  return h;
+}
+
+// Signed distance from c to the edge of the convex polygon (counter-clockwise): > 0 inside.
+double Margin(const std::vector<Eigen::Vector2d>& hull, const Eigen::Vector2d& c) {
+  if (hull.size() < 3) return 0;
+  double m = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < hull.size(); ++i) {
+    const Eigen::Vector2d e = hull[(i + 1) % hull.size()] - hull[i];
+    m = std::min(m, Cross(e, c - hull[i]) / e.norm());  // distance left of the edge
+  }
+  return m;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> SwayTargets(const std::vector<Eigen::Vector2d>& stance, double share) {
+  const double kCalmMargin = 0.25;  // margin (of the lifted foot's distance from the centre) needing no sway
+  const int n = static_cast<int>(stance.size());
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (const auto& p : stance) sum += p;
+  const Eigen::Vector2d centre = sum / std::max(n, 1);
+  std::vector<Eigen::Vector2d> out;
+  for (int i = 0; i < n; ++i) {
+    std::vector<Eigen::Vector2d> others = stance;
+    others.erase(others.begin() + i);
+    const double reach = (stance[i] - centre).norm();
+    // need: 1 with the centre on the edge of the others' hull, 0 from a margin of kCalmMargin x reach
+    const double need = std::clamp(1 - Margin(Hull(others), centre) / (kCalmMargin * reach + 1e-12), 0.0, 1.0);
+    // centroid of the others minus the centroid of all = (centre - p_i) / (n - 1)
+    out.push_back(n > 1 ? Eigen::Vector2d(need * share * (centre - stance[i]) / (n - 1)) : Eigen::Vector2d::Zero());
+  }
+  return out;
+}
+
+double SwingWeight(double u, double duty) {
+  const double swing = 1 - duty;
+  double delta = u - (1 + duty) / 2;  // from mid-swing, wrapped to [-0.5, 0.5)
+  delta -= std::floor(delta + 0.5);
+  return std::abs(delta) < swing ? 0.5 * (1 + std::cos(M_PI * delta / swing)) : 0;
 }
 
 }  // namespace dgmm::sim

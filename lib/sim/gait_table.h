@@ -49,4 +49,21 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
 // relative to the torso per stance.
 Eigen::Vector3d FootOffset(double u, double duty, const Eigen::Vector2d& d, double lift);
 
+// The sway share a gait uses: `sway` when given (>= 0); when negative, kDefaultSway for a
+// statically stable duty factor (>= 0.75: at most one leg of four in the air) and 0 below.
+double ResolveSway(double sway, double duty);
+
+// Each leg's sway target: `share` of the way from the centroid of all stance points to the
+// centroid of the other legs' (robot frame, horizontal): where the torso goes while that leg
+// swings. For a rectangle of four feet, share / 3 of the way from the centre to the opposite foot.
+// Scaled by the need: all of it when the centre lies on the edge of the other feet's polygon (the
+// rectangle), none from a margin of a quarter of the lifted foot's distance from the centre (a
+// hexapod lifting a middle foot), linearly in between.
+std::vector<Eigen::Vector2d> SwayTargets(const std::vector<Eigen::Vector2d>& stance, double share);
+
+// How much a leg at fraction u of its cycle weighs in the torso's sway: a raised cosine centred on
+// mid-swing, as wide as the swing on either side (1 there, 0 a swing's length away), so that the
+// weights of back-to-back swings add up to 1 and the torso blends from one target to the next.
+double SwingWeight(double u, double duty);
+
 }  // namespace dgmm::sim

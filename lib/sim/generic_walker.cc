@@ -15,6 +15,9 @@ GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Gr
     : config_(config), model_(std::move(model)), ground_(&ground), source_(source) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
   for (const LegChain& leg : robot_.legs) sides_.push_back(leg.side);
+  std::vector<Eigen::Vector2d> stance;
+  for (const LegChain& leg : robot_.legs) stance.push_back(leg.stance_m.head<2>());
+  sway_ = SwayTargets(stance, ResolveSway(config.robot->gait.sway, robot_.timing.duty));
   ApplyExperiment(config, robot_, model_.get(), source);
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
   control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
@@ -142,7 +145,8 @@ RunOutcome GenericWalker::Stand(double seconds) {
 // legs in the reversed order, GaitTiming::phase_backward, and a side-sequential pattern starts a
 // sideways command with its trailing side, LateralShift); a ramp of a tenth of a cycle at
 // either end of the command starts and ends the pattern at the stance; the stance leans with
-// gravity (robot.gait.lean).
+// gravity (robot.gait.lean) and, in statically stable gaits, sways towards the centroid of the
+// feet that stay down while each leg swings (robot.gait.sway).
 void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration) {
   const double period = config_.robot->gait.period_s;
   const double ramp = 0.1 * period;
@@ -158,20 +162,31 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   if (g.z() < -0.5) lean.head<2>() = config_.robot->gait.lean * robot_.stance_height_m * g.head<2>() / -g.z();
   const std::vector<double>& phase = c.x() < 0 ? robot_.timing.phase_backward : robot_.timing.phase;
   const double shift = LateralShift(robot_.timing, phase, sides_, c.y());
-  std::vector<Eigen::Vector3d> targets(robot_.legs.size());
-  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+  const std::size_t n = robot_.legs.size();
+  std::vector<double> u(n);
+  for (std::size_t i = 0; i < n; ++i) u[i] = t / period - phase[i] - shift;
+  Eigen::Vector3d sway = Eigen::Vector3d::Zero();  // the torso moves by +sway: every foot by -sway
+  sway.head<2>() = envelope * Sway(u);
+  std::vector<Eigen::Vector3d> targets(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const LegChain& leg = robot_.legs[i];
     const Eigen::Vector2d p = leg.stance_m.head<2>();
     const Eigen::Vector2d d = duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) +
                                       config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
-    const double u = t / period - phase[i] - shift;
-    targets[i] = robot_.robot_in_torso * (leg.stance_m + lean + envelope * FootOffset(u, duty, d, robot_.step_height_m));
+    targets[i] = robot_.robot_in_torso *
+                 (leg.stance_m + lean - sway + envelope * FootOffset(u[i], duty, d, robot_.step_height_m));
   }
   SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);
   int k = 0;
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
     for (int j = 0; j < q_[i].size(); ++j) u_[k++] = q_[i][j];
   }
+}
+
+Eigen::Vector2d GenericWalker::Sway(const std::vector<double>& u) const {
+  Eigen::Vector2d b = Eigen::Vector2d::Zero();  // sum over legs of weight(u_i) x target_i
+  for (std::size_t i = 0; i < u.size(); ++i) b += SwingWeight(u[i], robot_.timing.duty) * sway_[i];
+  return b;
 }
 
 RunOutcome GenericWalker::Run(const Eigen::Vector3d& command, const std::function<void(int)>& observe) {

@@ -45,6 +45,9 @@ class GenericWalker {
   bool Fallen() const;
   // The generic gait's joint targets at time t of a command (in u_).
   void Control(const Eigen::Vector3d& command, double t, double duration);
+  // The torso's sway at the legs' cycle fractions u (robot frame): the swinging legs' targets,
+  // weighted by SwingWeight.
+  Eigen::Vector2d Sway(const std::vector<double>& u) const;
   void HoldStance();
   const ReplayTrack& Recording(const Eigen::Vector3d& command) const;
 
@@ -53,6 +56,7 @@ class GenericWalker {
   MjDataPtr data_, scratch_;
   LeggedRobot robot_;
   std::vector<int> sides_;          // each leg's side (+1 left, -1 right), for the gait's timing
+  std::vector<Eigen::Vector2d> sway_;  // each leg's torso sway target while it swings (robot frame)
   std::vector<Eigen::VectorXd> q_;  // each leg's joint targets
   Eigen::VectorXd u_;               // the signal sent now: leg targets (gait) or every actuator's (replay)
   ActuationLine line_;

@@ -71,6 +71,7 @@ GaitDescription ReadGait(const json& j, const std::string& source) {
   f.Number("stance_height_m", &g.stance_height_m, 0, 100);
   f.Number("turn_rad", &g.turn_rad, 0, 3.2);
   f.Number("lean", &g.lean, 0, 1.5);
+  f.Number("sway", &g.sway, -1, 1);
   f.Done();
   static const std::set<std::string> kPatterns = {"auto", "trot", "crawl", "tripod", "tetrapod", "wave",
                                                   "alternating_tetrapod", "custom"};
@@ -183,7 +184,7 @@ std::string RobotDescriptionToJson(const RobotDescription& r) {
                {"stride_m", g.stride_m},       {"step_height_reach", g.step_height_reach},
                {"step_height_m", g.step_height_m}, {"stance_height_reach", g.stance_height_reach},
                {"stance_height_m", g.stance_height_m}, {"turn_rad", g.turn_rad},
-               {"lean", g.lean}};
+               {"lean", g.lean},               {"sway", g.sway}};
   if (!g.phases.empty()) gait["phases"] = g.phases;
   json j = {{"torso_body", r.torso_body},
             {"floor_geom", r.floor_geom},

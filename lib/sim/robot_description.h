@@ -46,6 +46,10 @@ struct GaitDescription {
   // slope: by lean x h tan(slope) along the ground's tilt at the robot's heading (h the stance
   // height). 0: feet where the gait puts them, whatever the ground.
   double lean = 1.0;
+  // Body sway of statically stable gaits: while a leg swings the torso moves `sway` of the way
+  // towards the centroid of the other legs' stance points (blended from one swing to the next).
+  // Negative (-1): the default, 0.1 for a duty factor of 0.75 or more and 0 below (ResolveSway).
+  double sway = -1;
 };
 
 // What drives the legs: the generic gait (foot placement through inverse kinematics), or a

@@ -129,5 +129,41 @@ TEST(GaitTable, FootOffsetIsContinuousAndOnTheGroundInStance) {
   EXPECT_TRUE(FootOffset(-0.3, duty, d, lift).isApprox(FootOffset(0.7, duty, d, lift)));
 }
 
+// The crawl's sway: each leg's target lies a share of the way towards the other three feet's
+// centroid (for a rectangle, share / 3 of the way to the opposite corner; none where the other
+// feet leave the centre a wide margin), and the swing weights
+// of its back-to-back swings add up to 1, so the torso blends from one target to the next.
+TEST(GaitTable, ACrawlSwaysAwayFromEachSwingingFootAndBlendsBetweenSwings) {
+  EXPECT_DOUBLE_EQ(ResolveSway(-1, 0.75), 0.1);  // default: a statically stable duty factor
+  EXPECT_DOUBLE_EQ(ResolveSway(-1, 0.5), 0.0);   // the trot does not sway
+  EXPECT_DOUBLE_EQ(ResolveSway(0.3, 0.5), 0.3);  // as given
+  const std::vector<Eigen::Vector2d> feet = {{0.3, 0.2}, {-0.3, 0.2}, {0.3, -0.2}, {-0.3, -0.2}};
+  const std::vector<Eigen::Vector2d> to = SwayTargets(feet, 0.6);
+  for (std::size_t i = 0; i < feet.size(); ++i) EXPECT_TRUE(to[i].isApprox(-0.2 * feet[i])) << i;
+  // Six feet as long as wide: lifting any one leaves the centre well inside the other five.
+  const std::vector<Eigen::Vector2d> six = {{0.3, 0.2}, {0, 0.25}, {-0.3, 0.2}, {0.3, -0.2}, {0, -0.25}, {-0.3, -0.2}};
+  for (const Eigen::Vector2d& target : SwayTargets(six, 0.6)) EXPECT_EQ(target, Eigen::Vector2d::Zero());
+  // Six feet in a short row (fore-aft 0.1 of the width): lifting a corner foot needs some sway.
+  const std::vector<Eigen::Vector2d> row = {{0.02, 0.2}, {0, 0.2}, {-0.02, 0.2}, {0.02, -0.2}, {0, -0.2}, {-0.02, -0.2}};
+  const Eigen::Vector2d corner = SwayTargets(row, 0.6)[0];
+  EXPECT_GT(corner.norm(), 0.0);
+  EXPECT_LT(corner.norm(), 0.6 * row[0].norm() / 5 + 1e-12);
+  GaitDescription g;
+  g.pattern = "crawl";
+  const GaitTiming t = ResolveGait(g, {{1, 0.3}, {1, -0.3}, {-1, 0.3}, {-1, -0.3}}, "test");
+  for (double time = 0; time < 1; time += 0.01) {
+    double sum = 0, swinging = 0;
+    for (std::size_t i = 0; i < 4; ++i) {
+      const double u = time - t.phase[i];
+      sum += SwingWeight(u, t.duty);
+      if (u - std::floor(u) >= t.duty) swinging += SwingWeight(u, t.duty);
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12) << time;
+    EXPECT_GE(swinging, 0.5 - 1e-12) << time;  // the leg in the air weighs at least half
+  }
+  EXPECT_DOUBLE_EQ(SwingWeight(0.875, 0.75), 1.0);  // mid-swing
+  EXPECT_DOUBLE_EQ(SwingWeight(0.375, 0.75), 0.0);  // mid-stance
+}
+
 }  // namespace
 }  // namespace dgmm::sim
