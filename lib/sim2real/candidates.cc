@@ -221,12 +221,15 @@ bool CandidateOptions::IsValid(std::string* error) const {
   return recording.IsValid(error) && first_pass.IsValid(error);
 }
 
+Eigen::VectorXd CandidateLogVariance(const CandidateSet& set, int k) {
+  if (!set.candidates[k].simulated || set.externals[k].shifts.empty()) return {};
+  return set.shifts[set.externals[k].shifts[0]].log_variance_ratio();
+}
+
 void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, int k,
                          FitProblem* fp) {
   if (set.library[k].is_noise) return;
-  if (set.spread_signatures && set.candidates[k].simulated && !set.externals[k].shifts.empty()) {
-    fp->log_var[k] = set.shifts[set.externals[k].shifts[0]].log_variance_ratio();
-  }
+  if (set.spread_signatures) fp->log_var[k] = CandidateLogVariance(set, k);
   const Samples& real = in.real;
   for (int i = 0; i < real.size(); ++i) {
     SetDesign(fp, k, i,

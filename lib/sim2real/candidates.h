@@ -82,6 +82,9 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
 
 // The fit problem of the real samples with every candidate's design.
 FitProblem MakeCandidateProblem(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set);
+// The spread signature of candidate k: the log-variance ratio per axis of its first recording
+// (signatures.h); empty for a candidate that is not a simulated knob.
+Eigen::VectorXd CandidateLogVariance(const CandidateSet& set, int k);
 // Refills the designs of candidate k (after its shifts changed).
 void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, int k,
                          FitProblem* fp);

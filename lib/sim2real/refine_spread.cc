@@ -33,11 +33,7 @@ void RefineTrackerSpread(const KnobSimulator& simulator, const AnalysisInputs& i
   SpreadProblem sp;
   sp.fit = &r->problem;
   sp.log_var.assign(set->library.size(), Eigen::VectorXd());
-  for (size_t k = 0; k < set->library.size(); ++k) {
-    if (set->candidates[k].simulated && !set->externals[k].shifts.empty()) {
-      sp.log_var[k] = set->shifts[set->externals[k].shifts[0]].log_variance_ratio();
-    }
-  }
+  for (size_t k = 0; k < set->library.size(); ++k) sp.log_var[k] = CandidateLogVariance(*set, static_cast<int>(k));
   SetTrackerSignature(set->shifts[set->tracker_shift], set->tracker_probe, knob, &sp);
   std::vector<int> mean;
   for (int e : sel.selected) {
