@@ -42,8 +42,9 @@ KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const
   if (check.unconverged) {
     for (const auto& f : r.refined) {
       if (f.candidate == k && !f.converged) {
-        check.doubts.push_back(c.knob + Fmt(": its refinement did not converge (best signature coefficient %.2f, "
-                                            "1 expected)", f.coefficient));
+        check.doubts.push_back(c.knob + (f.why.empty() ? Fmt(": its refinement did not converge (best signature "
+                                                             "coefficient %.2f, 1 expected)", f.coefficient)
+                                                       : ": " + f.why));
       }
     }
   }

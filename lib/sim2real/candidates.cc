@@ -247,10 +247,18 @@ FitProblem MakeCandidateProblem(const AnalysisInputs& in, const Baseline& base, 
 PairedShift RecordShift(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                         const std::vector<KnobValue>& values, const CandidateOptions& options, int* recorded,
                         int* from_cache) {
-  const RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), {values}, options.recording);
+  return RecordShifts(simulator, in, set, {values}, options, recorded, from_cache)[0];
+}
+
+std::vector<PairedShift> RecordShifts(const KnobSimulator& simulator, const AnalysisInputs& in,
+                                      const CandidateSet& set, const std::vector<std::vector<KnobValue>>& requests,
+                                      const CandidateOptions& options, int* recorded, int* from_cache) {
+  const RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), requests, options.recording);
   *recorded += batch.recorded;
   *from_cache += batch.from_cache;
-  return PairedShift::Fit(set.nominal, batch.sets[0], in.sim_set, options.slope_ridge);
+  std::vector<PairedShift> out;
+  for (const SampleSet& s : batch.sets) out.push_back(PairedShift::Fit(set.nominal, s, in.sim_set, options.slope_ridge));
+  return out;
 }
 
 CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,

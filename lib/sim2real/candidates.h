@@ -93,5 +93,9 @@ void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const C
 PairedShift RecordShift(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                         const std::vector<KnobValue>& values, const CandidateOptions& options, int* recorded,
                         int* from_cache);
+// The same for several requests at once (recorded in parallel, options.recording.threads).
+std::vector<PairedShift> RecordShifts(const KnobSimulator& simulator, const AnalysisInputs& in,
+                                      const CandidateSet& set, const std::vector<std::vector<KnobValue>>& requests,
+                                      const CandidateOptions& options, int* recorded, int* from_cache);
 
 }  // namespace dgmm::sim2real

@@ -119,44 +119,6 @@ void RefineKnobs(const RefineContext& ctx) {
   }
 }
 
-// The payload: recorded at the mass and position its fit implies, the mass refined along that
-// position; column 0 of its design becomes that recording (knob_design.h).
-void RefinePayload(const RefineContext& ctx) {
-  CandidateSet& set = *ctx.set;
-  const int pay = static_cast<int>(std::find_if(set.candidates.begin(), set.candidates.end(),
-                                                [](const KnobCandidate& c) { return c.key == "payload"; }) -
-                                   set.candidates.begin());
-  const int pos = PositionIn(ctx.out->selection.selected, pay);
-  if (pay >= static_cast<int>(set.candidates.size()) || pos >= static_cast<int>(ctx.out->selection.selected.size()) ||
-      ctx.options.refine_iterations == 0 || ctx.options.refine_knobs == 0) {
-    return;
-  }
-  const Eigen::VectorXd t = ctx.out->selection.fit.theta[pos];
-  if (t(0) <= 0.05) return;  // a payload heavier than nominal (a lighter one has no position to fit)
-  const auto& knobs = ctx.simulator.knobs();
-  const Knob& kx = knobs[set.payload_knob[1]];
-  const Knob& ky = knobs[set.payload_knob[2]];
-  const double px = std::clamp(kx.nominal + t(1) / t(0) * (kx.probes[0] - kx.nominal), kx.lo, kx.hi);
-  const double py = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
-  const KnobCandidate& c = set.candidates[pay];
-  const double start = std::clamp(c.nominal + t(0) * (c.probe - c.nominal), c.lo, c.hi);
-  const std::vector<int> probes = {set.payload_shift[0], set.payload_shift[1], set.payload_shift[2]};
-  const std::string label = c.knob + Fmt(" at (x %.3g, ", px) + Fmt("y %.3g) m", py);
-  const KnobRefinement r = RefineLoop(
-      ctx, pay, start, c.nominal, c.lo, c.hi, t(0), label,
-      [&](double m) {
-        const int s = ctx.Record({KnobValue{set.payload_knob[0], m}, KnobValue{set.payload_knob[1], px},
-                                  KnobValue{set.payload_knob[2], py}});
-        return std::vector<int>{s, probes[0], probes[1], probes[2]};
-      },
-      false);
-  ctx.out->refined.push_back(r);
-  if (!r.recorded) return;
-  ctx.out->payload_mass = r.value, ctx.out->payload_x = px, ctx.out->payload_y = py;
-  FillCandidateDesign(ctx.in, ctx.base, set, pay, &ctx.out->problem);
-  ctx.Reselect();
-}
-
 }  // namespace
 
 bool RefineOptions::IsValid(std::string* error) const {
@@ -195,7 +157,7 @@ Refinement SelectAndRefine(const KnobSimulator& simulator, const AnalysisInputs&
   out.selection_options = ctx.Selection();
   ctx.Reselect();
   RefineKnobs(ctx);
-  RefinePayload(ctx);
+  RefinePayload(simulator, in, base, recording, options, set, &out);
   RefineTrackerSpread(ctx.simulator, in, base, recording, options, set, &out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

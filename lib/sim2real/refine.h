@@ -4,7 +4,7 @@
 // knob is recorded again until its fitted coefficient is about 1 (its signature is then the
 // knob's own effect at that value, not a linear extrapolation from the probe), and the selection
 // reruns; at most `refine_knobs` knobs. The payload (mass at the centre, x and y directions) is
-// recorded at the mass and position its fit implies and the mass refined along that position.
+// found by a likelihood search over its mass and forward offset (refine_payload.cc).
 // A selected noise scale is the tracker's only when the selected knobs' own simulated spread
 // change does not account for it (spread.h); its scale is then refined by re-recording too.
 #include <cmath>
@@ -28,7 +28,8 @@ struct RefineOptions {
 
 struct RefineStep {
   std::string knob;
-  double value = 0, coefficient = 0;  // value recorded, fitted coefficient of its signature
+  double value = 0, coefficient = 0;  // value recorded, fitted coefficient of its signature (NaN: not fitted)
+  double score = NAN;  // a likelihood search's score (log-likelihood per real sample; NaN: a secant step)
 };
 
 // One refined knob (or the payload's mass): did its coefficient reach about 1?
@@ -39,6 +40,7 @@ struct KnobRefinement {
   double coefficient = 0;   // its fitted coefficient (1: the signature is the knob's own effect)
   bool converged = false;   // |coefficient - 1| < converged_within
   bool recorded = false;    // the best signature is a new recording (not the probe's)
+  std::string why;          // why it did not converge, in words (empty: the coefficient's distance from 1)
 };
 
 struct Refinement {
@@ -66,6 +68,13 @@ Refinement SelectAndRefine(const KnobSimulator& simulator, const AnalysisInputs&
 void RefineTrackerSpread(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                          const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
                          Refinement* r);
+
+// The payload part of the stage (refine_payload.cc): when the payload is selected heavier than
+// nominal, a likelihood search over its mass and forward offset from the probes' linear reading;
+// fills r->payload_mass/x/y, the trace and r->refined, and reruns the selection.
+void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                   const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
+                   Refinement* r);
 
 // The value in the knob's unit of candidate k at coefficient(s) theta (unclamped: the fit's own
 // reading, which may lie outside the knob's range). Measurement effects: their own parameter.

@@ -216,10 +216,12 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
   std::ostringstream o;
   o << "<h2>5. Details</h2>\n";
   if (a.knobs_analysed) {
-    o << "<h3>Refinement by re-recording</h3><table><tr><th>knob</th><th>value recorded</th><th>coefficient</th></tr>";
+    o << "<h3>Refinement by re-recording</h3><table><tr><th>knob</th><th>value recorded</th><th>coefficient</th>"
+      << "<th>log-likelihood per real sample (likelihood search)</th></tr>";
     for (const auto& s : a.refinement.trace) {
-      o << "<tr><td>" << Escape(s.knob) << "</td><td>" << F("%.4g", s.value) << "</td><td>" << F("%.3f", s.coefficient)
-        << "</td></tr>";
+      o << "<tr><td>" << Escape(s.knob) << "</td><td>" << F("%.4g", s.value) << "</td><td>"
+        << (std::isfinite(s.coefficient) ? F("%.3f", s.coefficient) : std::string("-")) << "</td><td>"
+        << (std::isfinite(s.score) ? F("%.4f", s.score) : std::string("-")) << "</td></tr>";
     }
     o << "</table>\n<p>Recordings: " << a.candidates.recorded << " for the signatures (" << a.candidates.from_cache
       << " from the cache), " << a.refinement.recorded << " for the refinement; " << a.ties.experiment_checks

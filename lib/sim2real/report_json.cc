@@ -74,10 +74,12 @@ json KnobsJson(const Analysis& a) {
                      {"inclusion", a.confidence.computed ? Num(a.confidence.inclusion[k]) : json(nullptr)}});
   }
   json trace = json::array();
-  for (const auto& s : r.trace) trace.push_back({{"knob", s.knob}, {"value", s.value}, {"coefficient", s.coefficient}});
+  for (const auto& s : r.trace) {
+    trace.push_back({{"knob", s.knob}, {"value", s.value}, {"coefficient", Num(s.coefficient)}, {"score", Num(s.score)}});
+  }
   json refined = json::array();
   for (const auto& f : r.refined) {
-    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", f.coefficient}, {"converged", f.converged}});
+    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", Num(f.coefficient)}, {"converged", f.converged}});
   }
   json removed = json::array();
   for (int k : r.selection.removed) removed.push_back(set.candidates[k].key);

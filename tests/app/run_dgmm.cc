@@ -33,9 +33,21 @@ std::string WithoutXvfbRunLines(const std::string& err) {
 
 }  // namespace
 
+// The process's folder of temporary files, removed when the test process exits (set
+// DGMM_KEEP_TEST_DIRS to keep it for a look after a failure).
+struct TestDirs {
+  std::filesystem::path base =
+      std::filesystem::temp_directory_path() / ("dgmm-test-" + std::to_string(::getpid()));
+  ~TestDirs() {
+    std::error_code ec;
+    if (!std::getenv("DGMM_KEEP_TEST_DIRS")) std::filesystem::remove_all(base, ec);
+  }
+};
+
 std::filesystem::path MakeTempDir(const std::string& name) {
   namespace fs = std::filesystem;
-  fs::path base = fs::temp_directory_path() / ("dgmm-test-" + std::to_string(::getpid()));
+  static const TestDirs dirs;
+  const fs::path& base = dirs.base;
   fs::path dir = base / name;
   fs::remove_all(dir);
   fs::create_directories(dir);

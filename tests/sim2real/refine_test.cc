@@ -37,6 +37,23 @@ TEST(Refine, ThePayloadIsRecordedAtItsFittedPosition) {
   EXPECT_TRUE(traced);
 }
 
+TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
+  const test::Stages s = test::RunStages({{test::kPayloadMass, 2.5}, {test::kPayloadX, 0.12}}, 4);
+  const Refinement& r = s.refinement;
+  ASSERT_TRUE(std::isfinite(r.payload_mass));
+  int scored = 0;
+  for (const auto& t : r.trace) scored += std::isfinite(t.score);
+  EXPECT_GE(scored, 9) << "a 3 x 3 grid of masses and offsets, each scored";
+  EXPECT_NEAR(r.payload_x, 0.12, 0.03);
+  const int k = test::CandidateOf(s.set, "payload");
+  const auto pos = std::find(r.selection.selected.begin(), r.selection.selected.end(), k);
+  ASSERT_NE(pos, r.selection.selected.end());
+  const double mass = CandidateValue(s.set, r, k, r.selection.fit.theta[pos - r.selection.selected.begin()]);
+  EXPECT_NEAR(mass, 2.5, 0.25 * 2.5);
+  ASSERT_FALSE(r.refined.empty());
+  EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
+}
+
 TEST(Refine, NothingSelectedOnANullPairAndNothingRecorded) {
   const test::Stages s = test::RunStages({}, 4);
   EXPECT_TRUE(s.refinement.selection.selected.empty());
