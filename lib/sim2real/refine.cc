@@ -122,8 +122,9 @@ void RefineKnobs(const RefineContext& ctx) {
 }  // namespace
 
 bool RefineOptions::IsValid(std::string* error) const {
-  if (refine_iterations < 0 || refine_knobs < 0 || !(converged_within > 0)) {
-    if (error) *error = "refine_iterations >= 0, refine_knobs >= 0, converged_within > 0";
+  if (refine_iterations < 0 || refine_knobs < 0 || !(converged_within > 0) ||
+      !(payload_contender_share > 0 && payload_contender_share <= 1)) {
+    if (error) *error = "refine_iterations >= 0, refine_knobs >= 0, converged_within > 0, payload_contender_share in (0, 1]";
     return false;
   }
   return selection.IsValid(error) && spread.IsValid(error);
@@ -133,6 +134,14 @@ double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const
   const KnobCandidate& c = set.candidates[k];
   if (c.key == "payload") {
     const double at = std::isfinite(r.payload_mass) ? r.payload_mass : c.probe;
+    // A searched payload's value is the mass whose recording scored best, taken at face value; a
+    // refit (a bootstrap resample's) scales it by its coefficient relative to the final fit's.
+    const auto& sel = r.selection.selected;
+    const auto pos = std::find(sel.begin(), sel.end(), k);
+    if (r.payload_searched && pos != sel.end()) {
+      const double full = r.selection.fit.theta[pos - sel.begin()](0);
+      if (full > 0) return c.nominal + (at - c.nominal) * theta(0) / full;
+    }
     return c.nominal + theta(0) * (at - c.nominal);
   }
   if (c.knob_index >= 0) return c.nominal + theta(0) * (r.signature_at[k] - c.nominal);
@@ -156,8 +165,8 @@ Refinement SelectAndRefine(const KnobSimulator& simulator, const AnalysisInputs&
   const RefineContext ctx{simulator, in, base, recording, options, set, &out};
   out.selection_options = ctx.Selection();
   ctx.Reselect();
-  RefineKnobs(ctx);
   RefinePayload(simulator, in, base, recording, options, set, &out);
+  RefineKnobs(ctx);
   RefineTrackerSpread(ctx.simulator, in, base, recording, options, set, &out);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;

@@ -22,6 +22,10 @@ struct RefineOptions {
   int refine_iterations = 3;      // re-recordings per refined knob (0: no refinement)
   int refine_knobs = 2;           // knobs refined at most (most important first)
   double converged_within = 0.1;  // |coefficient - 1| of a converged refinement
+  // The payload is searched (refine_payload.cc) when selected, or when it is a contender: at the
+  // first selection step significant with at least this share of the best candidate's gain (its
+  // linear probe design can lose to a knob whose effect is linear when its own is not).
+  double payload_contender_share = 0.5;
   SpreadOptions spread;
   bool IsValid(std::string* error) const;
 };
@@ -51,6 +55,7 @@ struct Refinement {
   std::vector<double> signature_at;     // per candidate: the value its signature was recorded at (NaN: none)
   double payload_mass = NAN;            // the payload's refined signature mass (NaN: the probe's)
   double payload_x = NAN, payload_y = NAN;  // and position
+  bool payload_searched = false;        // by the likelihood search (its value is payload_mass)
   SpreadTest spread;
   double tracker_scale = NAN;           // NaN: the tracker noise is not needed
   std::vector<RefineStep> trace;
@@ -69,15 +74,20 @@ void RefineTrackerSpread(const KnobSimulator& simulator, const AnalysisInputs& i
                          const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
                          Refinement* r);
 
-// The payload part of the stage (refine_payload.cc): when the payload is selected heavier than
-// nominal, a likelihood search over its mass and forward offset from the probes' linear reading;
-// fills r->payload_mass/x/y, the trace and r->refined, and reruns the selection.
+// The payload part of the stage (refine_payload.cc): when the payload is selected, or a contender
+// at the first selection step, and reads heavier than nominal, a likelihood search over its mass
+// and forward offset from the probes' linear reading; fills r->payload_mass/x/y, the trace and
+// r->refined, and reruns the selection. Runs before the knobs' refinement.
+// Is the payload (library index `pay`) searched: selected, or at the first selection step
+// significant (z at the step's threshold or above) with at least `share` of the best gain?
+bool PayloadIsAContender(const SelectionResult& sel, int pay, double share);
 void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                    const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
                    Refinement* r);
 
 // The value in the knob's unit of candidate k at coefficient(s) theta (unclamped: the fit's own
-// reading, which may lie outside the knob's range). Measurement effects: their own parameter.
+// reading, which may lie outside the knob's range). A searched payload's: the searched mass at the
+// final fit's coefficient, scaled by theta's coefficient relative to it elsewhere. Measurement effects: their own parameter.
 double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const Eigen::VectorXd& theta);
 
 }  // namespace dgmm::sim2real

@@ -6,8 +6,10 @@
 // reading), each scored by
 //   l(m, x) = max_theta log p(real | sim model + s(m, x) + D_others theta),
 // the recording's own shift taken at face value (coefficient 1), the other selected effects refit.
-// A quadratic in (log m, x) through the nine scores gives the maximum, recorded once more (within
-// twice the grid); the best-scoring recording becomes the payload's signature.
+// When the best point lies on the grid's edge, a second grid is recorded around it (the points
+// already recorded reused). A quadratic in (log m, x) through the last grid's nine scores gives the
+// maximum, recorded once more (within twice the grid); the best-scoring recording becomes the
+// payload's signature.
 #include <algorithm>
 #include <cmath>
 
@@ -22,9 +24,12 @@ constexpr double kOffsetShare = 0.25;  // grid spacing in x: this share of the x
 
 struct PayloadPoint {
   double mass = 0, x = 0;
+  double u = 0, v = 0;   // grid coordinates: mass steps (factor kMassFactor) and offset steps from the reading
   int shift = -1;        // index into CandidateSet::shifts
   double score = -INFINITY;
 };
+
+bool ByScore(const PayloadPoint& a, const PayloadPoint& b) { return a.score < b.score; }
 
 // l(m, x) of the recording `shift` as the payload's signature: the real residuals less its shift,
 // the other selected effects refit on them.
@@ -67,7 +72,81 @@ bool QuadraticMaximum(const std::vector<Eigen::Vector3d>& pts, double u_max, dou
   return true;
 }
 
+// The search's frame: the probes' linear reading (added mass t0 (probe - nominal), offsets t1 / t0
+// and t2 / t0 of the probes') and the grid's spacing; At(u, v) is the point u mass steps and v
+// offset steps from the reading.
+struct SearchFrame {
+  const Knob *mass, *x;
+  double nominal = 0, added = 0, x0 = 0, y = 0, h = 0;
+  PayloadPoint At(double u, double v) const {
+    return {std::clamp(nominal + added * std::exp(u * std::log(kMassFactor)), mass->lo, mass->hi),
+            std::clamp(x0 + v * h, x->lo, x->hi), u, v};
+  }
+};
+
+SearchFrame LinearReading(const std::vector<Knob>& knobs, const CandidateSet& set, const KnobCandidate& c,
+                          const Eigen::VectorXd& t) {
+  const Knob &kx = knobs[set.payload_knob[1]], &ky = knobs[set.payload_knob[2]];
+  SearchFrame f{&knobs[set.payload_knob[0]], &kx};
+  f.nominal = c.nominal;
+  f.added = std::max(t(0) * (c.probe - c.nominal), 1e-3 * (c.probe - c.nominal));
+  f.x0 = std::clamp(kx.nominal + t(1) / t(0) * (kx.probes[0] - kx.nominal), kx.lo, kx.hi);
+  f.y = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
+  f.h = kOffsetShare * std::abs(kx.probes[0] - kx.nominal);
+  return f;
+}
+
+// Records the points in one batch (sideways offset f.y) and scores each.
+void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                    const CandidateOptions& recording, const RefineOptions& options, const SearchFrame& f, int pay,
+                    CandidateSet* set, Refinement* r, std::vector<PayloadPoint>* pts) {
+  std::vector<std::vector<KnobValue>> requests;
+  for (const auto& p : *pts) {
+    requests.push_back({{set->payload_knob[0], p.mass}, {set->payload_knob[1], p.x}, {set->payload_knob[2], f.y}});
+  }
+  auto shifts = RecordShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
+  for (size_t i = 0; i < pts->size(); ++i) {
+    set->shifts.push_back(std::move(shifts[i]));
+    (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
+    (*pts)[i].score = FixedShiftScore(in, base, set, *r, pay, (*pts)[i].shift, options);
+    r->trace.push_back({set->candidates[pay].knob + Fmt(" at (x %.3g, ", (*pts)[i].x) + Fmt("y %.3g) m", f.y),
+                        (*pts)[i].mass, NAN, (*pts)[i].score / in.real.size()});
+  }
+}
+
+// The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
+void Adopt(const AnalysisInputs& in, const Baseline& base, const RefineOptions& options, const SearchFrame& f,
+           int pay, const PayloadPoint& best, bool converged, CandidateSet* set, Refinement* r) {
+  const std::vector<int> probes = set->externals[pay].shifts;
+  set->externals[pay].shifts = {best.shift, probes[probes.size() - 3], probes[probes.size() - 2],
+                                probes[probes.size() - 1]};
+  FillCandidateDesign(in, base, *set, pay, &r->problem);
+  SelectionOptions so = options.selection;
+  so.backward = true;
+  r->selection = ForwardSelect(r->problem, r->rows, base.fold, so);
+  KnobRefinement kr{pay, set->candidates[pay].knob + Fmt(" at (x %.3g, ", best.x) + Fmt("y %.3g) m", f.y), best.mass,
+                    NAN, converged, true};
+  const auto& sel = r->selection.selected;
+  const auto pos = std::find(sel.begin(), sel.end(), pay);
+  if (pos != sel.end()) kr.coefficient = r->selection.fit.theta[pos - sel.begin()](0);
+  if (!converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
+  r->refined.push_back(kr);
+  r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = f.y;
+  r->payload_searched = true;
+}
+
 }  // namespace
+
+bool PayloadIsAContender(const SelectionResult& sel, int pay, double share) {
+  if (std::find(sel.selected.begin(), sel.selected.end(), pay) != sel.selected.end()) return true;
+  if (sel.steps.empty() || sel.steps[0].candidates.empty()) return false;
+  const SelectionStep& first = sel.steps[0];
+  const double best = first.candidates[0].gain;
+  for (const CandidateScore& c : first.candidates) {
+    if (c.effect == pay) return c.z >= first.threshold_z && c.gain >= share * best && c.gain > 0;
+  }
+  return false;
+}
 
 void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                    const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
@@ -75,75 +154,53 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   const auto found = std::find_if(set->candidates.begin(), set->candidates.end(),
                                   [](const KnobCandidate& c) { return c.key == "payload"; });
   const int pay = static_cast<int>(found - set->candidates.begin());
-  const auto& sel = r->selection.selected;
-  const auto at = std::find(sel.begin(), sel.end(), pay);
-  if (found == set->candidates.end() || at == sel.end() || options.refine_iterations == 0 ||
-      options.refine_knobs == 0) {
+  if (found == set->candidates.end() || options.refine_iterations == 0 || options.refine_knobs == 0 ||
+      !PayloadIsAContender(r->selection, pay, options.payload_contender_share)) {
     return;
   }
-  const Eigen::VectorXd t = r->selection.fit.theta[at - sel.begin()];
+  // The probes' linear reading: the selected fit's, or for a contender the payload's fit alone (the
+  // effects selected before it may stand in for it).
+  const auto& sel = r->selection.selected;
+  const auto at = std::find(sel.begin(), sel.end(), pay);
+  const Eigen::VectorXd t = at != sel.end() ? r->selection.fit.theta[at - sel.begin()]
+                                            : FitEffects(r->problem, {pay}, {}, options.selection.fit).theta[0];
   if (t(0) <= 0.05) return;  // a payload heavier than nominal (a lighter one has no position to fit)
-  const auto& knobs = simulator.knobs();
-  const Knob &km = knobs[set->payload_knob[0]], &kx = knobs[set->payload_knob[1]], &ky = knobs[set->payload_knob[2]];
-  const KnobCandidate& c = *found;
-  // The probes' linear reading: added mass t0 (probe - nominal), offsets t1 / t0, t2 / t0 of the probes'.
-  const double added = std::max(t(0) * (c.probe - c.nominal), 1e-3 * (c.probe - c.nominal));
-  const double x0 = std::clamp(kx.nominal + t(1) / t(0) * (kx.probes[0] - kx.nominal), kx.lo, kx.hi);
-  const double py = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
-  const double h = kOffsetShare * std::abs(kx.probes[0] - kx.nominal);
-  const double lf = std::log(kMassFactor);
-  auto point = [&](double u, double v) {
-    return PayloadPoint{std::clamp(c.nominal + added * std::exp(u * lf), km.lo, km.hi),
-                        std::clamp(x0 + v * h, kx.lo, kx.hi)};
-  };
-  auto record = [&](std::vector<PayloadPoint>* pts) {
-    std::vector<std::vector<KnobValue>> requests;
-    for (const auto& p : *pts) {
-      requests.push_back({{set->payload_knob[0], p.mass}, {set->payload_knob[1], p.x}, {set->payload_knob[2], py}});
-    }
-    auto shifts = RecordShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
-    for (size_t i = 0; i < pts->size(); ++i) {
-      set->shifts.push_back(std::move(shifts[i]));
-      (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
-      (*pts)[i].score = FixedShiftScore(in, base, set, *r, pay, (*pts)[i].shift, options);
-    }
-  };
+  const SearchFrame f = LinearReading(simulator.knobs(), *set, *found, t);
+  // Round 1 around the reading; round 2 around round 1's best when that lies on the grid's edge.
   std::vector<PayloadPoint> grid;
-  std::vector<Eigen::Vector3d> scored;
-  for (int iu = -1; iu <= 1; ++iu) {
-    for (int iv = -1; iv <= 1; ++iv) grid.push_back(point(iu, iv));
+  int cu = 0, cv = 0;
+  for (int round = 0; round < 2; ++round) {
+    std::vector<PayloadPoint> fresh;
+    for (int iu = cu - 1; iu <= cu + 1; ++iu) {
+      for (int iv = cv - 1; iv <= cv + 1; ++iv) {
+        const bool known = std::any_of(grid.begin(), grid.end(), [&](const PayloadPoint& p) {
+          return p.u == iu && p.v == iv;
+        });
+        if (!known) fresh.push_back(f.At(iu, iv));
+      }
+    }
+    RecordAndScore(simulator, in, base, recording, options, f, pay, set, r, &fresh);
+    grid.insert(grid.end(), fresh.begin(), fresh.end());
+    const auto top = std::max_element(grid.begin(), grid.end(), ByScore);
+    if (top->u == cu && top->v == cv) break;
+    cu = static_cast<int>(top->u), cv = static_cast<int>(top->v);
   }
-  record(&grid);
-  for (int i = 0; i < 9; ++i) scored.emplace_back(i / 3 - 1, i % 3 - 1, grid[i].score);
+  std::vector<Eigen::Vector3d> scored;
+  for (const auto& p : grid) {
+    if (std::abs(p.u - cu) <= 1 && std::abs(p.v - cv) <= 1) scored.emplace_back(p.u - cu, p.v - cv, p.score);
+  }
   double u = 0, v = 0;
   const bool concave = QuadraticMaximum(scored, 2, 2, &u, &v);
   if (concave) {
-    std::vector<PayloadPoint> extra = {point(u, v)};
-    record(&extra);
+    std::vector<PayloadPoint> extra = {f.At(cu + u, cv + v)};
+    RecordAndScore(simulator, in, base, recording, options, f, pay, set, r, &extra);
     grid.push_back(extra[0]);
   }
-  const auto best = std::max_element(grid.begin(), grid.end(),
-                                     [](const PayloadPoint& a, const PayloadPoint& b) { return a.score < b.score; });
-  const std::string label = c.knob + Fmt(" at (x %.3g, ", best->x) + Fmt("y %.3g) m", py);
-  for (const auto& p : grid) {
-    r->trace.push_back({c.knob + Fmt(" at (x %.3g, ", p.x) + Fmt("y %.3g) m", py), p.mass, NAN, p.score / in.real.size()});
-  }
-  const std::vector<int> probes = set->externals[pay].shifts;
-  set->externals[pay].shifts = {best->shift, probes[probes.size() - 3], probes[probes.size() - 2],
-                                probes[probes.size() - 1]};
-  FillCandidateDesign(in, base, *set, pay, &r->problem);
-  SelectionOptions so = options.selection;
-  so.backward = true;
-  r->selection = ForwardSelect(r->problem, r->rows, base.fold, so);
-  KnobRefinement kr{pay, label, best->mass, NAN, false, true};
-  const auto pos = std::find(r->selection.selected.begin(), r->selection.selected.end(), pay);
-  if (pos != r->selection.selected.end()) kr.coefficient = r->selection.fit.theta[pos - r->selection.selected.begin()](0);
-  // Converged: the search brackets the maximum (the grid's centre scored best, or the quadratic's
-  // maximum lies inside the searched box).
-  kr.converged = best == grid.begin() + 4 || (concave && std::abs(u) < 2 && std::abs(v) < 2);
-  if (!kr.converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
-  r->refined.push_back(kr);
-  r->payload_mass = best->mass, r->payload_x = best->x, r->payload_y = py;
+  const auto best = std::max_element(grid.begin(), grid.end(), ByScore);
+  // Converged: the search brackets the maximum (the last grid's centre scored best, or the
+  // quadratic's maximum lies inside the searched box).
+  const bool converged = (best->u == cu && best->v == cv) || (concave && std::abs(u) < 2 && std::abs(v) < 2);
+  Adopt(in, base, options, f, pay, *best, converged, set, r);
 }
 
 }  // namespace dgmm::sim2real

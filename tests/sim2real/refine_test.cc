@@ -54,6 +54,20 @@ TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
   EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
 }
 
+TEST(Refine, APayloadCloseBehindTheFirstChoiceIsSearchedToo) {
+  SelectionResult sel;
+  sel.steps.push_back({3, {{3, 1.0, 0.1, 9.0}, {7, 0.6, 0.1, 5.0}, {8, 0.3, 0.1, 4.0}}, {}, 2.8});
+  sel.selected = {3};
+  EXPECT_TRUE(PayloadIsAContender(sel, 7, 0.5));
+  EXPECT_FALSE(PayloadIsAContender(sel, 7, 0.7)) << "below the share of the best gain";
+  EXPECT_TRUE(PayloadIsAContender(sel, 8, 0.2)) << "a lower share admits weaker contenders";
+  sel.steps[0].candidates[1].z = 2.0;
+  EXPECT_FALSE(PayloadIsAContender(sel, 7, 0.5)) << "not significant";
+  sel.selected = {3, 7};
+  EXPECT_TRUE(PayloadIsAContender(sel, 7, 0.5)) << "selected";
+  EXPECT_FALSE(PayloadIsAContender(SelectionResult{}, 7, 0.5));
+}
+
 TEST(Refine, NothingSelectedOnANullPairAndNothingRecorded) {
   const test::Stages s = test::RunStages({}, 4);
   EXPECT_TRUE(s.refinement.selection.selected.empty());
