@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <chrono>
 
-#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -51,32 +50,31 @@ int PositionIn(const std::vector<int>& v, int e) {
   return static_cast<int>(std::find(v.begin(), v.end(), e) - v.begin());
 }
 
-// The secant / regula-falsi loop of one refinement: `record(value)` sets candidate k's shifts to a
-// new recording at `value` and returns them; the best (|coefficient - 1| smallest) is kept.
-KnobRefinement RefineLoop(const RefineContext& ctx, int k, double start, double nominal, double lo, double hi,
-                          double first_coefficient, const std::string& label,
-                          const std::function<std::vector<int>(double)>& record, bool trace_start) {
+// The secant / regula-falsi loop refining one-parameter knob candidate k from `start`, its
+// probe's coefficient `first_coefficient`: each step records the knob at a value and refits; the
+// best signature (|coefficient - 1| smallest, the probe's included) is kept.
+KnobRefinement RefineLoop(const RefineContext& ctx, int k, double start, double first_coefficient) {
+  const KnobCandidate& c = ctx.set->candidates[k];
   const int pos = PositionIn(ctx.out->selection.selected, k);
-  std::vector<std::pair<double, double>> trace;
-  if (trace_start) trace.emplace_back(ctx.set->candidates[k].probe, first_coefficient);
-  KnobRefinement r{k, label, trace_start ? ctx.set->candidates[k].probe : start, first_coefficient, false};
-  double best_err = trace_start ? std::abs(first_coefficient - 1) : INFINITY;
+  std::vector<std::pair<double, double>> trace = {{c.probe, first_coefficient}};
+  KnobRefinement r{k, c.knob, c.probe, first_coefficient, false};
+  double best_err = std::abs(first_coefficient - 1);
   std::vector<int> best_shifts = ctx.set->externals[k].shifts;
   double value = start;
   FitProblem trial = ctx.out->problem;
   for (int it = 0; it < ctx.options.refine_iterations && best_err >= ctx.options.converged_within; ++it) {
-    if (std::abs(value - nominal) < 1e-9 * (1 + std::abs(nominal))) break;
-    ctx.set->externals[k].shifts = record(value);
+    if (std::abs(value - c.nominal) < 1e-9 * (1 + std::abs(c.nominal))) break;
+    ctx.set->externals[k].shifts = {ctx.Record({KnobValue{c.knob_index, value}})};
     FillCandidateDesign(ctx.in, ctx.base, *ctx.set, k, &trial);
     const double a = FitEffects(trial, ctx.out->selection.selected, {}, ctx.options.selection.fit).theta[pos](0);
     trace.emplace_back(value, a);
-    ctx.out->trace.push_back({label, value, a});
+    ctx.out->trace.push_back({c.knob, value, a});
     if (std::abs(a - 1) < best_err) {
       best_err = std::abs(a - 1);
       best_shifts = ctx.set->externals[k].shifts;
       r.value = value, r.coefficient = a, r.recorded = true;
     }
-    value = NextRefineValue(trace, nominal, value, a, lo, hi);
+    value = NextRefineValue(trace, c.nominal, value, a, c.lo, c.hi);
   }
   ctx.set->externals[k].shifts = best_shifts;
   r.converged = best_err < ctx.options.converged_within;
@@ -108,9 +106,7 @@ void RefineKnobs(const RefineContext& ctx) {
     const double a0 = ctx.out->selection.fit.theta[pos](0);
     ctx.out->trace.push_back({c.knob, c.probe, a0});
     const double start = std::clamp(c.nominal + a0 * (c.probe - c.nominal), c.lo, c.hi);
-    const KnobRefinement r = RefineLoop(
-        ctx, top, start, c.nominal, c.lo, c.hi, a0, c.knob,
-        [&](double v) { return std::vector<int>{ctx.Record({KnobValue{c.knob_index, v}})}; }, true);
+    const KnobRefinement r = RefineLoop(ctx, top, start, a0);
     ctx.out->refined.push_back(r);
     if (!r.recorded) continue;  // the probe's signature was already the best
     ctx.out->signature_at[top] = r.value;

@@ -74,20 +74,23 @@ void RefineTrackerSpread(const KnobSimulator& simulator, const AnalysisInputs& i
                          const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
                          Refinement* r);
 
-// The payload part of the stage (refine_payload.cc): when the payload is selected, or a contender
-// at the first selection step, and reads heavier than nominal, a likelihood search over its mass
-// and forward offset from the probes' linear reading; fills r->payload_mass/x/y, the trace and
-// r->refined, and reruns the selection. Runs before the knobs' refinement.
 // Is the payload (library index `pay`) searched: selected, or at the first selection step
 // significant (z at the step's threshold or above) with at least `share` of the best gain?
 bool PayloadIsAContender(const SelectionResult& sel, int pay, double share);
+
+// The payload part of the stage (refine_payload.cc): when the payload is selected, or a contender
+// at the first selection step, and reads heavier than nominal, a likelihood search over its mass
+// and forward offset from the probes' linear reading; fills r->payload_mass/x/y, the trace and
+// r->refined, and reruns the selection with r->selection_options. Runs before the knobs'
+// refinement.
 void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                    const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
                    Refinement* r);
 
 // The value in the knob's unit of candidate k at coefficient(s) theta (unclamped: the fit's own
 // reading, which may lie outside the knob's range). A searched payload's: the searched mass at the
-// final fit's coefficient, scaled by theta's coefficient relative to it elsewhere. Measurement effects: their own parameter.
+// final fit's coefficient, scaled by theta's coefficient relative to it elsewhere. Measurement
+// effects: their own parameter.
 double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const Eigen::VectorXd& theta);
 
 }  // namespace dgmm::sim2real

@@ -31,6 +31,11 @@ struct PayloadPoint {
 
 bool ByScore(const PayloadPoint& a, const PayloadPoint& b) { return a.score < b.score; }
 
+// "payload.mass_kg at (x 0.026, y -0.0136) m": a recorded point, as the trace and the refinement name it.
+std::string PointLabel(const std::string& knob, double x, double y) {
+  return knob + Fmt(" at (x %.3g, ", x) + Fmt("y %.3g) m", y);
+}
+
 // l(m, x) of the recording `shift` as the payload's signature: the real residuals less its shift,
 // the other selected effects refit on them.
 double FixedShiftScore(const AnalysisInputs& in, const Baseline& base, CandidateSet* set, const Refinement& r, int pay,
@@ -109,23 +114,20 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
     set->shifts.push_back(std::move(shifts[i]));
     (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
     (*pts)[i].score = FixedShiftScore(in, base, set, *r, pay, (*pts)[i].shift, options);
-    r->trace.push_back({set->candidates[pay].knob + Fmt(" at (x %.3g, ", (*pts)[i].x) + Fmt("y %.3g) m", f.y),
-                        (*pts)[i].mass, NAN, (*pts)[i].score / in.real.size()});
+    r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, f.y), (*pts)[i].mass, NAN,
+                        (*pts)[i].score / in.real.size()});
   }
 }
 
 // The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
-void Adopt(const AnalysisInputs& in, const Baseline& base, const RefineOptions& options, const SearchFrame& f,
-           int pay, const PayloadPoint& best, bool converged, CandidateSet* set, Refinement* r) {
+void Adopt(const AnalysisInputs& in, const Baseline& base, const SearchFrame& f, int pay, const PayloadPoint& best,
+           bool converged, CandidateSet* set, Refinement* r) {
   const std::vector<int> probes = set->externals[pay].shifts;
   set->externals[pay].shifts = {best.shift, probes[probes.size() - 3], probes[probes.size() - 2],
                                 probes[probes.size() - 1]};
   FillCandidateDesign(in, base, *set, pay, &r->problem);
-  SelectionOptions so = options.selection;
-  so.backward = true;
-  r->selection = ForwardSelect(r->problem, r->rows, base.fold, so);
-  KnobRefinement kr{pay, set->candidates[pay].knob + Fmt(" at (x %.3g, ", best.x) + Fmt("y %.3g) m", f.y), best.mass,
-                    NAN, converged, true};
+  r->selection = ForwardSelect(r->problem, r->rows, base.fold, r->selection_options);
+  KnobRefinement kr{pay, PointLabel(set->candidates[pay].knob, best.x, f.y), best.mass, NAN, converged, true};
   const auto& sel = r->selection.selected;
   const auto pos = std::find(sel.begin(), sel.end(), pay);
   if (pos != sel.end()) kr.coefficient = r->selection.fit.theta[pos - sel.begin()](0);
@@ -200,7 +202,7 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   // Converged: the search brackets the maximum (the last grid's centre scored best, or the
   // quadratic's maximum lies inside the searched box).
   const bool converged = (best->u == cu && best->v == cv) || (concave && std::abs(u) < 2 && std::abs(v) < 2);
-  Adopt(in, base, options, f, pay, *best, converged, set, r);
+  Adopt(in, base, f, pay, *best, converged, set, r);
 }
 
 }  // namespace dgmm::sim2real
