@@ -152,36 +152,14 @@ void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vecto
   AddImuAndHeading(in, set);
 }
 
-// The side knobs a first pass implicates: a side knob's candidate selected, or among the
-// `side_top` best candidates of a forward step with a positive held-out gain at z >= side_min_z (a
-// weak leg shows first as its side, often below the step's Bonferroni threshold while other
-// effects stand in for it). `why` says what implicated the first of them.
-std::vector<int> ImplicatedSides(const CandidateSet& set, const FitProblem& fp, const Baseline& base,
-                                 const CandidateOptions& options, std::string* why) {
+// The first pass: forward selection with the backward pass over every candidate but the legs.
+SelectionResult FirstPass(const FitProblem& fp, const Baseline& base, const CandidateOptions& options) {
   std::vector<int> rows(fp.n);
   for (int i = 0; i < fp.n; ++i) rows[i] = i;
   SelectionOptions quick = options.first_pass;
   quick.bootstrap_selection = 0;
   quick.backward = true;
-  const SelectionResult sel = ForwardSelect(fp, rows, base.fold, quick);
-  std::vector<int> sides;
-  auto implicate = [&](int e, const std::string& because) {
-    const KnobCandidate& c = set.candidates[e];
-    if (c.side.empty() || std::find(sides.begin(), sides.end(), c.knob_index) != sides.end()) return;
-    if (sides.empty()) *why = c.knob + because;
-    sides.push_back(c.knob_index);
-  };
-  for (int e : sel.selected) implicate(e, " was selected in the first pass");
-  for (size_t s = 0; s < sel.steps.size(); ++s) {
-    const auto& cands = sel.steps[s].candidates;
-    for (size_t r = 0; r < cands.size() && static_cast<int>(r) < options.side_top; ++r) {
-      if (cands[r].gain > 0 && cands[r].z >= options.side_min_z) {
-        implicate(cands[r].effect, Fmt(" ranked %.0f of the first pass's step %.0f", r + 1.0, s + 1.0) +
-                                       Fmt(" (held-out z %.1f)", cands[r].z));
-      }
-    }
-  }
-  return sides;
+  return ForwardSelect(fp, rows, base.fold, quick);
 }
 
 // The per-leg knobs of the implicated sides (every leg when a side does not list its legs).
@@ -212,6 +190,30 @@ std::string SideProbeToppled(const CandidateSet& set, const std::vector<Knob>& k
 }
 
 }  // namespace
+
+std::vector<int> ImplicatedSides(const CandidateSet& set, const SelectionResult& sel, const CandidateOptions& options,
+                                 std::string* why) {
+  std::vector<int> sides;
+  auto implicate = [&](int e, const std::string& because) {
+    const KnobCandidate& c = set.candidates[e];
+    if (c.side.empty() || std::find(sides.begin(), sides.end(), c.knob_index) != sides.end()) return;
+    if (sides.empty()) *why = c.knob + because;
+    sides.push_back(c.knob_index);
+  };
+  for (int e : sel.selected) implicate(e, " was selected in the first pass");
+  for (size_t s = 0; s < sel.steps.size(); ++s) {
+    int rank = 0;  // among the simulator's knobs: a measurement effect is no alternative to a leg
+    for (const CandidateScore& c : sel.steps[s].candidates) {
+      if (!set.candidates[c.effect].simulated) continue;
+      if (++rank > options.side_top) break;
+      if (c.gain > 0 && c.z >= options.side_min_z) {
+        implicate(c.effect, Fmt(" ranked %.0f among the simulator's knobs", rank) +
+                                Fmt(" in the first pass's step %.0f", s + 1.0) + Fmt(" (held-out z %.1f)", c.z));
+      }
+    }
+  }
+  return sides;
+}
 
 bool CandidateOptions::IsValid(std::string* error) const {
   if (placements < 0 || executions_per_placement < 0 || !(slope_ridge >= 0) || side_top < 1) {
@@ -293,7 +295,8 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
   }
   std::string why = SideProbeToppled(set, knobs);
   if (why.empty()) {
-    const std::vector<int> sides = ImplicatedSides(set, MakeCandidateProblem(in, base, set), base, options, &why);
+    const std::vector<int> sides =
+        ImplicatedSides(set, FirstPass(MakeCandidateProblem(in, base, set), base, options), options, &why);
     if (sides.empty()) {
       set.legs_note = "per-leg probes not recorded: no side knob is implicated by the first pass";
       return set;

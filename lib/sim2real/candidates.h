@@ -7,9 +7,9 @@
 //
 // Per-leg probes cost one recording per leg and value: they are recorded only for the legs of a
 // side a cheaper first pass (every other knob) implicates, i.e. whose side knob is selected or
-// ranks among the best `side_top` candidates of a forward step with held-out z >= side_min_z (both
-// sides' legs when both are), or for every leg when the robot has no side knobs at all or a side
-// probe toppled it.
+// ranks among the best `side_top` simulator knobs' candidates of a forward step (measurement
+// effects not counted) with held-out z >= side_min_z (both sides' legs when both are), or for
+// every leg when the robot has no side knobs at all or a side probe toppled it.
 #include <string>
 #include <vector>
 
@@ -34,7 +34,7 @@ struct CandidateOptions {
   RecordingOptions recording;   // cache and threads
   bool legs_only_when_implicated = true;
   SelectionOptions first_pass;  // the selection that decides whether a side is implicated
-  int side_top = 3;             // ... by a side knob among this many best candidates of a step
+  int side_top = 3;             // ... by a side knob among this many best simulator knobs of a step
   double side_min_z = 1.0;      // ... with at least this held-out z
   // Experimental: a knob's coefficient also scales the corrected covariance by its recording's
   // log-variance ratio per axis (effect_fit.h), so a knob whose effect is mostly a wider spread (a
@@ -79,6 +79,15 @@ struct CandidateSet {
 
 CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                              const CandidateOptions& options);
+
+// The side knobs (knob indices) the first pass `sel` implicates: a side knob's candidate
+// selected, or among the `side_top` best simulator knobs' candidates of a forward step
+// (measurement effects not counted: tracker noise often ranks first for a leg that sags now and
+// then) with a positive held-out gain at z >= side_min_z (a weak leg shows first as its side,
+// often below the step's Bonferroni threshold while other effects stand in for it). `why` says
+// what implicated the first of them.
+std::vector<int> ImplicatedSides(const CandidateSet& set, const SelectionResult& sel, const CandidateOptions& options,
+                                 std::string* why);
 
 // The fit problem of the real samples with every candidate's design.
 FitProblem MakeCandidateProblem(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set);

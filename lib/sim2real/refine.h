@@ -1,10 +1,12 @@
 #pragma once
 // Stage 4 of the analysis (analysis.h): selection by held-out real likelihood (selection.h, with
-// the backward pass), then refinement by re-recording. The most important selected one-parameter
-// knob is recorded again until its fitted coefficient is about 1 (its signature is then the
-// knob's own effect at that value, not a linear extrapolation from the probe), and the selection
-// reruns; at most `refine_knobs` knobs. The payload (mass at the centre, x and y directions) is
-// found by a likelihood search over its mass and forward offset (refine_payload.cc).
+// the backward pass), then refinement by re-recording. The payload (mass at the centre, x and y
+// directions) is found by a likelihood search over its mass and forward offset
+// (refine_payload.cc); then the most important selected one-parameter knobs, at most
+// `refine_knobs`, each by a likelihood search over its value (refine_knob.cc). A search scores a
+// recording by the real log-likelihood with its shift at face value (refine_search.h): its best
+// recording is the knob's own effect at that value, not a linear extrapolation from a probe, and
+// becomes the signature; the selection reruns.
 // A selected noise scale is the tracker's only when the selected knobs' own simulated spread
 // change does not account for it (spread.h); its scale is then refined by re-recording too.
 #include <cmath>
@@ -19,9 +21,9 @@ namespace dgmm::sim2real {
 struct RefineOptions {
   std::uint64_t seed = 1;
   SelectionOptions selection;     // the backward pass is always on
-  int refine_iterations = 3;      // re-recordings per refined knob (0: no refinement)
+  int refine_iterations = 3;      // a search's steps beyond its first grid (0: no refinement)
   int refine_knobs = 2;           // knobs refined at most (most important first)
-  double converged_within = 0.1;  // |coefficient - 1| of a converged refinement
+  double converged_within = 0.1;  // |coefficient - 1| of a converged tracker-noise refinement
   // The payload is searched (refine_payload.cc) when selected, or when it is a contender: at the
   // first selection step significant with at least this share of the best candidate's gain (its
   // linear probe design can lose to a knob whose effect is linear when its own is not).
@@ -33,16 +35,17 @@ struct RefineOptions {
 struct RefineStep {
   std::string knob;
   double value = 0, coefficient = 0;  // value recorded, fitted coefficient of its signature (NaN: not fitted)
-  double score = NAN;  // a likelihood search's score (log-likelihood per real sample; NaN: a secant step)
+  double score = NAN;  // a likelihood search's score (log-likelihood per real sample; NaN: the tracker noise's secant step)
 };
 
-// One refined knob (or the payload's mass): did its coefficient reach about 1?
+// One refined knob, the payload's mass or the tracker noise: did the search bracket its best value
+// (the tracker noise: did its coefficient reach about 1)?
 struct KnobRefinement {
   int candidate = -1;
   std::string knob;
   double value = 0;         // the value of the best signature
   double coefficient = 0;   // its fitted coefficient (1: the signature is the knob's own effect)
-  bool converged = false;   // |coefficient - 1| < converged_within
+  bool converged = false;   // bracketed (tracker noise: |coefficient - 1| < converged_within)
   bool recorded = false;    // the best signature is a new recording (not the probe's)
   std::string why;          // why it did not converge, in words (empty: the coefficient's distance from 1)
 };
@@ -55,7 +58,7 @@ struct Refinement {
   std::vector<double> signature_at;     // per candidate: the value its signature was recorded at (NaN: none)
   double payload_mass = NAN;            // the payload's refined signature mass (NaN: the probe's)
   double payload_x = NAN, payload_y = NAN;  // and position
-  bool payload_searched = false;        // by the likelihood search (its value is payload_mass)
+  std::vector<bool> searched;           // per candidate: its signature comes from a likelihood search
   SpreadTest spread;
   double tracker_scale = NAN;           // NaN: the tracker noise is not needed
   std::vector<RefineStep> trace;
@@ -87,9 +90,16 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
                    const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set,
                    Refinement* r);
 
+// The likelihood search over one-parameter knob candidate k's value (refine_knob.cc), its probe's
+// linear reading at coefficient a0: every candidate of that knob takes the best recording as its
+// signature; appends to r->refined and r->trace, and reruns the selection.
+void SearchKnob(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                const CandidateOptions& recording, const RefineOptions& options, CandidateSet* set, Refinement* r,
+                int k, double a0);
+
 // The value in the knob's unit of candidate k at coefficient(s) theta (unclamped: the fit's own
-// reading, which may lie outside the knob's range). A searched payload's: the searched mass at the
-// final fit's coefficient, scaled by theta's coefficient relative to it elsewhere. Measurement
+// reading, which may lie outside the knob's range). A searched knob's or payload's: the searched value
+// at the final fit's coefficient, its deviation scaled by theta's coefficient relative to it elsewhere. Measurement
 // effects: their own parameter.
 double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const Eigen::VectorXd& theta);
 

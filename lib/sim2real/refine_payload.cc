@@ -14,6 +14,7 @@
 #include <cmath>
 
 #include "sim2real/refine.h"
+#include "sim2real/refine_search.h"
 #include "sim2real/sentence_format.h"
 
 namespace dgmm::sim2real {
@@ -34,27 +35,6 @@ bool ByScore(const PayloadPoint& a, const PayloadPoint& b) { return a.score < b.
 // "payload.mass_kg at (x 0.026, y -0.0136) m": a recorded point, as the trace and the refinement name it.
 std::string PointLabel(const std::string& knob, double x, double y) {
   return knob + Fmt(" at (x %.3g, ", x) + Fmt("y %.3g) m", y);
-}
-
-// l(m, x) of the recording `shift` as the payload's signature: the real residuals less its shift,
-// the other selected effects refit on them.
-double FixedShiftScore(const AnalysisInputs& in, const Baseline& base, CandidateSet* set, const Refinement& r, int pay,
-                       int shift, const RefineOptions& options) {
-  FitProblem trial = r.problem;
-  const std::vector<int> keep = set->externals[pay].shifts;
-  set->externals[pay].shifts = {shift, keep[keep.size() - 3], keep[keep.size() - 2], keep[keep.size() - 1]};
-  FillCandidateDesign(in, base, *set, pay, &trial);
-  set->externals[pay].shifts = keep;
-  for (int i = 0; i < trial.n; ++i) {
-    trial.r0.row(i) -= trial.g[pay].col(0).segment(i * trial.dx, trial.dx).transpose();
-    trial.raw.row(i) -= trial.d[pay].col(0).segment(i * trial.dx, trial.dx).transpose();
-  }
-  std::vector<int> others;
-  for (int e : r.selection.selected) {
-    if (e != pay) others.push_back(e);
-  }
-  if (others.empty()) return CorrectedLogLikelihood(trial, EffectFit{}).sum();
-  return FitEffects(trial, others, {}, options.selection.fit).train_log_likelihood;
 }
 
 // The maximum of ll = a + b u + c v + d u^2 + e v^2 + g u v fitted to the points (u, v, ll), within
@@ -113,7 +93,11 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
   for (size_t i = 0; i < pts->size(); ++i) {
     set->shifts.push_back(std::move(shifts[i]));
     (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
-    (*pts)[i].score = FixedShiftScore(in, base, set, *r, pay, (*pts)[i].shift, options);
+    const std::vector<int>& probes = set->externals[pay].shifts;
+    (*pts)[i].score = FaceValueScore(in, base, set, *r, pay,
+                                     {(*pts)[i].shift, probes[probes.size() - 3], probes[probes.size() - 2],
+                                      probes[probes.size() - 1]},
+                                     {}, options);
     r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, f.y), (*pts)[i].mass, NAN,
                         (*pts)[i].score / in.real.size()});
   }
@@ -134,7 +118,7 @@ void Adopt(const AnalysisInputs& in, const Baseline& base, const SearchFrame& f,
   if (!converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
   r->refined.push_back(kr);
   r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = f.y;
-  r->payload_searched = true;
+  r->searched[pay] = true;
 }
 
 }  // namespace

@@ -37,6 +37,29 @@ TEST(Candidates, AWeakLegImplicatesItsSideAndThenThatSidesLegsAreProbed) {
   }
 }
 
+TEST(Candidates, MeasurementEffectsRankedAboveASideDoNotHideIt) {
+  // The hexapod's weak front leg in one first pass (seed 25002): tracker noise, then three knobs,
+  // nothing selected; the right side's gain ranks fourth overall but third among the knobs.
+  const test::Stages s = test::RunStages({}, 3);
+  const int noise = test::CandidateOf(s.set, "tracker_noise");
+  const int friction = test::CandidateOf(s.set, "floor.friction@0.6");
+  const int latency = test::CandidateOf(s.set, "actuators.latency_s@0.04");
+  const int right = test::CandidateOf(s.set, "actuators.side.right.gain@0.5");
+  SelectionResult sel;
+  sel.steps.push_back({-1, {{noise, 13.5, 10.2, 1.3}, {friction, 0.13, 0.07, 1.8}, {latency, 0.07, 0.18, 0.4},
+                            {right, 0.06, 0.03, 2.0}}, {}, 3.1});
+  std::string why;
+  const std::vector<int> sides = ImplicatedSides(s.set, sel, s.options.candidates, &why);
+  ASSERT_EQ(sides.size(), 1u);
+  EXPECT_EQ(sides[0], test::kRightGain);
+  EXPECT_NE(why.find("ranked 3 among the simulator's knobs"), std::string::npos) << why;
+  sel.steps[0].candidates[3].z = 0.5;
+  EXPECT_TRUE(ImplicatedSides(s.set, sel, s.options.candidates, &why).empty()) << "below side_min_z";
+  sel.steps[0].candidates.insert(sel.steps[0].candidates.begin() + 1, {test::CandidateOf(s.set, "payload"), 0.2, 0.05, 4});
+  sel.steps[0].candidates[4].z = 2.0;
+  EXPECT_TRUE(ImplicatedSides(s.set, sel, s.options.candidates, &why).empty()) << "fourth among the knobs";
+}
+
 TEST(Candidates, ACandidatesDesignIsItsRecordedShift) {
   const test::Stages s = test::RunStages({}, 3);
   const FitProblem fp = MakeCandidateProblem(s.in, s.base, s.set);

@@ -55,11 +55,12 @@ Eigen::Vector3d Gravity(double pitch, double roll) {
 
 // The mean pose change of one execution.
 Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, double roll, bool first,
-                     const FakeExtras& extras) {
+                     const FakeExtras& extras, double friction_threshold) {
   const Eigen::Vector3d g = Gravity(pitch, roll);
   Eigen::Vector3d x(0.2 * c(0) + 0.05 * g(0) * std::abs(c(0)), 0.15 * c(1) + 0.04 * g(1) * std::abs(c(1)),
                     0.3 * c(2) + 0.02 * g(1));
-  const double slip = (1 - k.v[kFriction]) + 0.5 * (1 - k.v[kFriction]) * (1 - k.v[kFriction]);
+  const double slip = friction_threshold > 0 ? 2 * std::max(0.0, friction_threshold - k.v[kFriction])
+                                             : (1 - k.v[kFriction]) + 0.5 * (1 - k.v[kFriction]) * (1 - k.v[kFriction]);
   x += slip * Eigen::Vector3d(0.15 * g(0), 0.15 * g(1), 0.0);
   const double left = 1 - k.v[kLeftGain], right = 1 - k.v[kRightGain];
   x += (left - right) * Eigen::Vector3d(0, 0.02 * c(0), 0.12 * c(0) + 0.02);
@@ -109,6 +110,11 @@ FakeSimulator::FakeSimulator() {
   for (int leg = 0; leg < 4; ++leg) knobs_[kLeg0Gain + leg].leg = "leg" + std::to_string(leg);
 }
 
+FakeSimulator::FakeSimulator(double friction_threshold, std::vector<double> friction_probes) : FakeSimulator() {
+  friction_threshold_ = friction_threshold;
+  knobs_[kFriction].probes = std::move(friction_probes);
+}
+
 SampleSet FakeSimulator::Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const {
   {
     std::lock_guard<std::mutex> lock(mu_);
@@ -147,7 +153,7 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
       Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
       s.z.row(i) << pitch, roll;
-      s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras) +
+      s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras, friction_threshold_) +
                     k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise)).transpose();
     }
   }
@@ -179,7 +185,7 @@ CellRecording FakeSimulator::RecordCell(const Cell& cell, const std::vector<Knob
     const double pitch = cell.terrain(0) + 0.01 * unit(rng), roll = cell.terrain(1) + 0.01 * unit(rng);
     Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
     out.set.z.row(i) << pitch, roll;
-    out.set.x.row(i) = (Mean(k, cell.command, pitch, roll, out.set.step(i) == 0, FakeExtras{}) +
+    out.set.x.row(i) = (Mean(k, cell.command, pitch, roll, out.set.step(i) == 0, FakeExtras{}, friction_threshold_) +
                         k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise)).transpose();
   }
   out.placement = "the fake plane";

@@ -46,8 +46,14 @@ struct FakeExtras {
 class FakeSimulator : public KnobSimulator {
  public:
   FakeSimulator();
+  // A fake whose friction only slips below `threshold` (slip 2 (threshold - f) below it, none
+  // above, as a Coulomb contact's), probed at `probes`.
+  FakeSimulator(double friction_threshold, std::vector<double> friction_probes);
   const std::vector<Knob>& knobs() const override { return knobs_; }
-  std::string Fingerprint() const override { return "fake-simulator-v1"; }
+  std::string Fingerprint() const override {
+    return friction_threshold_ > 0 ? "fake-simulator-v1-threshold-" + std::to_string(friction_threshold_)
+                                   : "fake-simulator-v1";
+  }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
   std::string ConfigJson(const std::vector<KnobValue>& values) const override;
@@ -69,6 +75,7 @@ class FakeSimulator : public KnobSimulator {
 
  private:
   std::vector<Knob> knobs_;
+  double friction_threshold_ = 0;
   mutable std::atomic<int> records_{0}, cells_{0};
   mutable std::mutex mu_;
   mutable std::vector<int> threads_seen_;

@@ -1,5 +1,5 @@
 // Stage 4: selection and refinement by re-recording. The fake's friction is non-linear, so the
-// probe's linear extrapolation is off and the refinement must move the signature to the value.
+// probe's linear extrapolation is off and the likelihood search must find the value.
 #include "sim2real/refine.h"
 
 #include <gtest/gtest.h>
@@ -9,21 +9,40 @@
 namespace dgmm::sim2real {
 namespace {
 
-TEST(Refine, FrictionIsRefinedUntilItsCoefficientIsAboutOne) {
+// The value the selected friction stands for, and the refinement of it.
+double NamedFriction(const test::Stages& s, const std::string& key) {
+  const Refinement& r = s.refinement;
+  const int k = test::CandidateOf(s.set, key);
+  const auto pos = std::find(r.selection.selected.begin(), r.selection.selected.end(), k);
+  if (pos == r.selection.selected.end()) return NAN;
+  return CandidateValue(s.set, r, k, r.selection.fit.theta[pos - r.selection.selected.begin()]);
+}
+
+TEST(Refine, FrictionIsFoundByALikelihoodSearchOverItsValue) {
   const test::Stages s = test::RunStages({{test::kFriction, 0.45}}, 4);
   const Refinement& r = s.refinement;
   ASSERT_FALSE(r.refined.empty());
   EXPECT_EQ(r.refined[0].knob, "floor.friction");
-  EXPECT_TRUE(r.refined[0].converged) << r.refined[0].coefficient;
+  EXPECT_TRUE(r.refined[0].converged) << "the search brackets its best value";
   EXPECT_TRUE(r.refined[0].recorded);
-  EXPECT_GE(r.recorded, 1);
+  int scored = 0;
+  for (const auto& t : r.trace) scored += t.knob == "floor.friction" && std::isfinite(t.score);
+  EXPECT_GE(scored, 4) << "the probe and a grid of three, each scored";
   const int k = test::CandidateOf(s.set, "floor.friction@0.6");
   EXPECT_EQ(r.signature_at[k], r.refined[0].value);
-  const int pos = static_cast<int>(std::find(r.selection.selected.begin(), r.selection.selected.end(), k) -
-                                   r.selection.selected.begin());
-  ASSERT_LT(pos, static_cast<int>(r.selection.selected.size()));
-  // The value the coefficient stands for is the planted one (the fake is exact up to noise).
-  EXPECT_NEAR(CandidateValue(s.set, r, k, r.selection.fit.theta[pos]), 0.45, 0.05);
+  EXPECT_TRUE(r.searched[k]);
+  // The value the signature stands for is the planted one (the fake is exact up to noise).
+  EXPECT_NEAR(NamedFriction(s, "floor.friction@0.6"), 0.45, 0.05);
+}
+
+TEST(Refine, AFrictionThatOnlySlipsBelowAThresholdIsFoundWhereTheLinearReadingIsFlat) {
+  // Probed at 0.35 below a threshold of 0.6, planted at 0.45: the linear reading (about 0.61) lies
+  // where friction changes nothing, so no coefficient there can say how far to go.
+  const test::FakeSimulator fake(0.6, {0.35});
+  const test::Stages s = test::RunStages(fake, {{test::kFriction, 0.45}}, 4);
+  ASSERT_FALSE(s.refinement.refined.empty());
+  EXPECT_TRUE(s.refinement.refined[0].converged);
+  EXPECT_NEAR(NamedFriction(s, "floor.friction@0.35"), 0.45, 0.05);
 }
 
 TEST(Refine, ThePayloadIsRecordedAtItsFittedPosition) {

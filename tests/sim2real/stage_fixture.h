@@ -25,15 +25,16 @@ struct Stages {
 
 // Runs the stages up to and including `last` (2 baseline, 3 candidates, 4 refine, 5 confidence,
 // 6 adequacy and naming).
-inline Stages RunStages(const std::vector<KnobValue>& planted, int last, const FakeExtras& extras = {}) {
+inline Stages RunStages(const FakeSimulator& fake, const std::vector<KnobValue>& planted, int last,
+                        const FakeExtras& extras = {}) {
   Stages s;
-  const FakePair pair = MakeFakePair(SharedFake(), planted, extras);
+  const FakePair pair = MakeFakePair(fake, planted, extras);
   s.in = PrepareInputs(pair.sim, pair.real, s.options.seed);
   s.base = LocateMismatch(s.in, s.options.locate);
   if (last < 3) return s;
-  s.set = BuildCandidates(SharedFake(), s.in, s.base, s.options.candidates);
+  s.set = BuildCandidates(fake, s.in, s.base, s.options.candidates);
   if (last < 4) return s;
-  s.refinement = SelectAndRefine(SharedFake(), s.in, s.base, s.options.candidates, s.options.refine, &s.set);
+  s.refinement = SelectAndRefine(fake, s.in, s.base, s.options.candidates, s.options.refine, &s.set);
   if (last < 5) return s;
   std::mt19937_64 rng(2);
   s.confidence = AssessConfidence(s.set, s.refinement, rng);
@@ -41,6 +42,10 @@ inline Stages RunStages(const std::vector<KnobValue>& planted, int last, const F
   s.adequacy = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
   s.naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
   return s;
+}
+
+inline Stages RunStages(const std::vector<KnobValue>& planted, int last, const FakeExtras& extras = {}) {
+  return RunStages(SharedFake(), planted, last, extras);
 }
 
 inline int CandidateOf(const CandidateSet& set, const std::string& key) {

@@ -1,0 +1,20 @@
+#pragma once
+// The score of stage 4's likelihood searches (refine.h): a recording taken at face value as
+// candidate k's signature,
+//   l = max_theta log p(real | sim model + s + D_others theta),
+// its paired shift s at coefficient 1, the other selected effects (less `skip`) refit on what is
+// left. A knob whose effect is far from linear in its value (friction with a threshold, a payload's
+// position) is found where its own recording fits the real samples best, not where a linear
+// extrapolation from a probe says.
+#include <vector>
+
+#include "sim2real/refine.h"
+
+namespace dgmm::sim2real {
+
+// `shifts`: candidate k's external shifts with the searched recording first (the payload keeps its
+// x and y probes after it). Returns log-likelihood summed over the real samples.
+double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateSet* set, const Refinement& r, int k,
+                      const std::vector<int>& shifts, const std::vector<int>& skip, const RefineOptions& options);
+
+}  // namespace dgmm::sim2real
