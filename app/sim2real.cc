@@ -39,6 +39,7 @@ struct Sim2RealArgs {
   bool json = false;
   bool no_figures = false;
   bool spread_signatures = false;
+  bool every_leg = false;
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -131,6 +132,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args) {
   o.candidates.placements = args.signature_placements;
   o.candidates.executions_per_placement = args.signature_executions;
   o.candidates.spread_signatures = args.spread_signatures;
+  o.candidates.legs_only_when_implicated = !args.every_leg;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -262,6 +264,8 @@ void Setup(CLI::App& root) {
                   "executions per placement of a signature recording (5: the paper protocol's; 2: 0.44 of the "
                   "time, but near-ties between knobs are decided less well, docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(2, 100));
+  cmd->add_flag("--every-leg", args->every_leg,
+                "probe every leg's gain (default: only the legs of a side the first pass implicates)");
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
                "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");

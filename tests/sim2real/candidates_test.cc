@@ -37,6 +37,17 @@ TEST(Candidates, AWeakLegImplicatesItsSideAndThenThatSidesLegsAreProbed) {
   }
 }
 
+TEST(Candidates, EveryLegIsProbedWhenAsked) {
+  // dgmm sim2real --every-leg: no first pass decides, every leg's gain is a candidate.
+  test::Stages s = test::RunStages({}, 2);
+  CandidateOptions options = s.options.candidates;
+  options.legs_only_when_implicated = false;
+  const CandidateSet set = BuildCandidates(test::SharedFake(), s.in, s.base, options);
+  EXPECT_TRUE(set.legs_probed);
+  EXPECT_NE(set.legs_note.find("(always)"), std::string::npos) << set.legs_note;
+  for (int leg = 0; leg < 4; ++leg) EXPECT_GE(test::CandidateOf(set, "actuators.leg" + std::to_string(leg) + ".gain@0.5"), 0);
+}
+
 TEST(Candidates, MeasurementEffectsRankedAboveASideDoNotHideIt) {
   // The hexapod's weak front leg in one first pass (seed 25002): tracker noise, then three knobs,
   // nothing selected; the right side's gain ranks fourth overall but third among the knobs.
