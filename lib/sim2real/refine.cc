@@ -59,7 +59,7 @@ namespace {
 double SearchedValue(const Refinement& r, int k, double nominal, double at, const Eigen::VectorXd& theta) {
   const auto& sel = r.selection.selected;
   const auto pos = std::find(sel.begin(), sel.end(), k);
-  if (r.searched[k] && pos != sel.end()) {
+  if (k < static_cast<int>(r.searched.size()) && r.searched[k] && pos != sel.end()) {
     const double full = r.selection.fit.theta[pos - sel.begin()](0);
     if (full > 0) return nominal + (at - nominal) * theta(0) / full;
   }
