@@ -35,7 +35,8 @@ struct RefineOptions {
 struct RefineStep {
   std::string knob;
   double value = 0, coefficient = 0;  // value recorded, fitted coefficient of its signature (NaN: not fitted)
-  double score = NAN;  // a likelihood search's score (log-likelihood per real sample; NaN: the tracker noise's secant step)
+  // A likelihood search's score (log-likelihood per real sample; NaN: the tracker noise's secant step).
+  double score = NAN;
 };
 
 // One refined knob, the payload's mass or the tracker noise: did the search bracket its best value
@@ -98,9 +99,9 @@ void SearchKnob(const KnobSimulator& simulator, const AnalysisInputs& in, const 
                 int k, double a0);
 
 // The value in the knob's unit of candidate k at coefficient(s) theta (unclamped: the fit's own
-// reading, which may lie outside the knob's range). A searched knob's or payload's: the searched value
-// at the final fit's coefficient, its deviation scaled by theta's coefficient relative to it elsewhere. Measurement
-// effects: their own parameter.
+// reading, which may lie outside the knob's range). A searched knob's or payload's: the searched
+// value at the final fit's coefficient, its deviation scaled by theta's coefficient relative to it
+// elsewhere. Measurement effects: their own parameter.
 double CandidateValue(const CandidateSet& set, const Refinement& r, int k, const Eigen::VectorXd& theta);
 
 }  // namespace dgmm::sim2real

@@ -66,9 +66,11 @@ struct KnobSearch {
   KnobFrame f;
   std::vector<int> same;  // candidates of the same knob (k among them): not refit while scoring
 
-  double Score(int shift) const { return FaceValueScore(in, base, set, *r, k, {shift}, same, options); }
-  void Trace(const KnobPoint& p) const {
+  // Scores the recording `shift` of the knob at `value`, traces it and adds it to `pts`.
+  void Add(double value, int shift, std::vector<KnobPoint>* pts) const {
+    KnobPoint p{value, f.UOf(value), shift, FaceValueScore(in, base, set, *r, k, {shift}, same, options)};
     r->trace.push_back({set->candidates[k].knob, p.value, NAN, p.score / in.real.size()});
+    pts->push_back(p);
   }
   // Records the values not yet known (one batch) and scores them into `pts`.
   void RecordAndScore(const std::vector<double>& values, std::vector<KnobPoint>* pts) const {
@@ -83,10 +85,7 @@ struct KnobSearch {
     auto shifts = RecordShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
     for (size_t i = 0; i < fresh.size(); ++i) {
       set->shifts.push_back(std::move(shifts[i]));
-      KnobPoint p{fresh[i], f.UOf(fresh[i]), static_cast<int>(set->shifts.size()) - 1};
-      p.score = Score(p.shift);
-      Trace(p);
-      pts->push_back(p);
+      Add(fresh[i], static_cast<int>(set->shifts.size()) - 1, pts);
     }
   }
 };
@@ -149,11 +148,7 @@ void SearchKnob(const KnobSimulator& simulator, const AnalysisInputs& in, const 
   std::vector<KnobPoint> pts;
   for (int j : s.same) {  // the probes' own recordings, on the reading's side of the nominal
     const double v = set->candidates[j].probe;
-    if (!std::isfinite(s.f.UOf(v)) || s.f.Known(pts, v)) continue;
-    KnobPoint p{v, s.f.UOf(v), set->externals[j].shifts[0]};
-    p.score = s.Score(p.shift);
-    s.Trace(p);
-    pts.push_back(p);
+    if (std::isfinite(s.f.UOf(v)) && !s.f.Known(pts, v)) s.Add(v, set->externals[j].shifts[0], &pts);
   }
   const size_t probes = pts.size();
   s.RecordAndScore({s.f.ValueAt(-1), s.f.ValueAt(0), s.f.ValueAt(1)}, &pts);

@@ -37,6 +37,12 @@ std::string PointLabel(const std::string& knob, double x, double y) {
   return knob + Fmt(" at (x %.3g, ", x) + Fmt("y %.3g) m", y);
 }
 
+// The payload's shifts with the recording `shift` as its mass column: `probes` (its current shifts)
+// end with the x and y probes' and the centre probe's, which stay.
+std::vector<int> WithMassShift(const std::vector<int>& probes, int shift) {
+  return {shift, probes[probes.size() - 3], probes[probes.size() - 2], probes[probes.size() - 1]};
+}
+
 // The maximum of ll = a + b u + c v + d u^2 + e v^2 + g u v fitted to the points (u, v, ll), within
 // |u| <= u_max, |v| <= v_max; false when the fit is not concave.
 bool QuadraticMaximum(const std::vector<Eigen::Vector3d>& pts, double u_max, double v_max, double* u, double* v) {
@@ -93,11 +99,8 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
   for (size_t i = 0; i < pts->size(); ++i) {
     set->shifts.push_back(std::move(shifts[i]));
     (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
-    const std::vector<int>& probes = set->externals[pay].shifts;
-    (*pts)[i].score = FaceValueScore(in, base, set, *r, pay,
-                                     {(*pts)[i].shift, probes[probes.size() - 3], probes[probes.size() - 2],
-                                      probes[probes.size() - 1]},
-                                     {}, options);
+    (*pts)[i].score =
+        FaceValueScore(in, base, set, *r, pay, WithMassShift(set->externals[pay].shifts, (*pts)[i].shift), {}, options);
     r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, f.y), (*pts)[i].mass, NAN,
                         (*pts)[i].score / in.real.size()});
   }
@@ -106,9 +109,7 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
 // The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
 void Adopt(const AnalysisInputs& in, const Baseline& base, const SearchFrame& f, int pay, const PayloadPoint& best,
            bool converged, CandidateSet* set, Refinement* r) {
-  const std::vector<int> probes = set->externals[pay].shifts;
-  set->externals[pay].shifts = {best.shift, probes[probes.size() - 3], probes[probes.size() - 2],
-                                probes[probes.size() - 1]};
+  set->externals[pay].shifts = WithMassShift(set->externals[pay].shifts, best.shift);
   FillCandidateDesign(in, base, *set, pay, &r->problem);
   r->selection = ForwardSelect(r->problem, r->rows, base.fold, r->selection_options);
   KnobRefinement kr{pay, PointLabel(set->candidates[pay].knob, best.x, f.y), best.mass, NAN, converged, true};
