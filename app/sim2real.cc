@@ -123,8 +123,10 @@ std::optional<sim::SimConfig> ResolveConfig(const Sim2RealArgs& args, const Samp
   return std::nullopt;
 }
 
-sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args) {
+// `uneven_ground`: the simulator config's ground is a height field.
+sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_ground) {
   sim2real::AnalysisOptions o;
+  o.locate.uneven_ground = uneven_ground;
   const int threads = args.threads > 0 ? args.threads : std::max(1u, std::thread::hardware_concurrency());
   o.seed = args.seed;
   o.locate.seed = args.seed;
@@ -171,10 +173,10 @@ void WriteOutputs(const Sim2RealArgs& args, const sim2real::Analysis& a, const s
 
 // The analysis; when the simulator cannot re-record the sim set's recording (e.g. a protocol it
 // does not know), the report says why and the analysis only locates.
-sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, const Sim2RealArgs& args,
+sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, const Sim2RealArgs& args, bool uneven,
                                    std::unique_ptr<MujocoKnobSimulator>* simulator, std::string* why,
                                    sim2real::ReportContext* ctx) {
-  const sim2real::AnalysisOptions options = MakeOptions(args);
+  const sim2real::AnalysisOptions options = MakeOptions(args, uneven);
   if (!*simulator) return sim2real::Analyse(sim, real, nullptr, options, *why);
   try {
     sim2real::Analysis a = sim2real::Analyse(sim, real, simulator->get(), options, *why);
@@ -222,7 +224,12 @@ void Run(const Sim2RealArgs& args) {
   if (!simulator) ctx.notes.push_back(why);
   ReportStage("sim2real: analysing " + std::to_string(real.size()) + " real vs " + std::to_string(sim.size()) +
               " sim samples");
-  const sim2real::Analysis a = AnalyseOrLocate(sim, real, args, &simulator, &why, &ctx);
+  const sim2real::Analysis a =
+      AnalyseOrLocate(sim, real, args, config && config->terrain.has_value(), &simulator, &why, &ctx);
+  if (a.baseline.permute_placements) {
+    ctx.notes.push_back("locate's tests permute whole placements (" + a.baseline.permute_why +
+                        "), so a region needs several placements on each side to be found");
+  }
   // Everything is written into a sibling folder that replaces -o whole at the end.
   AtomicDir output(args.out, "report.json");
   WriteOutputs(args, a, simulator.get(), output.temp_path(), &ctx);

@@ -9,6 +9,8 @@
 namespace dgmm::sim2real {
 namespace {
 
+constexpr int kTailsBootstrap = 200;  // placement resamples of the tails test's SE on uneven ground
+
 std::string Value(double v, const std::string& unit) { return Fmt("%.4g", v) + (unit.empty() ? "" : " " + unit); }
 
 KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const AdequacyOptions& options) {
@@ -98,9 +100,18 @@ void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refineme
   out->residuals = resid * std::exp(-fit.log_tau);
   std::vector<int> terrain_id(n, -1);
   if (in.real.terrain_dim() > 0 && base.terrain_centres.rows() > 0) terrain_id = base.real_terrain;
-  const double sim_kurtosis = ExcessKurtosis(base.sim_model.WhitenedResiduals(in.sim));
-  out->residual = TestResidualStructure(out->residuals, in.real.command, terrain_id, in.real.episode, step, sim_kurtosis,
-                                        options.residual, options.seed);
+  // Where a placement's executions are dependent (uneven ground), the tails test is made as locate's
+  // tests are: against the sim set's cross-fitted residuals (an in-sample fit of a few placements per
+  // command bounds its own residuals), its SE counting placements, not samples.
+  const Eigen::MatrixXd sim_resid =
+      base.permute_placements ? base.sim_residuals : base.sim_model.WhitenedResiduals(in.sim);
+  ResidualStructureOptions residual = options.residual;
+  if (base.permute_placements) residual.tails_bootstrap = kTailsBootstrap;
+  const double sim_se = base.permute_placements
+                            ? ExcessKurtosisSe(sim_resid, in.sim.episode, kTailsBootstrap, options.seed + 2)
+                            : 0.0;
+  out->residual = TestResidualStructure(out->residuals, in.real.command, terrain_id, in.real.episode, step,
+                                        ExcessKurtosis(sim_resid), residual, options.seed, sim_se);
 }
 
 // The held-out fit against the ceiling; the located regions that remain.

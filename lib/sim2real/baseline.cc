@@ -1,6 +1,7 @@
 #include "sim2real/baseline.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <map>
 #include <set>
 
@@ -96,7 +97,7 @@ bool BaselineOptions::IsValid(std::string* error) const {
     if (error) *error = "folds >= 2, terrain_regions >= 1 and sim_residual_folds >= 2";
     return false;
   }
-  return model.IsValid(error) && locate.IsValid(error);
+  return model.IsValid(error) && locate.IsValid(error) && placement.IsValid(error);
 }
 
 LocateSummary LocateModel(const AnalysisInputs& in, const Baseline& base, const Eigen::MatrixXd& real_residuals,
@@ -114,8 +115,10 @@ LocateSummary LocateModel(const AnalysisInputs& in, const Baseline& base, const 
   li.terrain_labels = base.terrain_labels;
   li.command_labels = in.command_labels;
   li.with_pooled_x = with_pooled_x;
+  LocateOptions o = options;
+  o.permute_placements = options.permute_placements || base.permute_placements;
   LocateSummary s;
-  s.regions = Locate(li, options, rng);
+  s.regions = Locate(li, o, rng);
   s.heat = HeatMap(s.regions, in.real_commands, static_cast<int>(base.terrain_labels.size()));
   for (const auto& g : s.regions) {
     if (!g.significant) continue;
@@ -143,6 +146,20 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
   TerrainRegions(in, options, rng, &b);
   b.sim_residuals = CrossFittedResiduals(in.sim, options.model, options.sim_residual_folds, rng);
   b.real_residuals = b.sim_model.WhitenedResiduals(in.real);
+  PlacementDependenceOptions placement = options.placement;
+  placement.seed = options.seed;
+  // Each set's residuals under its own fit: what z and the command leave, nothing of the mismatch.
+  const LinearGaussianModel real_own = LinearGaussianModel::Fit(in.real, options.model);
+  b.placement = TestPlacementDependence(in.sim, b.sim_model.WhitenedResiduals(in.sim), in.real,
+                                        real_own.WhitenedResiduals(in.real), placement);
+  b.permute_placements = options.uneven_ground || b.placement.dependent;
+  if (options.uneven_ground) {
+    b.permute_why = "the simulator's ground is a height field: where a placement stands shapes its executions";
+  } else if (b.placement.dependent) {
+    char p[32];
+    std::snprintf(p, sizeof p, "%.3g", b.placement.p_value);
+    b.permute_why = std::string("the executions at one placement are not independent: placement test p = ") + p;
+  }
   b.before = LocateModel(in, b, b.real_residuals, b.heldout_sim, true, options.locate, rng);
   b.significant_mismatch = b.before.conditional_flagged > 0;
   return b;

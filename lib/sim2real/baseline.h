@@ -12,6 +12,7 @@
 #include "sim2real/inputs.h"
 #include "sim2real/linear_gaussian.h"
 #include "sim2real/locate.h"
+#include "sim2real/placement_dependence.h"
 
 namespace dgmm::sim2real {
 
@@ -22,6 +23,10 @@ struct BaselineOptions {
   int sim_residual_folds = 5;
   LinearGaussianOptions model;
   LocateOptions locate;
+  PlacementDependenceOptions placement;  // its seed is this seed
+  // The simulator's ground is a height field: where a placement stands shapes all its executions
+  // and z does not say where, so locate permutes whole placements whatever the test says.
+  bool uneven_ground = false;
   bool IsValid(std::string* error) const;
 };
 
@@ -45,6 +50,11 @@ struct Baseline {
   std::vector<int> real_terrain, sim_terrain;  // region per sample
   Eigen::MatrixXd sim_residuals;      // cross-fitted whitened sim residuals (the null of the tests)
   Eigen::MatrixXd real_residuals;     // whitened real residuals under the sim model
+  // Are the executions at a placement dependent? When they are, or the ground is uneven, every
+  // locate permutes whole placements (LocateOptions::permute_placements), for the reason in words.
+  PlacementDependence placement;
+  bool permute_placements = false;
+  std::string permute_why;
   LocateSummary before;
   bool significant_mismatch = false;  // a terrain, sequence or command region is significant
 };
@@ -52,7 +62,8 @@ struct Baseline {
 Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options);
 
 // Locate for another model of the real samples: its whitened residuals (n x dx) and held-out
-// log-likelihoods (n), against the baseline's sim residuals and ceiling. `rng` seeds the tests.
+// log-likelihoods (n), against the baseline's sim residuals and ceiling. `rng` seeds the tests;
+// placements are permuted whole when `options` or the baseline's placement test says so.
 LocateSummary LocateModel(const AnalysisInputs& in, const Baseline& base, const Eigen::MatrixXd& real_residuals,
                           const Eigen::VectorXd& heldout, bool with_pooled_x, const LocateOptions& options,
                           std::mt19937_64& rng);

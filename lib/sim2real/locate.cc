@@ -17,6 +17,12 @@ Eigen::MatrixXd Rows(const Eigen::MatrixXd& m, const std::vector<int>& rows) {
   return out;
 }
 
+std::vector<int> Labels(const std::vector<int>& label, const std::vector<int>& rows) {
+  std::vector<int> out(rows.size());
+  for (size_t k = 0; k < rows.size(); ++k) out[k] = label[rows[k]];
+  return out;
+}
+
 }  // namespace
 
 bool LocateOptions::IsValid(std::string* error) const {
@@ -118,7 +124,10 @@ class RegionBuilder {
     double sum = 0;
     for (int i : rr) sum += in_.ceiling_heldout(i) - in_.model_heldout(i);
     r.deficit = rr.empty() ? 0.0 : sum / rr.size();
-    const MmdResult m = MmdTest(Rows(a, rr), Rows(b, sr), options_.mmd, rng_);
+    const MmdResult m = options_.permute_placements
+                            ? MmdTest(Rows(a, rr), Rows(b, sr), Labels(in_.real->episode, rr),
+                                      Labels(in_.sim->episode, sr), options_.mmd, rng_)
+                            : MmdTest(Rows(a, rr), Rows(b, sr), options_.mmd, rng_);
     r.mmd2 = m.mmd2;
     r.p_value = m.p_value;
     all_.push_back(r);

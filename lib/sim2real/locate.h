@@ -52,6 +52,9 @@ struct LocateOptions {
   MmdOptions mmd;
   double alpha = 0.05;
   int min_real_per_cell = 3;
+  // Permute whole placements (Samples::episode) instead of samples: the executions at one
+  // placement share its ground and are not exchangeable one by one on rough ground.
+  bool permute_placements = false;
   bool IsValid(std::string* error) const;
 };
 

@@ -44,6 +44,10 @@ json LocateJson(const Analysis& a) {
   const LocateSummary& s = a.baseline.before;
   return {{"terrain_regions", a.baseline.terrain_labels},
           {"significant_mismatch", a.baseline.significant_mismatch},
+          {"placement_dependence", {{"statistic", a.baseline.placement.statistic},
+                                    {"p_value", a.baseline.placement.p_value},
+                                    {"tests_permute", a.baseline.permute_placements ? "placements" : "samples"},
+                                    {"why", a.baseline.permute_why}}},
           {"pooled_x_flagged_commands", s.pooled_x_flagged},
           {"conditional_flagged_regions", s.conditional_flagged},
           {"regions", Regions(s.regions)},

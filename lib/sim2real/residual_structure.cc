@@ -54,6 +54,31 @@ double ExcessKurtosis(const Eigen::MatrixXd& r) {
   return total / r.cols();
 }
 
+double ExcessKurtosisSe(const Eigen::MatrixXd& r, const std::vector<int>& episode, int resamples, std::uint64_t seed) {
+  std::map<int, std::vector<int>> rows_of;
+  for (size_t i = 0; i < episode.size(); ++i) rows_of[episode[i]].push_back(static_cast<int>(i));
+  std::vector<const std::vector<int>*> units;
+  for (const auto& [e, rows] : rows_of) units.push_back(&rows);
+  if (units.size() < 2 || resamples < 2) return NAN;
+  std::mt19937_64 rng(seed);
+  std::uniform_int_distribution<size_t> pick(0, units.size() - 1);
+  std::vector<double> k;
+  for (int b = 0; b < resamples; ++b) {
+    std::vector<int> rows;
+    for (size_t u = 0; u < units.size(); ++u) {
+      const auto* unit = units[pick(rng)];
+      rows.insert(rows.end(), unit->begin(), unit->end());
+    }
+    Eigen::MatrixXd rb(rows.size(), r.cols());
+    for (size_t i = 0; i < rows.size(); ++i) rb.row(i) = r.row(rows[i]);
+    k.push_back(ExcessKurtosis(rb));
+  }
+  const double mean = std::accumulate(k.begin(), k.end(), 0.0) / k.size();
+  double ss = 0;
+  for (double v : k) ss += (v - mean) * (v - mean);
+  return std::sqrt(ss / (k.size() - 1));
+}
+
 namespace {
 
 // The residuals per episode (the exchangeable unit): sums, counts and labels (the first sample's
@@ -178,7 +203,8 @@ void StepTest(const Eigen::MatrixXd& r, const EpisodeUnits& e, const std::vector
 ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vector<int>& command,
                                         const std::vector<int>& terrain, const std::vector<int>& episode,
                                         const std::vector<int>& step, double sim_kurtosis,
-                                        const ResidualStructureOptions& options, std::uint64_t seed) {
+                                        const ResidualStructureOptions& options, std::uint64_t seed,
+                                        double sim_kurtosis_se) {
   ResidualStructure out;
   const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
   std::mt19937_64 rng(seed);
@@ -191,7 +217,10 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vec
     ResidualTest t;
     t.where = "tails";
     const double k = ExcessKurtosis(r);
-    const double se = std::sqrt(24.0 / std::max(1, n * dx));
+    const double se =
+        options.tails_bootstrap > 0
+            ? std::hypot(ExcessKurtosisSe(r, episode, options.tails_bootstrap, seed + 1), sim_kurtosis_se)
+            : std::sqrt(24.0 / std::max(1, n * dx));
     t.statistic = k - sim_kurtosis;
     t.p_value = t.statistic > std::max(1.0, 4 * se) ? 0.0 : 1.0;
     out.tests.push_back(t);

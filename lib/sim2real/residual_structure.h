@@ -8,7 +8,8 @@
 //             within each episode); "periodic" when the step means alternate in sign
 //             (lag-1 autocorrelation of the step-mean profile < -0.3)
 //   tails:    excess kurtosis of |r_i|^2-normalised residuals over the sim set's own
-//             (a difference > max(1, 4 SE) with SE = sqrt(24 / (n dx)))
+//             (a difference > max(1, 4 SE) with SE = sqrt(24 / (n dx)), or, where the executions
+//             at one placement are dependent, the two kurtoses' placement-bootstrap SEs combined)
 // Bonferroni over the four tests.
 #include <Eigen/Dense>
 #include <cstdint>
@@ -19,6 +20,9 @@ namespace dgmm::sim2real {
 
 struct ResidualStructureOptions {
   int permutations = 1000;
+  // > 0: the tails test's SE from this many bootstrap resamples of placements (rough ground, where
+  // a few placements hang up and a sample-count SE is far too small); 0: sqrt(24 / (n dx)).
+  int tails_bootstrap = 0;
   double alpha = 0.01;  // family-wise over the four tests
   bool IsValid(std::string* error) const;
 };
@@ -38,13 +42,18 @@ struct ResidualStructure {
 
 // `residuals` n x dx; `command`, `terrain` (region id, -1: none), `episode`, `step` per sample
 // (step -1: no sequence data); `sim_kurtosis` the excess kurtosis of the sim set's own
-// whitened residuals (NaN: skip the tails test).
+// whitened residuals (NaN: skip the tails test) and `sim_kurtosis_se` its standard error (used
+// with options.tails_bootstrap).
 ResidualStructure TestResidualStructure(const Eigen::MatrixXd& residuals, const std::vector<int>& command,
                                         const std::vector<int>& terrain, const std::vector<int>& episode,
                                         const std::vector<int>& step, double sim_kurtosis,
-                                        const ResidualStructureOptions& options, std::uint64_t seed);
+                                        const ResidualStructureOptions& options, std::uint64_t seed,
+                                        double sim_kurtosis_se = 0);
 
 // Mean excess kurtosis over the columns of r (n x dx).
 double ExcessKurtosis(const Eigen::MatrixXd& r);
+
+// Its standard error over `resamples` bootstrap resamples of whole placements (`episode` per row).
+double ExcessKurtosisSe(const Eigen::MatrixXd& r, const std::vector<int>& episode, int resamples, std::uint64_t seed);
 
 }  // namespace dgmm::sim2real

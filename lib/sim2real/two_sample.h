@@ -25,6 +25,13 @@ struct MmdResult {
 MmdResult MmdTest(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const MmdOptions& options,
                   std::mt19937_64& rng);
 
+// The same test with rows exchangeable only in whole clusters (e.g. the executions of one
+// placement, which share the ground under the robot): a permutation reassigns whole clusters, as
+// many clusters to a's side as a has. cluster_a[i] labels row i of a, cluster_b row i of b; labels
+// are per side (cluster 3 of a and cluster 3 of b are different clusters).
+MmdResult MmdTest(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const std::vector<int>& cluster_a,
+                  const std::vector<int>& cluster_b, const MmdOptions& options, std::mt19937_64& rng);
+
 // Benjamini-Hochberg adjusted p-values (q-values), same order as p.
 std::vector<double> BenjaminiHochberg(const std::vector<double>& p);
 

@@ -82,6 +82,7 @@ struct Verdict {
   double min_inclusion = 0;               // the threshold (family inclusion)
   std::vector<std::string> doubts;        // every doubt, in words (the named knobs' and the correction's)
   bool unexplained_present = false;
+  bool uneven_ground = false;  // locate permuted whole placements (Baseline::permute_placements)
   std::vector<std::string> structured_in;
   double gap_closed = 0;  // NaN: no gap (null)
   std::string sentence;   // one plain-language paragraph for the conclusion

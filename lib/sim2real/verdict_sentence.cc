@@ -108,7 +108,10 @@ std::string VerdictSentence(const Verdict& v, const Adequacy* adequacy, const Na
     s += v.status == "located" || v.status == "clean" ? " Note:" : " Doubts:";
     for (size_t d = 0; d < v.doubts.size(); ++d) s += Fmt(" (%.0f) ", d + 1.0) + v.doubts[d] + (d + 1 < v.doubts.size() ? ";" : ".");
     if (v.status == "partly_explained" || v.status == "unexplained") {
-      s += " What the knobs leave may be physics outside the knob list (e.g. leg geometry, a mass on one leg, a worn foot).";
+      s += " What the knobs leave may be physics outside the knob list (e.g. leg geometry, a mass on one leg, a worn foot)";
+      s += v.uneven_ground ? ", or a change in how the outcomes spread (how often the robot hangs up on the ground), "
+                             "which the correction, a shift of the means, does not model."
+                           : ".";
     }
   }
   return s;

@@ -23,6 +23,35 @@ TEST(Baseline, LocatesAPlantedMismatchAndNotANullOne) {
   EXPECT_TRUE(null.base.before.significant.empty());
 }
 
+// Rough ground: where a placement stands shapes all its executions. A null pair (two draws of
+// places) is clean because locate then permutes whole placements; a planted friction is still
+// located.
+TEST(Baseline, OnRoughGroundANullPairIsCleanAndAPlantedOneLocated) {
+  test::FakeSimulator rough;
+  rough.ground_sd = 1.5;
+  const test::Stages null = test::RunStages(rough, {}, 2);
+  EXPECT_TRUE(null.base.placement.dependent);
+  EXPECT_FALSE(null.base.significant_mismatch);
+  const test::Stages slip = test::RunStages(rough, {{test::kFriction, 0.5}}, 2);
+  EXPECT_TRUE(slip.base.placement.dependent);
+  EXPECT_TRUE(slip.base.significant_mismatch);
+  const test::Stages plane = test::RunStages({}, 2);
+  EXPECT_FALSE(plane.base.placement.dependent);
+  EXPECT_FALSE(plane.base.permute_placements);
+}
+
+// A simulator ground that is a height field permutes whole placements whatever the test says.
+TEST(Baseline, AnUnevenGroundPermutesPlacements) {
+  const test::FakeSimulator& fake = test::SharedFake();
+  AnalysisOptions o = test::FastOptions(1);
+  o.locate.uneven_ground = true;
+  const test::FakePair pair = test::MakeFakePair(fake, {}, {});
+  const Analysis a = Analyse(pair.sim, pair.real, nullptr, o, "locate only");
+  EXPECT_FALSE(a.baseline.placement.dependent);
+  EXPECT_TRUE(a.baseline.permute_placements);
+  EXPECT_NE(a.baseline.permute_why.find("height field"), std::string::npos);
+}
+
 TEST(Baseline, LocateModelOfTheSimModelIsTheBaselinesOwn) {
   const test::Stages s = test::RunStages({{test::kFriction, 0.5}}, 2);
   std::mt19937_64 rng(5);

@@ -146,6 +146,12 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
     int c;
     double heading;
     Placement(recording.seed, p, &rng, &c, &heading);
+    Eigen::Vector3d stands = Eigen::Vector3d::Zero();
+    if (ground_sd > 0) {
+      std::mt19937_64 ground(recording.seed * 7919 + p);
+      std::normal_distribution<double> place(0, ground_sd);
+      for (int j = 0; j < 3; ++j) stands(j) = kNoiseSd(j) * place(ground);
+    }
     for (int e = 0; e < 5; ++e) {
       const int i = 5 * p + e;
       const double pitch = kSlopeRad * std::cos(heading) + 0.02 * unit(rng);
@@ -154,7 +160,7 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
       s.z.row(i) << pitch, roll;
       s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras, friction_threshold_) +
-                    k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise)).transpose();
+                    k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise) + stands).transpose();
     }
   }
   s.x_names = {"dx", "dy", "dyaw"};

@@ -51,8 +51,9 @@ class FakeSimulator : public KnobSimulator {
   FakeSimulator(double friction_threshold, std::vector<double> friction_probes);
   const std::vector<Knob>& knobs() const override { return knobs_; }
   std::string Fingerprint() const override {
-    return friction_threshold_ > 0 ? "fake-simulator-v1-threshold-" + std::to_string(friction_threshold_)
-                                   : "fake-simulator-v1";
+    return (friction_threshold_ > 0 ? "fake-simulator-v1-threshold-" + std::to_string(friction_threshold_)
+                                    : "fake-simulator-v1") +
+           (ground_sd > 0 ? "-ground-" + std::to_string(ground_sd) : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -71,6 +72,9 @@ class FakeSimulator : public KnobSimulator {
   // Friction values below this topple the robot: the recording keeps one placement only.
   double topples_below_friction = 0;
   double topples_below_side_gain = 0;  // likewise for either side's gain
+  // Rough ground: every execution at a placement shares an offset of this many noise sds, drawn
+  // per (recording seed, placement): where the robot stands, which z does not tell.
+  double ground_sd = 0;
   int cells() const { return cells_; }
 
  private:

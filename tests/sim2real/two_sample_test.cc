@@ -49,5 +49,59 @@ TEST(MmdTest, TooFewSamplesGiveNoEvidence) {
   EXPECT_EQ(MmdTest(Normal(1, 2, 5, rng), Normal(10, 2, 0, rng), MmdOptions{}, rng).p_value, 1.0);
 }
 
+// `clusters` clusters of `size` rows; each cluster shares an offset of sd `between` in every
+// dimension (the ground under one placement), each row adds unit noise. Labels in `label`.
+Eigen::MatrixXd Clustered(int clusters, int size, double between, std::mt19937_64& rng, std::vector<int>* label) {
+  std::normal_distribution<double> z(0.0, 1.0);
+  Eigen::MatrixXd m(clusters * size, 2);
+  label->clear();
+  for (int c = 0; c < clusters; ++c) {
+    const Eigen::RowVector2d offset(between * z(rng), between * z(rng));
+    for (int i = 0; i < size; ++i) {
+      m.row(c * size + i) = offset + Eigen::RowVector2d(z(rng), z(rng));
+      label->push_back(c);
+    }
+  }
+  return m;
+}
+
+TEST(MmdTest, SingletonClustersAreTheSampleTest) {
+  std::mt19937_64 data(3), r1(4), r2(4);
+  const Eigen::MatrixXd a = Normal(20, 2, 0.5, data), b = Normal(25, 2, 0, data);
+  std::vector<int> ca(20), cb(25);
+  for (int i = 0; i < 20; ++i) ca[i] = 100 - i;  // any distinct labels
+  for (int i = 0; i < 25; ++i) cb[i] = i;
+  const MmdResult s = MmdTest(a, b, MmdOptions{300}, r1);
+  const MmdResult c = MmdTest(a, b, ca, cb, MmdOptions{300}, r2);
+  EXPECT_EQ(s.p_value, c.p_value);
+  EXPECT_EQ(s.mmd2, c.mmd2);
+}
+
+// Two draws of placements from the same ground: the rows of one placement share its offset. Permuting
+// rows treats them as independent and rejects far more often than its level; permuting whole
+// placements keeps the level.
+TEST(MmdTest, WholeClustersKeepTheLevelWhereRowsDoNot) {
+  std::mt19937_64 rng(5);
+  int by_rows = 0, by_clusters = 0;
+  const int trials = 40;
+  for (int t = 0; t < trials; ++t) {
+    std::vector<int> ca, cb;
+    const Eigen::MatrixXd a = Clustered(8, 5, 1.0, rng, &ca), b = Clustered(8, 5, 1.0, rng, &cb);
+    by_rows += MmdTest(a, b, MmdOptions{200}, rng).p_value < 0.05;
+    by_clusters += MmdTest(a, b, ca, cb, MmdOptions{200}, rng).p_value < 0.05;
+  }
+  EXPECT_LE(by_clusters, 8);  // 2 of 40 expected; 8 would be a p < 0.001 event for a valid test
+  EXPECT_GE(by_rows, 12);
+}
+
+TEST(MmdTest, WholeClustersStillSeeAShift) {
+  std::mt19937_64 rng(6);
+  std::vector<int> ca, cb;
+  Eigen::MatrixXd a = Clustered(20, 5, 0.3, rng, &ca);
+  const Eigen::MatrixXd b = Clustered(20, 5, 0.3, rng, &cb);
+  a.col(0).array() += 1.0;
+  EXPECT_LT(MmdTest(a, b, ca, cb, MmdOptions{500}, rng).p_value, 0.01);
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real

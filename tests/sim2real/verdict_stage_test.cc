@@ -51,6 +51,23 @@ TEST(VerdictStage, DoubtsMakeItPartlyExplainedAndAreInTheSentence) {
   EXPECT_NE(v.sentence.find(v.doubts[0]), std::string::npos);
 }
 
+// Nothing named and nothing located, but the real-trained ceiling beats the sim model on held-out
+// placements: a mismatch the region tests did not place (rough ground), never "clean". On uneven
+// ground the sentence says the correction shifts means only.
+TEST(VerdictStage, BelowTheCeilingWithNothingLocatedIsNotClean) {
+  test::Stages s = test::RunStages({}, 6);
+  ASSERT_TRUE(s.naming.named.empty());
+  ASSERT_FALSE(s.base.significant_mismatch);
+  EXPECT_EQ(Compose(s, s.naming).status, "clean");
+  s.adequacy.below_ceiling = true;
+  s.adequacy.doubts.push_back("the corrected model stays 1.657 nats per real sample (SE 0.407) below the ceiling");
+  s.base.permute_placements = true;
+  const Verdict v = Compose(s, s.naming);
+  EXPECT_EQ(v.status, "unexplained") << v.sentence;
+  ASSERT_FALSE(v.structured_in.empty());
+  EXPECT_NE(v.sentence.find("how the outcomes spread"), std::string::npos) << v.sentence;
+}
+
 TEST(VerdictStage, BootstrapOffWritesNullInclusionAndNotComputed) {
   test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 4);
   s.refinement.selection_options.bootstrap_selection = 0;
