@@ -242,8 +242,8 @@ def main():
            "changed the DGMM by +10.6 and +16.4 and EM-BIC by +2.4 and +1.8 paired standard errors (the last "
            "short of 2). The simulation there ran at 0.46 of the plane's speed, short of the issue's \"within "
            "2x\"; on 2026-11-27 the grid went to 0.07 m for speed alone (docs/simulation.md, \"Grid spacing and "
-           "speed\"). A new grid is a new ground, so the report seeds moved to 103 and 104, run once, with "
-           "nothing else changed.\n\n" + text)
+           "speed\"). A new grid is a new ground, so the report seeds moved to "
+           f"{' and '.join(str(r['seed']) for r in res['seeds'])}, run once, with nothing else changed.\n\n" + text)
     tmp = os.path.join(ROOT, f"rough-ground-{os.getpid()}.md")
     mm.write(tmp, doc)
     subprocess.run([sys.executable, os.path.join(ROOT, "scripts/replace_section.py"),
