@@ -146,12 +146,10 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
   TerrainRegions(in, options, rng, &b);
   b.sim_residuals = CrossFittedResiduals(in.sim, options.model, options.sim_residual_folds, rng);
   b.real_residuals = b.sim_model.WhitenedResiduals(in.real);
-  PlacementDependenceOptions placement = options.placement;
-  placement.seed = options.seed;
   // Each set's residuals under its own fit: what z and the command leave, nothing of the mismatch.
   const LinearGaussianModel real_own = LinearGaussianModel::Fit(in.real, options.model);
   b.placement = TestPlacementDependence(in.sim, b.sim_model.WhitenedResiduals(in.sim), in.real,
-                                        real_own.WhitenedResiduals(in.real), placement);
+                                        real_own.WhitenedResiduals(in.real), options.placement, options.seed);
   b.permute_placements = options.uneven_ground || b.placement.dependent;
   if (options.uneven_ground) {
     b.permute_why = "the simulator's ground is a height field: where a placement stands shapes its executions";

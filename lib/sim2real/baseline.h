@@ -23,7 +23,7 @@ struct BaselineOptions {
   int sim_residual_folds = 5;
   LinearGaussianOptions model;
   LocateOptions locate;
-  PlacementDependenceOptions placement;  // its seed is this seed
+  PlacementDependenceOptions placement;  // seeded with `seed`
   // The simulator's ground is a height field: where a placement stands shapes all its executions
   // and z does not say where, so locate permutes whole placements whatever the test says.
   bool uneven_ground = false;

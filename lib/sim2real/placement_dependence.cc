@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <map>
+#include <numeric>
 #include <random>
 #include <vector>
 
@@ -44,7 +45,7 @@ double Spread(const Grouped& g, const std::vector<int>& source) {
 
 std::vector<int> Identity(int n) {
   std::vector<int> v(n);
-  for (int i = 0; i < n; ++i) v[i] = i;
+  std::iota(v.begin(), v.end(), 0);
   return v;
 }
 
@@ -71,11 +72,11 @@ bool PlacementDependenceOptions::IsValid(std::string* error) const {
 
 PlacementDependence TestPlacementDependence(const Samples& sim, const Eigen::MatrixXd& sim_residuals,
                                             const Samples& real, const Eigen::MatrixXd& real_residuals,
-                                            const PlacementDependenceOptions& options) {
+                                            const PlacementDependenceOptions& options, std::uint64_t seed) {
   const Grouped sets[2] = {Group(sim, sim_residuals), Group(real, real_residuals)};
   PlacementDependence d;
   for (const Grouped& g : sets) d.statistic += Spread(g, Identity(static_cast<int>(g.placement.size())));
-  std::mt19937_64 rng(options.seed);
+  std::mt19937_64 rng(seed);
   int exceed = 0;
   for (int p = 0; p < options.permutations; ++p) {
     double t = 0;

@@ -5,9 +5,10 @@
 // not say where it stands. Then a two-sample test that permutes samples sees two sets of
 // placements as two populations; locate must permute whole placements (locate.h).
 //
-// The test, per set, on whitened residuals r under the set's own fit (what z and the command leave): T = sum_p n_p |mean of r over placement p|^2, the
-// between-placement spread, against T after shuffling samples among the placements of the same
-// command (which keeps each command's own fit); one statistic summed over both sets.
+// The test, per set, on whitened residuals r under the set's own fit (what z and the command
+// leave): T = sum_p n_p |mean of r over placement p|^2, the between-placement spread, against T
+// after shuffling samples among the placements of the same command (which keeps each command's own
+// fit); one statistic summed over both sets.
 #include <Eigen/Dense>
 #include <cstdint>
 #include <string>
@@ -17,7 +18,6 @@
 namespace dgmm::sim2real {
 
 struct PlacementDependenceOptions {
-  std::uint64_t seed = 1;
   int permutations = 500;
   double alpha = 0.05;  // p below this: placements are permuted whole
   bool IsValid(std::string* error) const;
@@ -31,10 +31,10 @@ struct PlacementDependence {
 
 // `sim_residuals` and `real_residuals`: whitened residuals of each set under its own fit (a model of
 // the other set would leave its mismatch, which may vary with z from placement to placement), one
-// row per sample.
-// Sets without placements (every sample its own episode) give p = 1.
+// row per sample. `seed` seeds the shuffles. Sets without placements (every sample its own
+// episode) give p = 1.
 PlacementDependence TestPlacementDependence(const Samples& sim, const Eigen::MatrixXd& sim_residuals,
                                             const Samples& real, const Eigen::MatrixXd& real_residuals,
-                                            const PlacementDependenceOptions& options);
+                                            const PlacementDependenceOptions& options, std::uint64_t seed);
 
 }  // namespace dgmm::sim2real

@@ -47,7 +47,7 @@ Eigen::MatrixXd Residuals(const Samples& s, int commands) {
 PlacementDependence Draw(double shared, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
   const Samples sim = Set(60, 5, 6, shared, rng), real = Set(30, 5, 6, shared, rng);
-  return TestPlacementDependence(sim, Residuals(sim, 6), real, Residuals(real, 6), PlacementDependenceOptions{});
+  return TestPlacementDependence(sim, Residuals(sim, 6), real, Residuals(real, 6), PlacementDependenceOptions{}, 1);
 }
 
 TEST(PlacementDependence, ASharedEffectPerPlacementIsFound) {
@@ -65,7 +65,8 @@ TEST(PlacementDependence, IndependentExecutionsAreNotFlaggedOften) {
 TEST(PlacementDependence, SetsWithoutPlacementsGiveNoEvidence) {
   std::mt19937_64 rng(2);
   Samples s = Set(40, 1, 4, 1.0, rng);
-  const PlacementDependence d = TestPlacementDependence(s, Residuals(s, 4), s, Residuals(s, 4), PlacementDependenceOptions{});
+  const PlacementDependence d =
+      TestPlacementDependence(s, Residuals(s, 4), s, Residuals(s, 4), PlacementDependenceOptions{}, 1);
   EXPECT_EQ(d.p_value, 1.0);
   EXPECT_FALSE(d.dependent);
 }
