@@ -2,10 +2,12 @@
 // offset. A payload's effect on a walking robot is far from linear in its position (on an
 // open-loop trot a few centimetres forward decide between a straight and a curving walk), so
 // the probes' linear reading only starts the search. The payload is recorded on a 3 x 3 grid of
-// added masses m0 {1/f, 1, f} and forward offsets x0 + {-h, 0, h} (sideways offset at its linear
-// reading), each scored by
+// added masses m0 {1/f, 1, f} and forward offsets x0 + {-h, 0, h}, each scored by
 //   l(m, x) = max_theta log p(real | sim model + s(m, x) + D_others theta),
 // the recording's own shift taken at face value (coefficient 1), the other selected effects refit.
+// The sideways offset is not searched: what the probes' reading measures is the sideways moment
+// M0 y0 (M: the payload's mass), so a point of mass M sits at y = y_n + (y0 - y_n) M0 / M (y_n the
+// nominal), not at y0, which would charge a heavier payload for a roll the real robot never had.
 // When the best point lies on the grid's edge, a second grid is recorded around it (the points
 // already recorded reused). A quadratic in (log m, x) through the last grid's nine scores gives the
 // maximum, recorded once more (within twice the grid); the best-scoring recording becomes the
@@ -24,7 +26,7 @@ constexpr double kMassFactor = 1.6;  // grid spacing in added mass (ratio)
 constexpr double kOffsetShare = 0.25;  // grid spacing in x: this share of the x probe's offset
 
 struct PayloadPoint {
-  double mass = 0, x = 0;
+  double mass = 0, x = 0, y = 0;
   double u = 0, v = 0;   // grid coordinates: mass steps (factor kMassFactor) and offset steps from the reading
   int shift = -1;        // index into CandidateSet::shifts
   double score = -INFINITY;
@@ -67,33 +69,35 @@ bool QuadraticMaximum(const std::vector<Eigen::Vector3d>& pts, double u_max, dou
 // and t2 / t0 of the probes') and the grid's spacing; At(u, v) is the point u mass steps and v
 // offset steps from the reading.
 struct SearchFrame {
-  const Knob *mass, *x;
-  double nominal = 0, added = 0, x0 = 0, y = 0, h = 0;
+  const Knob *mass, *x, *y;
+  double nominal = 0, added = 0, x0 = 0, y0 = 0, h = 0;
   PayloadPoint At(double u, double v) const {
-    return {std::clamp(nominal + added * std::exp(u * std::log(kMassFactor)), mass->lo, mass->hi),
-            std::clamp(x0 + v * h, x->lo, x->hi), u, v};
+    const double m = std::clamp(nominal + added * std::exp(u * std::log(kMassFactor)), mass->lo, mass->hi);
+    const double m0 = std::clamp(nominal + added, mass->lo, mass->hi);
+    const double side = m > 0 ? y->nominal + (y0 - y->nominal) * m0 / m : y0;
+    return {m, std::clamp(x0 + v * h, x->lo, x->hi), std::clamp(side, y->lo, y->hi), u, v};
   }
 };
 
 SearchFrame LinearReading(const std::vector<Knob>& knobs, const CandidateSet& set, const KnobCandidate& c,
                           const Eigen::VectorXd& t) {
   const Knob &kx = knobs[set.payload_knob[1]], &ky = knobs[set.payload_knob[2]];
-  SearchFrame f{&knobs[set.payload_knob[0]], &kx};
+  SearchFrame f{&knobs[set.payload_knob[0]], &kx, &ky};
   f.nominal = c.nominal;
   f.added = std::max(t(0) * (c.probe - c.nominal), 1e-3 * (c.probe - c.nominal));
   f.x0 = std::clamp(kx.nominal + t(1) / t(0) * (kx.probes[0] - kx.nominal), kx.lo, kx.hi);
-  f.y = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
+  f.y0 = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
   f.h = kOffsetShare * std::abs(kx.probes[0] - kx.nominal);
   return f;
 }
 
-// Records the points in one batch (sideways offset f.y) and scores each.
+// Records the points in one batch and scores each.
 void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
-                    const CandidateOptions& recording, const RefineOptions& options, const SearchFrame& f, int pay,
-                    CandidateSet* set, Refinement* r, std::vector<PayloadPoint>* pts) {
+                    const CandidateOptions& recording, const RefineOptions& options, int pay, CandidateSet* set,
+                    Refinement* r, std::vector<PayloadPoint>* pts) {
   std::vector<std::vector<KnobValue>> requests;
   for (const auto& p : *pts) {
-    requests.push_back({{set->payload_knob[0], p.mass}, {set->payload_knob[1], p.x}, {set->payload_knob[2], f.y}});
+    requests.push_back({{set->payload_knob[0], p.mass}, {set->payload_knob[1], p.x}, {set->payload_knob[2], p.y}});
   }
   auto shifts = RecordShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
   for (size_t i = 0; i < pts->size(); ++i) {
@@ -101,24 +105,24 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
     (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
     (*pts)[i].score =
         FaceValueScore(in, base, set, *r, pay, WithMassShift(set->externals[pay].shifts, (*pts)[i].shift), {}, options);
-    r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, f.y), (*pts)[i].mass, NAN,
+    r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, (*pts)[i].y), (*pts)[i].mass, NAN,
                         (*pts)[i].score / in.real.size()});
   }
 }
 
 // The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
-void Adopt(const AnalysisInputs& in, const Baseline& base, const SearchFrame& f, int pay, const PayloadPoint& best,
-           bool converged, CandidateSet* set, Refinement* r) {
+void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const PayloadPoint& best, bool converged,
+           CandidateSet* set, Refinement* r) {
   set->externals[pay].shifts = WithMassShift(set->externals[pay].shifts, best.shift);
   FillCandidateDesign(in, base, *set, pay, &r->problem);
   r->selection = ForwardSelect(r->problem, r->rows, base.fold, r->selection_options);
-  KnobRefinement kr{pay, PointLabel(set->candidates[pay].knob, best.x, f.y), best.mass, NAN, converged, true};
+  KnobRefinement kr{pay, PointLabel(set->candidates[pay].knob, best.x, best.y), best.mass, NAN, converged, true};
   const auto& sel = r->selection.selected;
   const auto pos = std::find(sel.begin(), sel.end(), pay);
   if (pos != sel.end()) kr.coefficient = r->selection.fit.theta[pos - sel.begin()](0);
   if (!converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
   r->refined.push_back(kr);
-  r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = f.y;
+  r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = best.y;
   r->searched[pay] = true;
 }
 
@@ -166,7 +170,7 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
         if (!known) fresh.push_back(f.At(iu, iv));
       }
     }
-    RecordAndScore(simulator, in, base, recording, options, f, pay, set, r, &fresh);
+    RecordAndScore(simulator, in, base, recording, options, pay, set, r, &fresh);
     grid.insert(grid.end(), fresh.begin(), fresh.end());
     const auto top = std::max_element(grid.begin(), grid.end(), ByScore);
     if (top->u == cu && top->v == cv) break;
@@ -180,14 +184,14 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   const bool concave = QuadraticMaximum(scored, 2, 2, &u, &v);
   if (concave) {
     std::vector<PayloadPoint> extra = {f.At(cu + u, cv + v)};
-    RecordAndScore(simulator, in, base, recording, options, f, pay, set, r, &extra);
+    RecordAndScore(simulator, in, base, recording, options, pay, set, r, &extra);
     grid.push_back(extra[0]);
   }
   const auto best = std::max_element(grid.begin(), grid.end(), ByScore);
   // Converged: the search brackets the maximum (the last grid's centre scored best, or the
   // quadratic's maximum lies inside the searched box).
   const bool converged = (best->u == cu && best->v == cv) || (concave && std::abs(u) < 2 && std::abs(v) < 2);
-  Adopt(in, base, f, pay, *best, converged, set, r);
+  Adopt(in, base, pay, *best, converged, set, r);
 }
 
 }  // namespace dgmm::sim2real

@@ -4,6 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstdio>
+
 #include "tests/sim2real/stage_fixture.h"
 
 namespace dgmm::sim2real {
@@ -54,6 +57,25 @@ TEST(Refine, ThePayloadIsRecordedAtItsFittedPosition) {
   bool traced = false;
   for (const auto& t : r.trace) traced |= t.knob.find("payload.mass_kg at (x") == 0;
   EXPECT_TRUE(traced);
+}
+
+// The sideways offset is not searched: every point of the search keeps the sideways moment the
+// probes read (mass x y), so a heavier point sits nearer the middle, not at the same y.
+TEST(Refine, ThePayloadsSearchKeepsItsSidewaysMoment) {
+  const test::Stages s = test::RunStages({{test::kPayloadMass, 2.5}, {test::kPayloadY, 0.1}}, 4);
+  std::vector<double> moments, masses;
+  for (const auto& t : s.refinement.trace) {
+    double x = 0, y = 0;
+    if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
+    moments.push_back(t.value * y);
+    masses.push_back(t.value);
+  }
+  ASSERT_GE(moments.size(), 9u);
+  EXPECT_GT(*std::max_element(masses.begin(), masses.end()), 2 * *std::min_element(masses.begin(), masses.end()))
+      << "the grid spans masses";
+  // Within the label's three significant digits.
+  EXPECT_LT(*std::max_element(moments.begin(), moments.end()), 1.02 * *std::min_element(moments.begin(), moments.end()));
+  EXPECT_NEAR(s.refinement.payload_mass * s.refinement.payload_y, 0.25, 0.25 * 0.25);
 }
 
 TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
