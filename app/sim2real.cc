@@ -268,8 +268,8 @@ void Setup(CLI::App& root) {
                   "placements per recording (paper protocol: >= 78 covers every command 3 times)")
       ->capture_default_str()->check(CLI::Range(3, 10000));
   cmd->add_option("--signature-executions", args->signature_executions,
-                  "executions per placement of a signature recording (5: the paper protocol's; 2: 0.44 of the "
-                  "time, but near-ties between knobs are decided less well, docs/sim2real.md)")
+                  "executions per placement of a signature recording (2: 0.44 of the paper protocol's 5 in "
+                  "time; 5 decides near-ties between knobs better, docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(2, 100));
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");

@@ -37,12 +37,13 @@ t=$(run cached "$cores" "$tmp/cache-$cores")
 n=$(field cached "j['knobs']['recordings']['signatures'] + j['knobs']['recordings']['refinement']")
 rows+="| cached | $cores | $(printf '%.1f' "$t") | - | $n |"$'\n'
 echo "sim2real $pair cached, $cores thread(s): ${t}s ($n recordings)"
+design=$(field cached "'%d placements of %d executions' % (j['knobs']['placements_per_recording'], j['knobs']['executions_per_placement'])")
 verdict=$(field cached "j['verdict']['status'] + ': ' + '; '.join('%s %.3g' % (n['knob'], n['value']) for n in j['verdict']['named'])")
 cat > "$tmp/section.md" <<MD
 ### sim2real (\`scripts/bench_sim2real.sh\`)
 
 \`dgmm sim2real\` on the shipped payload pair (390 real vs 830 sim samples), the sim set's recorded
-config, default settings (78 placements of 5 executions per recording, 20 bootstrap resamples, 1000 permutations
+config, default settings ($design per recording, 20 bootstrap resamples, 1000 permutations
 per test), no figures; $(date -u +%Y-%m-%d) on $cores cores ($(uptime | sed 's/.*load average/load average/')). Uncached: a
 fresh recording cache; cached: the same analysis again. Verdict: $verdict. Targets (issue #22):
 uncached <= 90 s on 2 cores and <= 30 s with 16 threads, cached <= 10 s.

@@ -28,8 +28,9 @@ struct CandidateOptions {
   int placements = 78;          // per recording (0: the protocol's own)
   // Executions per placement of a signature recording (the paper's 5; 0: the protocol's own). The
   // paired shift is fitted per command with a first-execution term, so two identify it at 0.44 of
-  // the cost, with noisier signatures: near-ties between knobs are decided less well.
-  int executions_per_placement = 5;
+  // the cost. Two became the default after the blind range 29000-29039 met every target with it
+  // (docs/sim2real-history.md); 5 decides near-ties between knobs from noisier data better.
+  int executions_per_placement = 2;
   double slope_ridge = 5.0;     // PairedShift's pull of each command's slopes to the pooled ones
   RecordingOptions recording;   // cache and threads
   bool legs_only_when_implicated = true;

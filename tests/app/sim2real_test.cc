@@ -63,13 +63,13 @@ void ExpectOneStory(const Outputs& o) {
 // The real simulator on the shipped payload pair (2 kg at x 0, y +0.12 m), then the null pair
 // with the same signatures (read back from the cache): the payload is named within 30%, the null
 // is clean, the corrected model scores the real set better than the sim model, and the config at
-// the named values is one the simulator accepts. 26 placements per recording keep it short (with
-// --signature-executions 2 as well the payload came out at 1.1 kg: too few paired samples).
+// the named values is one the simulator accepts. 26 placements per recording keep it short, with 5
+// executions each (with 2 as well the payload came out at 1.1 kg: too few paired samples).
 TEST(Sim2RealApp, ShippedPayloadAndNullPairsWithTheRecordedConfig) {
   const auto dir = MakeTempDir("sim2real-knobs");
   const std::vector<std::string> common = {"--sim", Sim(), "--bootstrap", "5", "--permutations", "300",
-                                           "--signature-placements", "26", "--cache", (dir / "cache").string(),
-                                           "--threads", "2"};
+                                           "--signature-placements", "26", "--signature-executions", "5",
+                                           "--cache", (dir / "cache").string(), "--threads", "2"};
   std::vector<std::string> payload_args = common;
   payload_args.insert(payload_args.end(), {"--real", Real("payload"), "--no-experiment-check"});
   const Outputs payload = RunSim2Real(payload_args, dir / "payload");
