@@ -1,11 +1,11 @@
 #include "sim2real/baseline.h"
 
 #include <algorithm>
-#include <cstdio>
 #include <map>
 #include <set>
 
 #include "sim2real/selection.h"
+#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -154,9 +154,8 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
   if (options.uneven_ground) {
     b.permute_why = "the simulator's ground is a height field: where a placement stands shapes its executions";
   } else if (b.placement.dependent) {
-    char p[32];
-    std::snprintf(p, sizeof p, "%.3g", b.placement.p_value);
-    b.permute_why = std::string("the executions at one placement are not independent: placement test p = ") + p;
+    b.permute_why = Fmt("the executions at one placement are not independent: placement test p = %.3g",
+                        b.placement.p_value);
   }
   b.before = LocateModel(in, b, b.real_residuals, b.heldout_sim, true, options.locate, rng);
   b.significant_mismatch = b.before.conditional_flagged > 0;

@@ -169,7 +169,8 @@ Verdict ComposeVerdict(const Baseline& base, const CandidateSet& set, const Refi
     if (mismatch && v.structured_in.empty()) {
       for (const auto& g : base.before.significant) AddUnique(&v.structured_in, g.label);
       if (v.structured_in.empty()) {
-        v.structured_in = {base.significant_mismatch ? "located regions" : "the fit as a whole (below the real-trained ceiling)"};
+        v.structured_in = {base.significant_mismatch ? "located regions"
+                                                     : "the fit as a whole (below the real-trained ceiling)"};
       }
     }
   } else {
