@@ -103,8 +103,7 @@ void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refineme
   // Where a placement's executions are dependent (uneven ground), the tails test is made as locate's
   // tests are: against the sim set's cross-fitted residuals (an in-sample fit of a few placements per
   // command bounds its own residuals), its SE counting placements, not samples.
-  const Eigen::MatrixXd sim_resid =
-      base.permute_placements ? base.sim_residuals : base.sim_model.WhitenedResiduals(in.sim);
+  const Eigen::MatrixXd& sim_resid = base.permute_placements ? base.sim_residuals : base.sim_own_residuals;
   ResidualStructureOptions residual = options.residual;
   if (base.permute_placements) residual.tails_bootstrap = kTailsBootstrap;
   const double sim_se = base.permute_placements

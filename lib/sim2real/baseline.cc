@@ -147,8 +147,9 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
   b.sim_residuals = CrossFittedResiduals(in.sim, options.model, options.sim_residual_folds, rng);
   b.real_residuals = b.sim_model.WhitenedResiduals(in.real);
   // Each set's residuals under its own fit: what z and the command leave, nothing of the mismatch.
+  b.sim_own_residuals = b.sim_model.WhitenedResiduals(in.sim);
   const LinearGaussianModel real_own = LinearGaussianModel::Fit(in.real, options.model);
-  b.placement = TestPlacementDependence(in.sim, b.sim_model.WhitenedResiduals(in.sim), in.real,
+  b.placement = TestPlacementDependence(in.sim, b.sim_own_residuals, in.real,
                                         real_own.WhitenedResiduals(in.real), options.placement, options.seed);
   b.permute_placements = options.uneven_ground || b.placement.dependent;
   if (options.uneven_ground) {

@@ -49,6 +49,7 @@ struct Baseline {
   std::vector<std::string> terrain_labels;
   std::vector<int> real_terrain, sim_terrain;  // region per sample
   Eigen::MatrixXd sim_residuals;      // cross-fitted whitened sim residuals (the null of the tests)
+  Eigen::MatrixXd sim_own_residuals;  // whitened sim residuals under the sim model fitted on them all
   Eigen::MatrixXd real_residuals;     // whitened real residuals under the sim model
   // Are the executions at a placement dependent? When they are, or the ground is uneven, every
   // locate permutes whole placements (LocateOptions::permute_placements), for the reason in words.
