@@ -7,7 +7,9 @@ forward by up to 15% of the leg reach), the values from random.Random(s). Fricti
 config (robot.overwrite_physics with friction.sliding; payload). The sim set is the
 nominal robot (protocol paper, seed 2 s), the real set the planted robot (seed 2 s + 1); then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
-what was named, the value and whether it lies within 25% of the truth, the status and wall time.
+what was named, the value and whether it lies within 25% of the truth, the values its likelihood
+search found to fit the real samples as well (verdict.named[].fits_as_well), the status and wall
+time.
 
 Usage: scripts/sim2real_robots.py [--build build] [--config datasets/robots/hexapod.json]
                                   [--seeds 13000-13002] [--threads 2] [--out DIR]
@@ -71,8 +73,8 @@ def main():
     for rec in base["robot"].get("controller", {}).get("recordings", []):  # a replayed controller's files
         rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
     print(f"Robot {a.config}, seeds {lo}-{hi}, sim2real with --threads {a.threads}\n")
-    print("| seed | planted | truth | named | value | within 25% | status | wall s |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("| seed | planted | truth | named | value | within 25% | fit as well | status | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|")
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)
@@ -96,7 +98,10 @@ def main():
         value = hit["value"] if hit else float("nan")
         ok = hit is not None and abs(value - truth) <= 0.25 * abs(truth)
         names = ", ".join(f"{n['knob']}" for n in named) or "-"
-        print(f"| {seed} | {knob} | {truth:.3g} | {names} | {value:.3g} | {'yes' if ok else 'no'} | {v['status']} | {wall:.0f} |",
+        span = hit.get("fits_as_well") if hit else None
+        as_well = f"{span['values'][0]:.3g} to {span['values'][1]:.3g}" if span else "-"
+        print(f"| {seed} | {knob} | {truth:.3g} | {names} | {value:.3g} | {'yes' if ok else 'no'} | {as_well} | "
+              f"{v['status']} | {wall:.0f} |",
               flush=True)
     return 0
 

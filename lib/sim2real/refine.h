@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "sim2real/candidates.h"
+#include "sim2real/search_span.h"
 #include "sim2real/spread.h"
 
 namespace dgmm::sim2real {
@@ -28,6 +29,8 @@ struct RefineOptions {
   // first selection step significant with at least this share of the best candidate's gain (its
   // linear probe design can lose to a knob whose effect is linear when its own is not).
   double payload_contender_share = 0.5;
+  // A searched point fits as well as the best when its deficit is under this many SEs (refine_search.h).
+  double as_well_z = 2.0;
   SpreadOptions spread;
   bool IsValid(std::string* error) const;
 };
@@ -49,6 +52,7 @@ struct KnobRefinement {
   bool converged = false;   // bracketed (tracker noise: |coefficient - 1| < converged_within)
   bool recorded = false;    // the best signature is a new recording (not the probe's)
   std::string why;          // why it did not converge, in words (empty: the coefficient's distance from 1)
+  SearchSpan as_well;       // the search's points that fit as well as its best (no search: empty)
 };
 
 struct Refinement {

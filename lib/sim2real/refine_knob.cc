@@ -26,6 +26,7 @@ struct KnobPoint {
   double value = 0, u = 0;
   int shift = -1;  // index into CandidateSet::shifts
   double score = -INFINITY;
+  Eigen::VectorXd rows;  // the score per real sample
 };
 
 bool ByScore(const KnobPoint& a, const KnobPoint& b) { return a.score < b.score; }
@@ -68,7 +69,8 @@ struct KnobSearch {
 
   // Scores the recording `shift` of the knob at `value`, traces it and adds it to `pts`.
   void Add(double value, int shift, std::vector<KnobPoint>* pts) const {
-    KnobPoint p{value, f.UOf(value), shift, FaceValueScore(in, base, set, *r, k, {shift}, same, options)};
+    KnobPoint p{value, f.UOf(value), shift};
+    p.score = FaceValueScore(in, base, set, *r, k, {shift}, same, options, &p.rows);
     r->trace.push_back({set->candidates[k].knob, p.value, NAN, p.score / in.real.size()});
     pts->push_back(p);
   }
@@ -115,8 +117,24 @@ double NextInside(const KnobPoint& a, const KnobPoint& b, const KnobPoint& c) {
   return b.u - a.u > c.u - b.u ? 0.5 * (a.u + b.u) : 0.5 * (b.u + c.u);
 }
 
+// The range of the searched values that fit as well as the best (refine_search.h).
+void AsWell(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoint& best, KnobRefinement* kr) {
+  std::vector<Eigen::VectorXd> rows;
+  for (const auto& p : pts) rows.push_back(p.rows);
+  const std::vector<bool> as_well =
+      FitAsWellAsTheBest(rows, static_cast<int>(&best - pts.data()), s.in.real.episode, s.options.as_well_z);
+  kr->as_well.z = s.options.as_well_z;
+  kr->as_well.searched = static_cast<int>(pts.size());
+  for (size_t i = 0; i < pts.size(); ++i) {
+    if (!as_well[i]) continue;
+    kr->as_well.lower = std::fmin(kr->as_well.lower, pts[i].value);
+    kr->as_well.upper = std::fmax(kr->as_well.upper, pts[i].value);
+    ++kr->as_well.points;
+  }
+}
+
 // Every candidate of the knob takes the best recording as its signature; the selection reruns.
-void Adopt(const KnobSearch& s, const KnobPoint& best, bool bracketed) {
+void Adopt(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoint& best, bool bracketed) {
   for (int j : s.same) {
     s.set->externals[j].shifts = {best.shift};
     s.r->signature_at[j] = best.value;
@@ -132,6 +150,7 @@ void Adopt(const KnobSearch& s, const KnobPoint& best, bool bracketed) {
     }
   }
   if (!bracketed) kr.why = "the likelihood search's best value lies at the edge of the values searched";
+  AsWell(s, pts, best, &kr);
   s.r->refined.push_back(kr);
 }
 
@@ -163,10 +182,10 @@ void SearchKnob(const KnobSimulator& simulator, const AnalysisInputs& in, const 
     if (s.f.Known(pts, next) || !std::isfinite(s.f.UOf(next))) break;  // at the knob's range limit
     s.RecordAndScore({next}, &pts);
   }
-  const KnobPoint best = *std::max_element(pts.begin(), pts.end(), ByScore);
+  const KnobPoint& best = *std::max_element(pts.begin(), pts.end(), ByScore);
   Neighbours(pts, best, &below, &above);
   const bool bracketed = below && above;
-  Adopt(s, best, bracketed);
+  Adopt(s, pts, best, bracketed);
 }
 
 }  // namespace dgmm::sim2real

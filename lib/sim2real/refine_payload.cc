@@ -30,6 +30,7 @@ struct PayloadPoint {
   double u = 0, v = 0;   // grid coordinates: mass steps (factor kMassFactor) and offset steps from the reading
   int shift = -1;        // index into CandidateSet::shifts
   double score = -INFINITY;
+  Eigen::VectorXd rows;  // the score per real sample
 };
 
 bool ByScore(const PayloadPoint& a, const PayloadPoint& b) { return a.score < b.score; }
@@ -103,16 +104,34 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
   for (size_t i = 0; i < pts->size(); ++i) {
     set->shifts.push_back(std::move(shifts[i]));
     (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
-    (*pts)[i].score =
-        FaceValueScore(in, base, set, *r, pay, WithMassShift(set->externals[pay].shifts, (*pts)[i].shift), {}, options);
+    (*pts)[i].score = FaceValueScore(in, base, set, *r, pay, WithMassShift(set->externals[pay].shifts, (*pts)[i].shift),
+                                     {}, options, &(*pts)[i].rows);
     r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, (*pts)[i].y), (*pts)[i].mass, NAN,
                         (*pts)[i].score / in.real.size()});
   }
 }
 
+// The masses and forward offsets of the searched points that fit as well as the best (refine_search.h).
+void AsWell(const AnalysisInputs& in, const std::vector<PayloadPoint>& grid, const PayloadPoint& best, double z,
+            KnobRefinement* kr) {
+  std::vector<Eigen::VectorXd> rows;
+  for (const auto& p : grid) rows.push_back(p.rows);
+  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, static_cast<int>(&best - grid.data()), in.real.episode, z);
+  kr->as_well.z = z;
+  kr->as_well.searched = static_cast<int>(grid.size());
+  for (size_t i = 0; i < grid.size(); ++i) {
+    if (!as_well[i]) continue;
+    kr->as_well.lower = std::fmin(kr->as_well.lower, grid[i].mass);
+    kr->as_well.upper = std::fmax(kr->as_well.upper, grid[i].mass);
+    kr->as_well.x_lower = std::fmin(kr->as_well.x_lower, grid[i].x);
+    kr->as_well.x_upper = std::fmax(kr->as_well.x_upper, grid[i].x);
+    ++kr->as_well.points;
+  }
+}
+
 // The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
-void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const PayloadPoint& best, bool converged,
-           CandidateSet* set, Refinement* r) {
+void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const std::vector<PayloadPoint>& grid,
+           const PayloadPoint& best, bool converged, double as_well_z, CandidateSet* set, Refinement* r) {
   set->externals[pay].shifts = WithMassShift(set->externals[pay].shifts, best.shift);
   FillCandidateDesign(in, base, *set, pay, &r->problem);
   r->selection = ForwardSelect(r->problem, r->rows, base.fold, r->selection_options);
@@ -121,6 +140,7 @@ void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const Payloa
   const auto pos = std::find(sel.begin(), sel.end(), pay);
   if (pos != sel.end()) kr.coefficient = r->selection.fit.theta[pos - sel.begin()](0);
   if (!converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
+  AsWell(in, grid, best, as_well_z, &kr);
   r->refined.push_back(kr);
   r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = best.y;
   r->searched[pay] = true;
@@ -191,7 +211,7 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   // Converged: the search brackets the maximum (the last grid's centre scored best, or the
   // quadratic's maximum lies inside the searched box).
   const bool converged = (best->u == cu && best->v == cv) || (concave && std::abs(u) < 2 && std::abs(v) < 2);
-  Adopt(in, base, pay, *best, converged, set, r);
+  Adopt(in, base, pay, grid, *best, converged, options.as_well_z, set, r);
 }
 
 }  // namespace dgmm::sim2real

@@ -1,11 +1,14 @@
 #include "sim2real/refine_search.h"
 
 #include <algorithm>
+#include <cmath>
+#include <map>
 
 namespace dgmm::sim2real {
 
 double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateSet* set, const Refinement& r, int k,
-                      const std::vector<int>& shifts, const std::vector<int>& skip, const RefineOptions& options) {
+                      const std::vector<int>& shifts, const std::vector<int>& skip, const RefineOptions& options,
+                      Eigen::VectorXd* rows) {
   FitProblem trial = r.problem;
   const std::vector<int> keep = set->externals[k].shifts;
   set->externals[k].shifts = shifts;
@@ -19,8 +22,35 @@ double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateS
   for (int e : r.selection.selected) {
     if (e != k && std::find(skip.begin(), skip.end(), e) == skip.end()) others.push_back(e);
   }
-  if (others.empty()) return CorrectedLogLikelihood(trial, EffectFit{}).sum();
-  return FitEffects(trial, others, {}, options.selection.fit).train_log_likelihood;
+  if (others.empty()) {
+    const Eigen::VectorXd l = CorrectedLogLikelihood(trial, EffectFit{});
+    if (rows) *rows = l;
+    return l.sum();
+  }
+  const EffectFit fit = FitEffects(trial, others, {}, options.selection.fit);
+  if (rows) *rows = CorrectedLogLikelihood(trial, fit);
+  return fit.train_log_likelihood;
+}
+
+std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
+                                     const std::vector<int>& placement, double z) {
+  std::map<int, int> group;
+  for (int p : placement) group.emplace(p, static_cast<int>(group.size()));
+  const int g = static_cast<int>(group.size());
+  std::vector<bool> out(rows.size(), false);
+  for (size_t k = 0; k < rows.size(); ++k) {
+    if (static_cast<int>(k) == best) {
+      out[k] = true;
+      continue;
+    }
+    if (rows[k].size() != rows[best].size() || g < 2) continue;
+    Eigen::VectorXd sums = Eigen::VectorXd::Zero(g);
+    for (int i = 0; i < rows[k].size(); ++i) sums(group.at(placement[i])) += rows[best](i) - rows[k](i);
+    const double deficit = sums.sum();
+    const double se = std::sqrt(g / (g - 1.0) * (sums.array() - deficit / g).square().sum());
+    out[k] = std::isfinite(deficit) && deficit < z * se;
+  }
+  return out;
 }
 
 }  // namespace dgmm::sim2real

@@ -13,8 +13,18 @@
 namespace dgmm::sim2real {
 
 // `shifts`: candidate k's external shifts with the searched recording first (the payload keeps its
-// x and y probes after it). Returns log-likelihood summed over the real samples.
+// x and y probes after it). Returns log-likelihood summed over the real samples; `rows` (if given)
+// receives it per real sample.
 double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateSet* set, const Refinement& r, int k,
-                      const std::vector<int>& shifts, const std::vector<int>& skip, const RefineOptions& options);
+                      const std::vector<int>& shifts, const std::vector<int>& skip, const RefineOptions& options,
+                      Eigen::VectorXd* rows = nullptr);
+
+// Which searched points fit the real samples as well as the best one (`best`, included): those
+// whose deficit D = sum_i (l_best,i - l_i) is below z times its standard error, the per-placement
+// sums of the differences taken as independent (placements are, samples of a placement are not):
+//   SE(D)^2 = G / (G - 1) sum_g (S_g - D / G)^2.
+// The recordings' own simulation noise is not counted, so the set errs on the narrow side.
+std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
+                                     const std::vector<int>& placement, double z);
 
 }  // namespace dgmm::sim2real

@@ -128,6 +128,9 @@ std::string NamedTable(const Verdict& v) {
     o << "<tr><td>" << k + 1 << "</td><td>" << Escape(n.family) << "</td><td>" << Escape(n.knob) << "</td><td>"
       << F("%.4g", n.value) << " " << Escape(n.unit)
       << (std::isfinite(n.value_lower) ? " [" + F("%.4g", n.value_lower) + ", " + F("%.4g", n.value_upper) + "]" : "")
+      << (n.as_well.Beyond(n.value_lower, n.value_upper)
+              ? "<br>fit as well: " + F("%.4g", n.as_well.lower) + " to " + F("%.4g", n.as_well.upper)
+              : "")
       << "</td><td>" << (std::isfinite(n.lo) ? F("%.4g", n.lo) + " to " + F("%.4g", n.hi) : "-") << "</td><td>"
       << F("%.4g", n.nominal) << "</td><td>" << (n.inclusion < 0 ? "not computed" : F("%.0f%%", 100 * n.inclusion))
       << "</td><td>";

@@ -83,7 +83,13 @@ json KnobsJson(const Analysis& a) {
   }
   json refined = json::array();
   for (const auto& f : r.refined) {
-    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", Num(f.coefficient)}, {"converged", f.converged}});
+    json span = nullptr;
+    if (f.as_well.Searched()) {
+      span = {{"values", {f.as_well.lower, f.as_well.upper}}, {"forward_offset_m", {Num(f.as_well.x_lower), Num(f.as_well.x_upper)}},
+              {"points", f.as_well.points}, {"searched", f.as_well.searched}};
+    }
+    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", Num(f.coefficient)}, {"converged", f.converged},
+                       {"fits_as_well", span}});
   }
   json removed = json::array();
   for (int k : r.selection.removed) removed.push_back(set.candidates[k].key);

@@ -13,6 +13,12 @@ using json = nlohmann::json;
 
 json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
 
+json SpanJson(const SearchSpan& s) {
+  if (!s.Searched()) return nullptr;
+  return {{"values", {Number(s.lower), Number(s.upper)}}, {"forward_offset_m", {Number(s.x_lower), Number(s.x_upper)}},
+          {"points", s.points}, {"searched", s.searched}, {"z", s.z}};
+}
+
 }  // namespace
 
 std::string DescribeExperiment(const VerdictExperiment& e) {
@@ -41,6 +47,7 @@ std::string VerdictJson(const Verdict& v) {
     named.push_back({{"family", n.family}, {"knob", n.knob}, {"value", Number(n.value)}, {"unit", n.unit},
                      {"nominal", Number(n.nominal)}, {"fitted_value", Number(n.fitted)},
                      {"range", {Number(n.lo), Number(n.hi)}}, {"ci95", {Number(n.value_lower), Number(n.value_upper)}},
+                     {"fits_as_well", SpanJson(n.as_well)},
                      {"inclusion", n.inclusion < 0 ? json(nullptr) : json(n.inclusion)},
                      {"candidate_inclusion", n.candidate_inclusion < 0 ? json(nullptr) : json(n.candidate_inclusion)},
                      {"tie_group", n.tie_group < 0 ? json(nullptr) : json(n.tie_group)},

@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "sim2real/search_span.h"
+
 namespace dgmm::sim2real {
 
 struct VerdictExperiment {
@@ -49,6 +51,7 @@ struct VerdictNamed {
   double fitted = 0;                     // the fit's own reading (value is it clamped to the range)
   double lo = NAN, hi = NAN;             // the knob's range (NaN: a measurement effect)
   double value_lower = NAN, value_upper = NAN;  // 95% bootstrap interval of the value
+  SearchSpan as_well;     // the likelihood search's values that fit as well as the named one
   double inclusion = -1;  // of the family, in [0, 1]; < 0: not computed (--bootstrap 0), written as null
   double candidate_inclusion = -1;       // of this candidate alone
   int tie_group = -1;     // index into ties, -1: null

@@ -7,6 +7,18 @@ namespace {
 
 std::string Unit(const std::string& u) { return u.empty() ? "" : " " + u; }
 
+// " - recordings from 1.6 to 2.56 kg at forward offsets 0.0066 to 0.027 m fit the real samples as well
+// (...)": the values the likelihood search could not tell from the named one.
+std::string AsWellPart(const VerdictNamed& n) {
+  const SearchSpan& a = n.as_well;
+  std::string s = Fmt(" - recordings from %.4g", a.lower) + Fmt(" to %.4g", a.upper) + Unit(n.unit);
+  if (std::isfinite(a.x_lower) && a.x_upper > a.x_lower) {
+    s += Fmt(" at forward offsets %.3g", a.x_lower) + Fmt(" to %.3g m", a.x_upper);
+  }
+  return s + Fmt(" fit the real samples as well (%.0f", a.points) + Fmt(" of the %.0f the search scored, within", a.searched) +
+         Fmt(" %.3g SE of the best): these data do not tell those values apart", a.z);
+}
+
 std::string NamedPart(const Verdict& v, size_t k) {
   const auto& n = v.named[k];
   std::string s = Fmt(" (%.0f) ", k + 1.0) + n.family + " (" + n.knob + Fmt(" = %.4g", n.value) + Unit(n.unit);
@@ -16,6 +28,7 @@ std::string NamedPart(const Verdict& v, size_t k) {
   if (std::isfinite(n.lo) && std::isfinite(n.hi)) s += Fmt(", range %.4g to %.4g", n.lo, n.hi);
   s += Fmt(", nominal %.4g", n.nominal) +
        (n.inclusion < 0 ? std::string(", inclusion not computed") : Fmt(", inclusion %.0f%%", 100 * n.inclusion)) + ")";
+  if (n.as_well.Beyond(n.value_lower, n.value_upper)) s += AsWellPart(n);
   if (n.tie_group >= 0) {
     const auto& t = v.ties[n.tie_group];
     s += " - cannot be told apart from";

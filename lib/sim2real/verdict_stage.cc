@@ -41,6 +41,9 @@ VerdictNamed Named(const CandidateSet& set, const Refinement& r, const Confidenc
   if (pos < static_cast<int>(confidence.value_lower.size())) {
     n.value_lower = confidence.value_lower[pos], n.value_upper = confidence.value_upper[pos];
   }
+  for (const KnobRefinement& kr : r.refined) {
+    if (kr.candidate == k) n.as_well = kr.as_well;
+  }
   if (confidence.computed) {
     n.inclusion = std::clamp(confidence.family_inclusion.at(c.family), 0.0, 1.0);
     n.candidate_inclusion = confidence.inclusion[k];

@@ -36,6 +36,14 @@ TEST(Refine, FrictionIsFoundByALikelihoodSearchOverItsValue) {
   EXPECT_TRUE(r.searched[k]);
   // The value the signature stands for is the planted one (the fake is exact up to noise).
   EXPECT_NEAR(NamedFriction(s, "floor.friction@0.6"), 0.45, 0.05);
+  // The values that fit as well as the best: the best among them, no more than were scored.
+  const SearchSpan& a = r.refined[0].as_well;
+  ASSERT_TRUE(a.Searched());
+  EXPECT_LE(a.lower, r.refined[0].value);
+  EXPECT_GE(a.upper, r.refined[0].value);
+  EXPECT_LE(a.points, a.searched);
+  EXPECT_EQ(a.searched, scored);
+  EXPECT_TRUE(std::isnan(a.x_lower)) << "a forward offset only for the payload";
 }
 
 TEST(Refine, AFrictionThatOnlySlipsBelowAThresholdIsFoundWhereTheLinearReadingIsFlat) {
@@ -93,6 +101,16 @@ TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
   EXPECT_NEAR(mass, 2.5, 0.25 * 2.5);
   ASSERT_FALSE(r.refined.empty());
   EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
+  // The masses and offsets that fit as well hold the best point; the fake's payload is exact, so
+  // a point a mass step (x 1.6) away from the best does not fit as well.
+  const SearchSpan& a = r.refined.back().as_well;
+  ASSERT_TRUE(a.Searched());
+  EXPECT_LE(a.lower, r.payload_mass);
+  EXPECT_GE(a.upper, r.payload_mass);
+  EXPECT_LE(a.x_lower, r.payload_x);
+  EXPECT_GE(a.x_upper, r.payload_x);
+  EXPECT_LT(a.upper / a.lower, 1.6 * 1.6) << "not every mass searched";
+  EXPECT_LT(a.points, a.searched);
 }
 
 TEST(Refine, APayloadCloseBehindTheFirstChoiceIsSearchedToo) {

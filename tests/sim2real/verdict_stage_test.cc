@@ -81,6 +81,34 @@ TEST(VerdictStage, BootstrapOffWritesNullInclusionAndNotComputed) {
   EXPECT_TRUE(nlohmann::json::parse(VerdictJson(v))["named"][0]["inclusion"].is_null());
 }
 
+// A search's values that fit as well as the named one are said in the sentence only where they
+// reach beyond the bootstrap interval (a payload's mass against its position); the JSON has them
+// whenever there was a search.
+TEST(VerdictStage, ValuesTheSearchCannotTellApartAreSaidBeyondTheInterval) {
+  test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 6);
+  ASSERT_FALSE(s.refinement.refined.empty());
+  const int k = s.refinement.refined[0].candidate;
+  ASSERT_GE(k, 0);
+  Verdict v = Compose(s, s.naming);
+  ASSERT_FALSE(v.named.empty());
+  const VerdictNamed& n = v.named[0];
+  SearchSpan& span = s.refinement.refined[0].as_well;
+  span.lower = n.value_lower, span.upper = n.value_upper, span.points = 2, span.searched = 5, span.z = 2;
+  v = Compose(s, s.naming);
+  EXPECT_EQ(v.sentence.find("fit the real samples as well"), std::string::npos) << v.sentence;
+  EXPECT_FALSE(nlohmann::json::parse(VerdictJson(v))["named"][0]["fits_as_well"].is_null());
+  span.lower = n.value_lower - 0.2 * (n.value_upper - n.value_lower);
+  v = Compose(s, s.naming);
+  EXPECT_EQ(v.sentence.find("fit the real samples as well"), std::string::npos) << "a grid step past it is noise";
+  span.lower = 0.5 * n.value_lower;
+  v = Compose(s, s.naming);
+  EXPECT_NE(v.sentence.find("fit the real samples as well (2 of the 5 the search scored, within 2 SE"), std::string::npos)
+      << v.sentence;
+  const auto j = nlohmann::json::parse(VerdictJson(v));
+  EXPECT_DOUBLE_EQ(j["named"][0]["fits_as_well"]["values"][0].get<double>(), span.lower);
+  EXPECT_TRUE(j["named"][0]["fits_as_well"]["forward_offset_m"][0].is_null());
+}
+
 TEST(VerdictStage, LocateOnlySaysWhyAndWhere) {
   const test::Stages s = test::RunStages({{test::kFriction, 0.5}}, 2);
   const Verdict v = LocateOnlyVerdict(s.base, "no simulator config");

@@ -1,0 +1,67 @@
+// The likelihood searches' shared parts: which searched points fit the real samples as well as the
+// best one, with placements (not samples) as the independent units.
+#include "sim2real/refine_search.h"
+
+#include <gtest/gtest.h>
+
+#include <random>
+
+namespace dgmm::sim2real {
+namespace {
+
+// 40 placements of 5 samples; the best point's log-likelihoods are 0.
+struct Rows {
+  std::vector<int> placement;
+  std::vector<Eigen::VectorXd> rows;
+  Rows() {
+    for (int g = 0; g < 40; ++g) {
+      for (int e = 0; e < 5; ++e) placement.push_back(g);
+    }
+    rows.push_back(Eigen::VectorXd::Zero(200));
+  }
+};
+
+TEST(RefineSearch, APointWithAConsistentDeficitDoesNotFitAsWell) {
+  Rows r;
+  std::mt19937_64 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.5);
+  Eigen::VectorXd worse(200);
+  for (int i = 0; i < 200; ++i) worse(i) = -0.3 + noise(rng);  // 60 nats in all, SE about 7
+  r.rows.push_back(worse);
+  r.rows.push_back(Eigen::VectorXd::Constant(200, -1e-3));  // 0.2 nats in all, no spread: still worse
+  const std::vector<bool> as_well = FitAsWellAsTheBest(r.rows, 0, r.placement, 2.0);
+  EXPECT_TRUE(as_well[0]) << "the best is among them";
+  EXPECT_FALSE(as_well[1]);
+  EXPECT_FALSE(as_well[2]) << "a deficit with no spread at all is real";
+}
+
+// The same deficit per sample: a point whose samples err together within a placement (one sag
+// decides a whole placement) is within the noise; spread over independent placements it is not.
+TEST(RefineSearch, SamplesOfOnePlacementCountOnceInTheStandardError) {
+  Rows r;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  Eigen::VectorXd d(200);
+  for (int g = 0; g < 40; ++g) {
+    const double shared = noise(rng);
+    for (int e = 0; e < 5; ++e) d(5 * g + e) = -0.25 + 1.5 * shared;
+  }
+  d.array() -= d.mean() + 0.25;  // a deficit of exactly 50 nats
+  r.rows.push_back(d);
+  EXPECT_TRUE(FitAsWellAsTheBest(r.rows, 0, r.placement, 2.0)[1]) << "SE about 47 nats over 40 placements";
+  std::vector<int> every_sample_alone(200);
+  for (int i = 0; i < 200; ++i) every_sample_alone[i] = i;
+  EXPECT_FALSE(FitAsWellAsTheBest(r.rows, 0, every_sample_alone, 2.0)[1]) << "SE about 21 nats over 200 samples";
+}
+
+TEST(RefineSearch, ALargerZAdmitsMorePoints) {
+  Rows r;
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(200);
+  for (int g = 0; g < 40; ++g) d(5 * g) = g % 2 ? -2.0 : 1.0;  // 20 nats deficit, SE 9.5
+  r.rows.push_back(d);
+  EXPECT_FALSE(FitAsWellAsTheBest(r.rows, 0, r.placement, 1.0)[1]);
+  EXPECT_TRUE(FitAsWellAsTheBest(r.rows, 0, r.placement, 3.0)[1]);
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real
