@@ -6,6 +6,8 @@
 #include <random>
 #include <vector>
 
+#include "sim2real/units.h"
+
 namespace dgmm::sim2real {
 namespace {
 
@@ -20,13 +22,11 @@ struct Grouped {
 Grouped Group(const Samples& s, const Eigen::MatrixXd& r) {
   Grouped g;
   g.r = &r;
-  std::map<int, int> slot;
+  const UnitIds placements = NumberUnits(s.episode);
+  g.placement = placements.unit;
+  g.placements = placements.count;
   std::map<int, std::vector<int>> commands;
-  for (int i = 0; i < s.size(); ++i) {
-    g.placement.push_back(slot.emplace(s.episode[i], static_cast<int>(slot.size())).first->second);
-    commands[s.command[i]].push_back(i);
-  }
-  g.placements = static_cast<int>(slot.size());
+  for (int i = 0; i < s.size(); ++i) commands[s.command[i]].push_back(i);
   for (auto& [c, rows] : commands) g.by_command.push_back(std::move(rows));
   return g;
 }

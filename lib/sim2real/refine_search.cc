@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
+
+#include "sim2real/units.h"
 
 namespace dgmm::sim2real {
 
@@ -34,9 +35,8 @@ double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateS
 
 std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
                                      const std::vector<int>& placement, double z) {
-  std::map<int, int> group;
-  for (int p : placement) group.emplace(p, static_cast<int>(group.size()));
-  const int g = static_cast<int>(group.size());
+  const UnitIds units = NumberUnits(placement);
+  const int g = units.count;
   std::vector<bool> out(rows.size(), false);
   for (size_t k = 0; k < rows.size(); ++k) {
     if (static_cast<int>(k) == best) {
@@ -45,7 +45,7 @@ std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, i
     }
     if (rows[k].size() != rows[best].size() || g < 2) continue;
     Eigen::VectorXd sums = Eigen::VectorXd::Zero(g);
-    for (int i = 0; i < rows[k].size(); ++i) sums(group.at(placement[i])) += rows[best](i) - rows[k](i);
+    for (int i = 0; i < rows[k].size(); ++i) sums(units.unit[i]) += rows[best](i) - rows[k](i);
     const double deficit = sums.sum();
     const double se = std::sqrt(g / (g - 1.0) * (sums.array() - deficit / g).square().sum());
     out[k] = std::isfinite(deficit) && deficit < z * se;

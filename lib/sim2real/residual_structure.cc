@@ -7,6 +7,8 @@
 #include <random>
 #include <set>
 
+#include "sim2real/units.h"
+
 namespace dgmm::sim2real {
 namespace {
 
@@ -92,16 +94,15 @@ struct EpisodeUnits {
 EpisodeUnits Units(const Eigen::MatrixXd& r, const std::vector<int>& command, const std::vector<int>& terrain,
                    const std::vector<int>& episode) {
   const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
-  std::map<int, int> unit_of;
-  for (int i = 0; i < n; ++i) unit_of.emplace(episode[i], static_cast<int>(unit_of.size()));
-  const int units = static_cast<int>(unit_of.size());
+  const UnitIds ids = NumberUnits(episode);
+  const int units = ids.count;
   EpisodeUnits e;
   e.sum = Eigen::MatrixXd::Zero(units, dx);
   e.count.assign(units, 0), e.command.assign(units, -1), e.terrain.assign(units, -1);
   std::vector<std::map<int, int>> terrain_votes(units);
-  e.unit.resize(n);
+  e.unit = ids.unit;
   for (int i = 0; i < n; ++i) {
-    const int u = e.unit[i] = unit_of[episode[i]];
+    const int u = e.unit[i];
     e.sum.row(u) += r.row(i);
     ++e.count[u];
     if (e.command[u] < 0) e.command[u] = command[i];

@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 #include <numeric>
+
+#include "sim2real/units.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -60,12 +61,10 @@ std::vector<std::vector<int>> PooledClusters(const std::vector<int>& cluster_a, 
                                              int* clusters_a) {
   std::vector<std::vector<int>> out;
   auto add = [&](const std::vector<int>& labels, int offset) {
-    std::map<int, int> slot;
-    for (size_t i = 0; i < labels.size(); ++i) {
-      auto [it, fresh] = slot.emplace(labels[i], static_cast<int>(out.size()));
-      if (fresh) out.emplace_back();
-      out[it->second].push_back(offset + static_cast<int>(i));
-    }
+    const UnitIds ids = NumberUnits(labels);
+    const size_t first = out.size();
+    out.resize(first + ids.count);
+    for (size_t i = 0; i < labels.size(); ++i) out[first + ids.unit[i]].push_back(offset + static_cast<int>(i));
   };
   add(cluster_a, 0);
   *clusters_a = static_cast<int>(out.size());
