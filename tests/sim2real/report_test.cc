@@ -62,5 +62,21 @@ TEST(Report, NullSingleKnobAndOutOfLibraryPairsTellOneStory) {
   EXPECT_TRUE(statuses[2] == "unexplained" || statuses[2] == "partly_explained") << statuses[2];
 }
 
+// The values a likelihood search could not tell from the named one show beside its value in the
+// HTML's table where they widen the bootstrap interval by half or more, not otherwise.
+TEST(Report, TheHtmlTableShowsWhatTheSearchCouldNotTellApart) {
+  const test::FakeSimulator fake;
+  const test::FakePair pair = test::MakeFakePair(fake, {{test::kFriction, 0.6}}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &fake, test::FastOptions());
+  ASSERT_FALSE(a.verdict.named.empty());
+  ReportContext ctx;
+  VerdictNamed& n = a.verdict.named[0];
+  n.value_lower = 0.55, n.value_upper = 0.65;
+  n.as_well.lower = 0.56, n.as_well.upper = 0.64, n.as_well.points = 2, n.as_well.searched = 6, n.as_well.z = 2;
+  EXPECT_EQ(ReportHtml(a, ctx, ".").find("fit as well"), std::string::npos);
+  n.as_well.lower = 0.4;
+  EXPECT_NE(ReportHtml(a, ctx, ".").find("fit as well: 0.4 to 0.64"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real
