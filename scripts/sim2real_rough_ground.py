@@ -4,30 +4,32 @@ height field (default datasets/robots/rough_ground.json, the octopod among 10 cm
 
 One sim set for the whole range: the nominal config, protocol paper, --sim-placements placements
 (default 166), seed --sim-seed (default 100), so every pair reuses its knob signatures from the
-recording cache. For each seed s the kind of planted physics is s mod 4, the values from
-random.Random(s):
-  0: nothing (a null pair: two draws of places on the same ground);
-  1: the boulders' height, a factor in [1.3, 1.8] on terrain.stones.height_m (the knob
+recording cache. For each seed s the kind of planted physics is --kinds[s mod (number of kinds)] (by default
+null,stones,payload,leg: s mod 4), the values from random.Random(s):
+  null: nothing (a null pair: two draws of places on the same ground);
+  stones: the boulders' height, a factor in [1.3, 1.8] on terrain.stones.height_m (the knob
      terrain.stones.height_scale: the same places, higher stones);
-  2: a payload of 1.5-3 kg on the torso, forward by up to 0.1 m (payload.mass_kg);
-  3: one leg's servo gain in [0.25, 0.5] (actuators.legN.gain, N drawn among the 8 legs).
+  payload: a payload of 1.5-3 kg on the torso, forward by up to 0.1 m (payload.mass_kg);
+  leg: one leg's servo gain in [0.25, 0.5] (actuators.legN.gain, N drawn among the 8 legs);
+  friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1).
 The real set is the planted config, protocol paper, the same placements count, seed s. Then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
 what was named, the value and whether it lies within 25% of the truth, the status, whether the
 located tests permuted whole placements, and the wall time.
 
 Usage: scripts/sim2real_rough_ground.py [--build build] [--config datasets/robots/rough_ground.json]
-          [--seeds 301-308] [--sim-seed 100] [--sim-placements 166] [--threads 2] [--out DIR]
+          [--seeds 301-308] [--kinds null,stones,payload,leg] [--sim-seed 100]
+          [--sim-placements 166] [--threads 2] [--out DIR]
 """
 import argparse, copy, json, os, random, subprocess, sys, tempfile, time
 
-KINDS = ["null", "stones", "payload", "leg"]
+KINDS = ["null", "stones", "payload", "leg", "friction"]
 
 
-def planted(seed, cfg):
+def planted(seed, cfg, kinds=KINDS[:4]):
     """Plants the seed's physics into `cfg`; returns (knob that should be named or None, truth)."""
     r = random.Random(seed)
-    kind = KINDS[seed % 4]
+    kind = kinds[seed % len(kinds)]
     if kind == "stones":
         factor = r.uniform(1.3, 1.8)
         cfg["terrain"]["stones"]["height_m"] *= factor
@@ -40,6 +42,10 @@ def planted(seed, cfg):
         leg, gain = r.randrange(8), r.uniform(0.25, 0.5)
         cfg.setdefault("actuators", {})["leg_gain"] = [gain if i == leg else 1.0 for i in range(8)]
         return f"actuators.leg{leg}.gain", gain
+    if kind == "friction":
+        mu = r.uniform(0.3, 0.6)
+        cfg.setdefault("friction", {})["sliding"] = mu
+        return "floor.friction.sliding", mu
     return None, float("nan")
 
 
@@ -69,12 +75,16 @@ def main():
     ap.add_argument("--build", default="build")
     ap.add_argument("--config", default="datasets/robots/rough_ground.json")
     ap.add_argument("--seeds", default="301-308")
+    ap.add_argument("--kinds", default=",".join(KINDS[:4]), help="comma list among " + ",".join(KINDS))
     ap.add_argument("--sim-seed", type=int, default=100)
     ap.add_argument("--sim-placements", type=int, default=166)
     ap.add_argument("--threads", default="2")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     lo, hi = (int(v) for v in a.seeds.split("-"))
+    kinds = a.kinds.split(",")
+    if not kinds or any(k not in KINDS for k in kinds):
+        ap.error(f"--kinds: expected a comma list among {','.join(KINDS)}, got {a.kinds!r}")
     out = a.out or tempfile.mkdtemp()
     os.makedirs(out, exist_ok=True)
     base = json.load(open(a.config))
@@ -85,14 +95,14 @@ def main():
         dgmm(a.build, "simulate", "--config", nominal, "--protocol", "paper", "--placements", str(a.sim_placements),
              "--seed", str(a.sim_seed), "-o", sim)
     print(f"Rough ground {a.config}, sim set seed {a.sim_seed} ({a.sim_placements} placements), real seeds "
-          f"{lo}-{hi}, sim2real with --threads {a.threads}\n")
+          f"{lo}-{hi} (kinds {a.kinds}), sim2real with --threads {a.threads}\n")
     print("| seed | planted | truth | named | value | right | status | tests permute | wall s |")
     print("|---|---|---|---|---|---|---|---|---|")
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)
         cfg = copy.deepcopy(base)
-        knob, truth = planted(seed, cfg)
+        knob, truth = planted(seed, cfg, kinds)
         real_cfg = os.path.join(d, "real.json")
         json.dump(cfg, open(real_cfg, "w"), indent=1)
         real = os.path.join(d, "real.h5")
