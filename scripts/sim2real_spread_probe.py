@@ -11,12 +11,13 @@ again with the leg's gain at each listed value, and prints per recording
 The signatures of `dgmm sim2real` (lib/sim2real/signatures.h) are mean shifts; this shows what
 they leave out.
 
-With --every-leg GAIN it also records each leg in turn at that gain (a row per leg, named by
-the leg): which leg's probe a screen of recordings at face value would pick.
+With --every-leg GAINS it also records each leg in turn at each listed gain (a row per leg and
+gain, named by the leg): which leg's probe, or which leg and gain of a search over every leg, a
+screen of recordings at face value would pick.
 
 Usage: scripts/sim2real_spread_probe.py [--build build] [--config datasets/robots/hexapod.json]
                                         [--seed 18000] [--leg rear_left] [--truth 0.3135]
-                                        [--values 1,0.5,0.4,0.25] [--every-leg GAIN] [--out DIR]
+                                        [--values 1,0.5,0.4,0.25] [--every-leg GAINS] [--out DIR]
 """
 import argparse, json, os, subprocess, sys, tempfile
 
@@ -68,8 +69,9 @@ def main():
     ap.add_argument("--leg", default="rear_left")
     ap.add_argument("--truth", type=float, default=0.3135)
     ap.add_argument("--values", default="1,0.5,0.4,0.25")
-    ap.add_argument("--every-leg", type=float, default=None, metavar="GAIN",
-                    help="also record every leg in turn at this gain (what a per-leg probe sees)")
+    ap.add_argument("--every-leg", default=None, metavar="GAINS",
+                    help="also record every leg in turn at each of these gains (comma list; what per-leg "
+                         "probes see, or a search of every leg's gain)")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     out = a.out or tempfile.mkdtemp()
@@ -97,9 +99,9 @@ def main():
     rows = [("real set", a.truth, real, None)]
     for v in values:
         rows.append(("sim" if v == 1 else ("truth" if v == a.truth else "probe"), v, at(v, 2 * a.seed, f"g{v:g}"), 1))
-    if a.every_leg is not None:
+    for g in [float(v) for v in a.every_leg.split(",")] if a.every_leg else []:
         for leg in (l["name"] for l in base["robot"]["legs"]):
-            rows.append((leg, a.every_leg, at(a.every_leg, 2 * a.seed, f"{leg}_g{a.every_leg:g}", leg), 1))
+            rows.append((leg, g, at(g, 2 * a.seed, f"{leg}_g{g:g}", leg), 1))
     for name, v, (x, c, z), rec in rows:
         sd = spread(x, c)
         ll = loglik(fit(x, c, z), *real).mean() if rec else float("nan")
