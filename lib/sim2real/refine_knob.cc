@@ -118,19 +118,11 @@ double NextInside(const KnobPoint& a, const KnobPoint& b, const KnobPoint& c) {
 }
 
 // The range of the searched values that fit as well as the best (refine_search.h).
-void AsWell(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoint& best, KnobRefinement* kr) {
+SearchSpan AsWell(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoint& best) {
   std::vector<Eigen::VectorXd> rows;
-  for (const auto& p : pts) rows.push_back(p.rows);
-  const std::vector<bool> as_well =
-      FitAsWellAsTheBest(rows, static_cast<int>(&best - pts.data()), s.in.real.episode, s.options.as_well_z);
-  kr->as_well.z = s.options.as_well_z;
-  kr->as_well.searched = static_cast<int>(pts.size());
-  for (size_t i = 0; i < pts.size(); ++i) {
-    if (!as_well[i]) continue;
-    kr->as_well.lower = std::fmin(kr->as_well.lower, pts[i].value);
-    kr->as_well.upper = std::fmax(kr->as_well.upper, pts[i].value);
-    ++kr->as_well.points;
-  }
+  std::vector<double> values;
+  for (const auto& p : pts) rows.push_back(p.rows), values.push_back(p.value);
+  return FitAsWellSpan(rows, static_cast<int>(&best - pts.data()), values, {}, s.in.real.episode, s.options.as_well_z);
 }
 
 // Every candidate of the knob takes the best recording as its signature; the selection reruns.
@@ -150,7 +142,7 @@ void Adopt(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoi
     }
   }
   if (!bracketed) kr.why = "the likelihood search's best value lies at the edge of the values searched";
-  AsWell(s, pts, best, &kr);
+  kr.as_well = AsWell(s, pts, best);
   s.r->refined.push_back(kr);
 }
 

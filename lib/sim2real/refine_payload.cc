@@ -112,21 +112,11 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
 }
 
 // The masses and forward offsets of the searched points that fit as well as the best (refine_search.h).
-void AsWell(const AnalysisInputs& in, const std::vector<PayloadPoint>& grid, const PayloadPoint& best, double z,
-            KnobRefinement* kr) {
+SearchSpan AsWell(const AnalysisInputs& in, const std::vector<PayloadPoint>& grid, const PayloadPoint& best, double z) {
   std::vector<Eigen::VectorXd> rows;
-  for (const auto& p : grid) rows.push_back(p.rows);
-  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, static_cast<int>(&best - grid.data()), in.real.episode, z);
-  kr->as_well.z = z;
-  kr->as_well.searched = static_cast<int>(grid.size());
-  for (size_t i = 0; i < grid.size(); ++i) {
-    if (!as_well[i]) continue;
-    kr->as_well.lower = std::fmin(kr->as_well.lower, grid[i].mass);
-    kr->as_well.upper = std::fmax(kr->as_well.upper, grid[i].mass);
-    kr->as_well.x_lower = std::fmin(kr->as_well.x_lower, grid[i].x);
-    kr->as_well.x_upper = std::fmax(kr->as_well.x_upper, grid[i].x);
-    ++kr->as_well.points;
-  }
+  std::vector<double> masses, x;
+  for (const auto& p : grid) rows.push_back(p.rows), masses.push_back(p.mass), x.push_back(p.x);
+  return FitAsWellSpan(rows, static_cast<int>(&best - grid.data()), masses, x, in.real.episode, z);
 }
 
 // The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
@@ -140,7 +130,7 @@ void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const std::v
   const auto pos = std::find(sel.begin(), sel.end(), pay);
   if (pos != sel.end()) kr.coefficient = r->selection.fit.theta[pos - sel.begin()](0);
   if (!converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
-  AsWell(in, grid, best, as_well_z, &kr);
+  kr.as_well = AsWell(in, grid, best, as_well_z);
   r->refined.push_back(kr);
   r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = best.y;
   r->searched[pay] = true;

@@ -53,4 +53,20 @@ std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, i
   return out;
 }
 
+SearchSpan FitAsWellSpan(const std::vector<Eigen::VectorXd>& rows, int best, const std::vector<double>& values,
+                         const std::vector<double>& x, const std::vector<int>& placement, double z) {
+  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, best, placement, z);
+  SearchSpan span;
+  span.z = z;
+  span.searched = static_cast<int>(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) {
+    if (!as_well[i]) continue;
+    span.lower = std::fmin(span.lower, values[i]);
+    span.upper = std::fmax(span.upper, values[i]);
+    if (!x.empty()) span.x_lower = std::fmin(span.x_lower, x[i]), span.x_upper = std::fmax(span.x_upper, x[i]);
+    ++span.points;
+  }
+  return span;
+}
+
 }  // namespace dgmm::sim2real

@@ -27,4 +27,9 @@ double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateS
 std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
                                      const std::vector<int>& placement, double z);
 
+// The span of those points: the range of their `values` and, when `x` is given (the payload's
+// forward offsets, one per point), of their x.
+SearchSpan FitAsWellSpan(const std::vector<Eigen::VectorXd>& rows, int best, const std::vector<double>& values,
+                         const std::vector<double>& x, const std::vector<int>& placement, double z);
+
 }  // namespace dgmm::sim2real

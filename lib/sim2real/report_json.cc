@@ -3,19 +3,19 @@
 
 #include <cmath>
 
+#include "sim2real/json_number.h"
 #include "sim2real/report.h"
+#include "sim2real/search_span_json.h"
 
 namespace dgmm::sim2real {
 namespace {
 
 using nlohmann::json;
 
-// NaN/Inf are not JSON: null.
-json Num(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
+// NaN/Inf are not JSON: null (JsonNumber).
 json Vec(const Eigen::VectorXd& v) {
   json out = json::array();
-  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(Num(v(i)));
+  for (Eigen::Index i = 0; i < v.size(); ++i) out.push_back(JsonNumber(v(i)));
   return out;
 }
 
@@ -24,7 +24,7 @@ json Regions(const std::vector<Region>& regions) {
   for (const auto& r : regions) {
     out.push_back({{"family", r.family}, {"label", r.label}, {"command", r.command}, {"terrain", r.terrain},
                    {"sequence", r.sequence}, {"n_real", r.n_real}, {"n_sim", r.n_sim},
-                   {"deficit_nats_per_sample", Num(r.deficit)}, {"mmd2", Num(r.mmd2)}, {"p_value", r.p_value},
+                   {"deficit_nats_per_sample", JsonNumber(r.deficit)}, {"mmd2", JsonNumber(r.mmd2)}, {"p_value", r.p_value},
                    {"q_value", r.q_value}, {"significant", r.significant}});
   }
   return out;
@@ -34,7 +34,7 @@ json HeatMap(const Analysis& a, const Eigen::MatrixXd& h) {
   json rows = json::array();
   for (int i = 0; i < h.rows(); ++i) {
     json row = json::array();
-    for (int j = 0; j < h.cols(); ++j) row.push_back(Num(h(i, j)));
+    for (int j = 0; j < h.cols(); ++j) row.push_back(JsonNumber(h(i, j)));
     rows.push_back({{"command", a.inputs.command_labels[a.inputs.real_commands[i]]}, {"deficit", row}});
   }
   return {{"terrain", a.baseline.terrain_labels}, {"rows", rows}};
@@ -59,7 +59,7 @@ json StepsJson(const Analysis& a) {
   for (const auto& s : a.refinement.selection.steps) {
     json cs = json::array();
     for (const auto& c : s.candidates) {
-      cs.push_back({{"key", a.candidates.candidates[c.effect].key}, {"gain", c.gain}, {"se", Num(c.se)}, {"z", c.z}});
+      cs.push_back({{"key", a.candidates.candidates[c.effect].key}, {"gain", c.gain}, {"se", JsonNumber(c.se)}, {"z", c.z}});
     }
     steps.push_back({{"chosen", s.chosen >= 0 ? json(a.candidates.candidates[s.chosen].key) : json(nullptr)},
                      {"threshold_z", s.threshold_z}, {"candidates", cs}});
@@ -75,21 +75,16 @@ json KnobsJson(const Analysis& a) {
     const auto& c = set.candidates[k];
     cands.push_back({{"key", c.key}, {"family", c.family}, {"knob", c.knob}, {"nominal", c.nominal}, {"probe", c.probe},
                      {"range", {c.lo, c.hi}}, {"simulated", c.simulated},
-                     {"inclusion", a.confidence.computed ? Num(a.confidence.inclusion[k]) : json(nullptr)}});
+                     {"inclusion", a.confidence.computed ? JsonNumber(a.confidence.inclusion[k]) : json(nullptr)}});
   }
   json trace = json::array();
   for (const auto& s : r.trace) {
-    trace.push_back({{"knob", s.knob}, {"value", s.value}, {"coefficient", Num(s.coefficient)}, {"score", Num(s.score)}});
+    trace.push_back({{"knob", s.knob}, {"value", s.value}, {"coefficient", JsonNumber(s.coefficient)}, {"score", JsonNumber(s.score)}});
   }
   json refined = json::array();
   for (const auto& f : r.refined) {
-    json span = nullptr;
-    if (f.as_well.Searched()) {
-      span = {{"values", {f.as_well.lower, f.as_well.upper}}, {"forward_offset_m", {Num(f.as_well.x_lower), Num(f.as_well.x_upper)}},
-              {"points", f.as_well.points}, {"searched", f.as_well.searched}};
-    }
-    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", Num(f.coefficient)}, {"converged", f.converged},
-                       {"fits_as_well", span}});
+    refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", JsonNumber(f.coefficient)}, {"converged", f.converged},
+                       {"fits_as_well", SearchSpanJson(f.as_well)}});
   }
   json removed = json::array();
   for (int k : r.selection.removed) removed.push_back(set.candidates[k].key);
@@ -99,7 +94,7 @@ json KnobsJson(const Analysis& a) {
   if (r.spread.tested) {
     spread = {{"knob_log_variance_ratio", Vec(r.spread.knob_log_ratio)}, {"tracker_coefficient", r.spread.a},
               {"gain", r.spread.gain}, {"se", r.spread.se}, {"z", r.spread.z}, {"tracker_needed", r.spread.tracker_needed},
-              {"tracker_scale", Num(r.tracker_scale)}};
+              {"tracker_scale", JsonNumber(r.tracker_scale)}};
   }
   json out = {{"candidates", cands}, {"selection_steps", StepsJson(a)}, {"removed_by_backward_pass", removed},
           {"refinement", trace}, {"refined", refined}, {"family_inclusion", family},
@@ -118,7 +113,7 @@ json KnobsJson(const Analysis& a) {
 }
 
 json DriftJson(const EffectDrift& d, const char* change, const char* flag) {
-  return {{change, Num(d.gamma)}, {"p_value", Num(d.p_value)}, {"z", Num(d.z)}, {flag, d.drifting}};
+  return {{change, JsonNumber(d.gamma)}, {"p_value", JsonNumber(d.p_value)}, {"z", JsonNumber(d.z)}, {flag, d.drifting}};
 }
 
 json AdequacyJson(const Analysis& a) {
@@ -136,14 +131,14 @@ json AdequacyJson(const Analysis& a) {
   }
   json checks = json::array();
   for (const auto& c : q.checks) {
-    checks.push_back({{"key", a.candidates.candidates[c.candidate].key}, {"fitted_value", Num(c.fitted)},
-                      {"value", Num(c.value)}, {"outside_range", c.outside_range}, {"pinned_low", c.pinned_low},
+    checks.push_back({{"key", a.candidates.candidates[c.candidate].key}, {"fitted_value", JsonNumber(c.fitted)},
+                      {"value", JsonNumber(c.value)}, {"outside_range", c.outside_range}, {"pinned_low", c.pinned_low},
                       {"pinned_high", c.pinned_high}, {"impossible", c.impossible}, {"unconverged", c.unconverged},
                       {"doubts", c.doubts}});
   }
   return {{"regions_after", Regions(q.after.regions)}, {"conditional_flagged_regions_after", q.after.conditional_flagged},
           {"heat_map_after", HeatMap(a, q.after.heat)},
-          {"shortfall_nats_per_sample", Num(q.shortfall)}, {"shortfall_se", Num(q.shortfall_se)},
+          {"shortfall_nats_per_sample", JsonNumber(q.shortfall)}, {"shortfall_se", JsonNumber(q.shortfall_se)},
           {"below_ceiling", q.below_ceiling}, {"knob_checks", checks}, {"residual_tests", tests},
           {"drift_tests", drift}, {"total_drift", DriftJson(q.total_drift, "relative_change", "drifting")},
           {"total_step_variation", DriftJson(q.total_step_variation, "relative_rms", "varies")},
@@ -153,11 +148,11 @@ json AdequacyJson(const Analysis& a) {
 json FitJson(const Analysis& a) {
   const Baseline& b = a.baseline;
   return {{"heldout_log_likelihood_per_sample",
-           {{"sim", b.ll_sim}, {"corrected", a.knobs_analysed ? Num(a.adequacy.ll_corrected) : json(nullptr)},
+           {{"sim", b.ll_sim}, {"corrected", a.knobs_analysed ? JsonNumber(a.adequacy.ll_corrected) : json(nullptr)},
             {"real_trained_ceiling", b.ll_ceiling}, {"real_only", b.ll_real_only},
             {"ceiling_sim_prior_count", b.ceiling_prior_count}}},
-          {"gap_closed", a.knobs_analysed ? Num(a.adequacy.gap_closed) : json(nullptr)},
-          {"gap_closed_se", a.knobs_analysed ? Num(a.adequacy.gap_closed_se) : json(nullptr)}};
+          {"gap_closed", a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed) : json(nullptr)},
+          {"gap_closed_se", a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed_se) : json(nullptr)}};
 }
 
 }  // namespace

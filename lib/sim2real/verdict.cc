@@ -4,20 +4,13 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
+#include "sim2real/search_span_json.h"
 #include "sim2real/sentence_format.h"
 
 namespace dgmm::sim2real {
 namespace {
 
 using json = nlohmann::json;
-
-json Number(double v) { return std::isfinite(v) ? json(v) : json(nullptr); }
-
-json SpanJson(const SearchSpan& s) {
-  if (!s.Searched()) return nullptr;
-  return {{"values", {Number(s.lower), Number(s.upper)}}, {"forward_offset_m", {Number(s.x_lower), Number(s.x_upper)}},
-          {"points", s.points}, {"searched", s.searched}, {"z", s.z}};
-}
 
 }  // namespace
 
@@ -44,10 +37,10 @@ std::string DescribeExperiment(const VerdictExperiment& e) {
 std::string VerdictJson(const Verdict& v) {
   json named = json::array();
   for (const auto& n : v.named) {
-    named.push_back({{"family", n.family}, {"knob", n.knob}, {"value", Number(n.value)}, {"unit", n.unit},
-                     {"nominal", Number(n.nominal)}, {"fitted_value", Number(n.fitted)},
-                     {"range", {Number(n.lo), Number(n.hi)}}, {"ci95", {Number(n.value_lower), Number(n.value_upper)}},
-                     {"fits_as_well", SpanJson(n.as_well)},
+    named.push_back({{"family", n.family}, {"knob", n.knob}, {"value", JsonNumber(n.value)}, {"unit", n.unit},
+                     {"nominal", JsonNumber(n.nominal)}, {"fitted_value", JsonNumber(n.fitted)},
+                     {"range", {JsonNumber(n.lo), JsonNumber(n.hi)}}, {"ci95", {JsonNumber(n.value_lower), JsonNumber(n.value_upper)}},
+                     {"fits_as_well", SearchSpanJson(n.as_well)},
                      {"inclusion", n.inclusion < 0 ? json(nullptr) : json(n.inclusion)},
                      {"candidate_inclusion", n.candidate_inclusion < 0 ? json(nullptr) : json(n.candidate_inclusion)},
                      {"tie_group", n.tie_group < 0 ? json(nullptr) : json(n.tie_group)},
@@ -85,20 +78,20 @@ std::string VerdictJson(const Verdict& v) {
   json drifting = json::array();
   for (const auto& d : v.drifting) {
     json e = {{"family", d.family}, {"knob", d.knob}, {"unit", d.unit}, {"along", d.along},
-              {"value", Number(d.value)}, {"nominal", Number(d.nominal)},
-              {"relative_change", Number(d.gamma)}, {"p_value", Number(d.p_value)},
+              {"value", JsonNumber(d.value)}, {"nominal", JsonNumber(d.nominal)},
+              {"relative_change", JsonNumber(d.gamma)}, {"p_value", JsonNumber(d.p_value)},
               {"inclusion", d.inclusion < 0 ? json(nullptr) : json(d.inclusion)}};
     if (d.along == "session order") {
-      e["first"] = Number(d.first), e["last"] = Number(d.last);
+      e["first"] = JsonNumber(d.first), e["last"] = JsonNumber(d.last);
     } else {
-      e["lowest"] = Number(d.first), e["lowest_step"] = d.first_step;
-      e["highest"] = Number(d.last), e["highest_step"] = d.last_step;
+      e["lowest"] = JsonNumber(d.first), e["lowest_step"] = d.first_step;
+      e["highest"] = JsonNumber(d.last), e["highest_step"] = d.last_step;
     }
     drifting.push_back(e);
   }
   json weak = json::array();
   for (const auto& w : v.weak) {
-    weak.push_back({{"family", w.family}, {"knob", w.knob}, {"value", Number(w.value)}, {"inclusion", w.inclusion}});
+    weak.push_back({{"family", w.family}, {"knob", w.knob}, {"value", JsonNumber(w.value)}, {"inclusion", w.inclusion}});
   }
   json out = {{"status", v.status},
               {"sentence", v.sentence},
@@ -109,7 +102,7 @@ std::string VerdictJson(const Verdict& v) {
               {"ties", ties},
               {"drifting", drifting},
               {"unexplained", {{"present", v.unexplained_present}, {"structured_in", v.structured_in}}},
-              {"gap_closed", Number(v.gap_closed)}};
+              {"gap_closed", JsonNumber(v.gap_closed)}};
   return out.dump();
 }
 
