@@ -40,6 +40,7 @@ struct Sim2RealArgs {
   bool no_figures = false;
   bool spread_signatures = false;
   bool every_leg = false;
+  bool leg_search = false;
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -135,6 +136,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.executions_per_placement = args.signature_executions;
   o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.legs_only_when_implicated = !args.every_leg;
+  o.legs.enabled = args.leg_search;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -273,6 +275,10 @@ void Setup(CLI::App& root) {
       ->capture_default_str()->check(CLI::Range(2, 100));
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
+  cmd->add_flag("--leg-search", args->leg_search,
+                "experimental: when nothing is named and the residual has heavy tails, search every leg's gain with "
+                "recordings scored by their own model (three per leg and two more, 5 executions per placement; "
+                "docs/sim2real.md)");
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
                "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");

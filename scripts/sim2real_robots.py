@@ -13,6 +13,7 @@ time.
 
 Usage: scripts/sim2real_robots.py [--build build] [--config datasets/robots/hexapod.json]
                                   [--seeds 13000-13002] [--threads 2] [--out DIR]
+                                  [--sim2real-args 'ARGS']
 """
 import argparse, json, os, random, subprocess, sys, tempfile, time
 
@@ -60,6 +61,8 @@ def main():
     ap.add_argument("--seeds", default="13000-13002")
     ap.add_argument("--threads", default="2")
     ap.add_argument("--out", default=None)
+    ap.add_argument("--sim2real-args", default="", metavar="'ARGS'",
+                    help="more options of every dgmm sim2real call, e.g. '--leg-search'")
     ap.add_argument("--model-friction", type=float, default=1.0,
                     help="largest sliding friction coefficient among the model's geoms")
     a = ap.parse_args()
@@ -90,7 +93,7 @@ def main():
         dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--seed", str(2 * seed + 1), "-o", real)
         start = time.time()
         dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", os.path.join(d, "report"), "--no-figures",
-             "--threads", a.threads)
+             "--threads", a.threads, *a.sim2real_args.split())
         wall = time.time() - start
         v = json.load(open(os.path.join(d, "report", "report.json")))["verdict"]
         named = [n for n in v["named"]]

@@ -1,5 +1,6 @@
 #include "sim2real/analysis.h"
 
+#include <algorithm>
 #include <chrono>
 #include <random>
 
@@ -29,11 +30,19 @@ std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement
   return out;
 }
 
+// The leg search runs when the stages before named nothing for a located mismatch whose residual
+// has heavy tails (or any residual structure, when the options do not ask for tails).
+bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
+  if (!options.enabled || !a.naming.named.empty() || a.verdict.status != "unexplained") return false;
+  const auto& in = a.adequacy.residual.structured_in;
+  return !options.only_with_tails || std::find(in.begin(), in.end(), "tails") != in.end();
+}
+
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
-         ties.IsValid(error) && verdict.IsValid(error);
+         ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error);
 }
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
@@ -76,8 +85,22 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   a.seconds.ties = Since(t);
   a.verdict = ComposeVerdict(a.baseline, a.candidates, a.refinement, a.confidence, a.adequacy, a.naming, a.ties,
                              options.verdict);
-  a.correction = MakeCorrection(a.inputs, a.baseline, a.candidates, a.refinement.selection.fit);
-  a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);
+  if (WantLegSearch(a, options.legs)) {
+    t = Clock::now();
+    stage("leg search (every leg's gain)");
+    LegSearchOptions legs = options.legs;
+    legs.model = options.locate.model;
+    a.leg_search = SearchLegGains(*simulator, a.inputs, a.baseline, a.candidates, options.candidates, legs);
+    AddLegSearch(a.leg_search, &a.verdict);
+    a.seconds.legs = Since(t);
+  }
+  if (a.leg_search.named) {
+    a.correction = LegSearchCorrection(a.leg_search);
+    a.named_values = {{a.leg_search.knob_index, a.leg_search.value}};
+  } else {
+    a.correction = MakeCorrection(a.inputs, a.baseline, a.candidates, a.refinement.selection.fit);
+    a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);
+  }
   a.seconds.total = Since(start);
   return a;
 }

@@ -10,6 +10,8 @@
 //                                    values pinned or impossible, residual structure and drift;
 //   7. ties        (ties.h)          what the data cannot tell apart, and the experiment that would;
 //   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence;
+//      legs        (leg_search.h)    opt-in: when nothing is named and the residual has heavy tails,
+//                                    every leg's gain searched, each recording scored by its own model;
 //   9. report      (report.h)        report.json, report.html, the stdout summary (in the app).
 // Without a simulator the analysis stops after stage 2 and says so.
 #include <cstdint>
@@ -18,6 +20,7 @@
 #include <vector>
 
 #include "sim2real/correction.h"
+#include "sim2real/leg_search.h"
 #include "sim2real/verdict_stage.h"
 
 namespace dgmm::sim2real {
@@ -30,12 +33,13 @@ struct AnalysisOptions {
   AdequacyOptions adequacy;
   TieOptions ties;
   VerdictOptions verdict;
+  LegSearchOptions legs;   // its model options are the baseline's (locate.model)
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };
 
 struct StageTimes {
-  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, total = 0;
+  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, legs = 0, total = 0;
 };
 
 struct Analysis {
@@ -50,6 +54,7 @@ struct Analysis {
   Naming naming;
   TieResult ties;
   Verdict verdict;
+  LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
   Correction correction;           // the knob correction (empty without a simulator)
   std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)
   StageTimes seconds;

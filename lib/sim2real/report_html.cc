@@ -189,13 +189,24 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   std::ostringstream o;
   o << "<h2>4. The fit (adequacy of the correction)</h2><table><tr><th>model</th><th>held-out real log-likelihood per "
        "sample</th></tr><tr><td>(a) sim-trained</td><td>" << F("%.3f", b.ll_sim) << "</td></tr>";
-  if (a.knobs_analysed) {
+  const LegSearch& leg = a.leg_search;
+  if (leg.named) {
+    o << "<tr><td>(b) corrected (the weak leg of the leg search, its recording's own model)</td><td>"
+      << F("%.3f", leg.best_plain) << "</td></tr>";
+  } else if (a.knobs_analysed) {
     o << "<tr><td>(b) corrected (the knob correction)</td><td>" << F("%.3f", a.adequacy.ll_corrected) << "</td></tr>";
   }
   o << "<tr><td>(c) real-trained ceiling (sim prior strength " << F("%.0f", b.ceiling_prior_count) << ")</td><td>"
     << F("%.3f", b.ll_ceiling) << "</td></tr><tr><td>real-trained from real data alone</td><td>" << F("%.3f", b.ll_real_only)
     << "</td></tr></table>\n";
   if (!a.knobs_analysed) return o.str();
+  if (leg.named) {
+    o << "<p>Share of the nominal recording's misfit (" << F("%.3f", leg.nominal_misfit)
+      << " nats per sample: the real samples against the recording's own unseen samples) removed by the weak leg: "
+      << F("%.0f%%", 100 * leg.gap_closed) << ". The corrected model is written as <code>"
+      << Escape(ctx.corrected_model_file) << "</code>.</p>\n";
+    return o.str();
+  }
   const Adequacy& q = a.adequacy;
   o << "<p>Share of the gap closed: "
     << (std::isfinite(q.gap_closed) ? F("%.0f%%", 100 * q.gap_closed) + " (SE " + F("%.0f%%", 100 * q.gap_closed_se) + ")"
@@ -209,6 +220,23 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
     << "<h3>Residual tests</h3><table><tr><th>where</th><th>p</th><th>significant</th></tr>";
   for (const auto& t : q.residual.tests) {
     o << "<tr><td>" << Escape(t.where) << "</td><td>" << F("%.4f", t.p_value) << "</td><td>" << (t.significant ? "yes" : "no")
+      << "</td></tr>";
+  }
+  o << "</table>\n";
+  return o.str();
+}
+
+std::string LegSearchTable(const LegSearch& l) {
+  std::ostringstream o;
+  o << "<h3>Search of every leg's gain</h3><p>" << (l.named ? "Named " + Escape(l.knob) + F(" = %.4g", l.value) + "."
+                                                            : "Names no leg: " + Escape(l.why) + ".")
+    << " Nominal recording's own model: " << F("%.4f", l.nominal_score) << " nats per real sample (misfit "
+    << F("%.4f", l.nominal_misfit) << "; the best point's " << F("%.4f", l.best_misfit) << "); " << l.recorded << " recordings (" << l.from_cache << " from the cache), "
+    << F("%.0f s", l.seconds) << ".</p><table><tr><th>leg</th><th>gain</th><th>log-likelihood per real sample (own model)</th>"
+    << "<th>fits as well as the best</th></tr>";
+  for (const LegSearchPoint& p : l.points) {
+    o << "<tr><td>" << Escape(p.leg) << "</td><td>" << F("%.4g", p.value) << "</td><td>"
+      << (std::isfinite(p.score) ? F("%.4f", p.score) : std::string("fell")) << "</td><td>" << (p.fits_as_well ? "yes" : "")
       << "</td></tr>";
   }
   o << "</table>\n";
@@ -230,6 +258,7 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
       << " from the cache), " << a.refinement.recorded << " for the refinement; " << a.ties.experiment_checks
       << " experiment checks.</p>\n";
   }
+  if (a.leg_search.ran) o << LegSearchTable(a.leg_search);
   if (!ctx.recalibrated_config_file.empty()) {
     o << "<p>The simulator config at the named values: <code>" << Escape(ctx.recalibrated_config_file)
       << "</code> (<code>dgmm simulate --config</code>).</p>\n";
@@ -271,11 +300,16 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   if (!s.significant.empty()) o << " (worst: " << s.significant.front().label << ")";
   o << "\n";
   o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
-  if (a.knobs_analysed) {
+  const LegSearch& leg = a.leg_search;
+  if (leg.named) {
+    o << ", corrected (weak " << leg.leg << ") " << F("%.3f", leg.best_plain);
+  } else if (a.knobs_analysed) {
     o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);
   }
   o << ", ceiling " << F("%.3f", a.baseline.ll_ceiling);
-  if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
+  if (leg.named) {
+    o << " (" << F("%.0f%%", 100 * leg.gap_closed) << " of the gap closed)";
+  } else if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
     o << " (" << F("%.0f%%", 100 * a.adequacy.gap_closed) << " of the gap closed, SE " << F("%.0f%%", 100 * a.adequacy.gap_closed_se)
       << ")";
   }

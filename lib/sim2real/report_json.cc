@@ -145,14 +145,39 @@ json AdequacyJson(const Analysis& a) {
           {"doubts", q.doubts}};
 }
 
+// The fit of what the verdict names: the leg search's correction when it named a leg (its
+// recordings' own models score real samples they never saw, so there is no SE of folds), else the
+// knob correction's held-out fit.
 json FitJson(const Analysis& a) {
   const Baseline& b = a.baseline;
+  const LegSearch& l = a.leg_search;
+  const bool leg = l.named;
+  const json corrected = leg ? JsonNumber(l.best_plain)
+                             : a.knobs_analysed ? JsonNumber(a.adequacy.ll_corrected) : json(nullptr);
   return {{"heldout_log_likelihood_per_sample",
-           {{"sim", b.ll_sim}, {"corrected", a.knobs_analysed ? JsonNumber(a.adequacy.ll_corrected) : json(nullptr)},
+           {{"sim", b.ll_sim}, {"corrected", corrected},
             {"real_trained_ceiling", b.ll_ceiling}, {"real_only", b.ll_real_only},
             {"ceiling_sim_prior_count", b.ceiling_prior_count}}},
-          {"gap_closed", a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed) : json(nullptr)},
-          {"gap_closed_se", a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed_se) : json(nullptr)}};
+          {"corrected_by", !a.knobs_analysed ? json(nullptr) : json(leg ? "leg_search" : "knobs")},
+          {"gap_closed", leg ? JsonNumber(l.gap_closed) : a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed) : json(nullptr)},
+          {"gap_closed_se", !leg && a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed_se) : json(nullptr)}};
+}
+
+json LegSearchJson(const LegSearch& l) {
+  if (!l.ran) return nullptr;
+  json points = json::array();
+  for (const LegSearchPoint& p : l.points) {
+    points.push_back({{"leg", p.leg}, {"knob", p.knob}, {"value", p.value}, {"score", JsonNumber(p.score)},
+                      {"fits_as_well", p.fits_as_well}});
+  }
+  return {{"named", l.named}, {"why", l.why}, {"leg", l.best >= 0 ? json(l.leg) : json(nullptr)},
+          {"knob", l.best >= 0 ? json(l.knob) : json(nullptr)}, {"value", JsonNumber(l.value)},
+          {"nominal_score", JsonNumber(l.nominal_score)}, {"nominal_misfit", JsonNumber(l.nominal_misfit)},
+          {"best_misfit", JsonNumber(l.best_misfit)},
+          {"best_plain_score", JsonNumber(l.best_plain)}, {"z_vs_nominal", JsonNumber(l.z_vs_nominal)},
+          {"gap_closed", JsonNumber(l.gap_closed)},
+          {"legs_as_well", l.legs_as_well}, {"fits_as_well", SearchSpanJson(l.as_well)}, {"points", points},
+          {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 
 }  // namespace
@@ -167,6 +192,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"locate", LocateJson(a)},
               {"knobs", a.knobs_analysed ? KnobsJson(a) : json(nullptr)},
               {"adequacy", a.knobs_analysed ? AdequacyJson(a) : json(nullptr)},
+              {"leg_search", LegSearchJson(a.leg_search)},
               {"fit", FitJson(a)},
               {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},
                              {"fingerprint", ctx.simulator_fingerprint},
@@ -180,7 +206,8 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"dropped_real_commands", in.dropped_commands}, {"dropped_real_samples", in.dropped_samples},
               {"seconds", {{"locate", a.seconds.locate}, {"candidates", a.seconds.candidates},
                            {"refine", a.seconds.refine}, {"confidence", a.seconds.confidence},
-                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"total", a.seconds.total}}}};
+                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"leg_search", a.seconds.legs},
+                           {"total", a.seconds.total}}}};
   for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});
   return out.dump(2) + "\n";
 }

@@ -1,0 +1,321 @@
+#include "sim2real/leg_search.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "sim2real/refine_search.h"
+#include "sim2real/sentence_format.h"
+#include "sim2real/units.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A recording with its own model: the real samples' log-likelihood per sample under it, and the
+// per-axis variance of its own residuals.
+struct Scored {
+  Samples samples;
+  Eigen::VectorXd rows;
+  LinearGaussianModel model;
+  Eigen::VectorXd residual_var;
+  bool walkable = true;
+};
+
+// log of (1 - e) N(x; m, S) + e N(x; m, k^2 S) for every sample of s.
+Eigen::VectorXd RobustLogLikelihood(const LinearGaussianModel& model, const Samples& s, double e, double k) {
+  Eigen::VectorXd out(s.size());
+  const double d = s.pose_dim();
+  for (int i = 0; i < s.size(); ++i) {
+    const Prediction p = model.Predict(s.command[i], s.z.row(i).transpose(), s.first_execution[i]);
+    const double m = p.chol.triangularView<Eigen::Lower>().solve(s.x.row(i).transpose() - p.mean).squaredNorm();
+    const double base = -0.5 * (d * std::log(2 * M_PI) + p.log_det);
+    const double core = std::log1p(-e) + base - 0.5 * m;
+    const double broad = std::log(e) + base - d * std::log(k) - 0.5 * m / (k * k);
+    const double top = std::max(core, broad);
+    out(i) = top + std::log(std::exp(core - top) + std::exp(broad - top));
+  }
+  return out;
+}
+
+// How much worse the real samples fit a recording's model than the recording's own unseen samples:
+// the model fitted on the even executions of every placement (each placement stands for one
+// command and heading, so every cell keeps samples on both sides), then per sample
+//   misfit = mean robust l(odd executions) - mean robust l(real).
+// About 0 when the real robot is that simulation; the nominal's misfit is the whole mismatch.
+double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearchOptions& options) {
+  std::map<int, int> executions;  // per placement, seen so far
+  std::vector<int> fit_rows, held;
+  for (int i = 0; i < recording.size(); ++i) (executions[recording.episode[i]]++ % 2 == 0 ? fit_rows : held).push_back(i);
+  if (fit_rows.empty() || held.empty()) return NAN;
+  const LinearGaussianModel m = LinearGaussianModel::Fit(recording, options.model, fit_rows);
+  const double self =
+      RobustLogLikelihood(m, SubsetSamples(recording, held), options.outlier_share, options.outlier_scale).mean();
+  return self - RobustLogLikelihood(m, in.real, options.outlier_share, options.outlier_scale).mean();
+}
+
+Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, const LegSearchOptions& options,
+                      int nominal_size) {
+  std::vector<int> identity(recording.num_commands());
+  for (int c = 0; c < recording.num_commands(); ++c) identity[c] = c;
+  Scored out;
+  out.samples = MakeSamples(recording, identity);
+  const Samples& s = out.samples;
+  // A recording that lost most of its samples (the robot fell in most placements) is no model of a robot that walked.
+  out.walkable = s.size() >= nominal_size / 2 && s.size() > 0;
+  if (!out.walkable) {
+    out.rows = Eigen::VectorXd::Constant(in.real.size(), -INFINITY);
+    return out;
+  }
+  out.model = LinearGaussianModel::Fit(s, options.model);
+  out.rows = RobustLogLikelihood(out.model, in.real, options.outlier_share, options.outlier_scale);
+  Eigen::MatrixXd r(s.size(), s.pose_dim());
+  for (int i = 0; i < s.size(); ++i) {
+    const double first = s.has_sequence ? s.first_execution[i] : 0.0;
+    r.row(i) = s.x.row(i) - out.model.Predict(s.command[i], s.z.row(i).transpose(), first).mean.transpose();
+  }
+  out.residual_var = (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, s.size() - 1.0);
+  return out;
+}
+
+// (sum of a - b) / SE, per-placement sums as the independent units (refine_search.h).
+double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement) {
+  const UnitIds units = NumberUnits(placement);
+  if (units.count < 2 || a.size() != b.size()) return 0;
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(units.count);
+  for (int i = 0; i < a.size(); ++i) sums(units.unit[i]) += a(i) - b(i);
+  const double d = sums.sum();
+  const double se = std::sqrt(units.count / (units.count - 1.0) * (sums.array() - d / units.count).square().sum());
+  return se > 0 && std::isfinite(d) ? d / se : 0;
+}
+
+// The values to record for one knob: `factors` of its nominal, inside its range, distinct.
+std::vector<double> GridValues(const Knob& k, const std::vector<double>& factors) {
+  std::vector<double> out;
+  for (double f : factors) {
+    const double v = std::clamp(f * k.nominal, k.lo, k.hi);
+    if (std::none_of(out.begin(), out.end(), [&](double u) { return std::fabs(u - v) < 1e-9 * std::fabs(k.nominal); })) {
+      out.push_back(v);
+    }
+  }
+  return out;
+}
+
+// The points' search state: what was recorded, with scores.
+struct SearchState {
+  std::vector<LegSearchPoint> points;
+  std::vector<Scored> scored;
+  Scored nominal;
+  int nominal_size = 0;
+};
+
+Recording SearchRecording(const CandidateSet& set, const LegSearchOptions& options) {
+  Recording r = set.recording;
+  r.executions_per_placement = options.executions_per_placement;
+  return r;
+}
+
+// Records the wanted (knob, value) points (and first the nominal, when `state` has none yet) and
+// scores them.
+void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                  const CandidateOptions& recording, const LegSearchOptions& options,
+                  const std::vector<std::pair<int, double>>& wanted, SearchState* state, LegSearch* out) {
+  const bool need_nominal = state->nominal.rows.size() == 0;
+  std::vector<std::vector<KnobValue>> requests;
+  if (need_nominal) requests.push_back({});
+  for (const auto& [k, v] : wanted) requests.push_back({{k, v}});
+  RecordingBatch batch = RecordBatch(simulator, SearchRecording(set, options), requests, recording.recording);
+  if (need_nominal) {
+    state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size());
+    state->nominal_size = batch.sets[0].size();
+    batch.sets.erase(batch.sets.begin());
+  }
+  out->recorded += batch.recorded;
+  out->from_cache += batch.from_cache;
+  const auto& knobs = simulator.knobs();
+  for (size_t j = 0; j < wanted.size(); ++j) {
+    const Knob& knob = knobs[wanted[j].first];
+    state->scored.push_back(ScoreRecording(batch.sets[j], in, options, state->nominal_size));
+    const Scored& s = state->scored.back();
+    state->points.push_back({knob.leg, knob.name, wanted[j].first, wanted[j].second,
+                             s.walkable ? s.rows.mean() : -INFINITY, false});
+  }
+}
+
+int BestPoint(const SearchState& state) {
+  int best = -1;
+  for (size_t j = 0; j < state.points.size(); ++j) {
+    if (std::isfinite(state.points[j].score) && (best < 0 || state.points[j].score > state.points[best].score)) {
+      best = static_cast<int>(j);
+    }
+  }
+  return best;
+}
+
+// Half-steps either side of the named leg's best gain (towards its neighbours among the recorded
+// gains, or a grid step beyond the last), inside the range, not yet recorded.
+std::vector<std::pair<int, double>> HalfSteps(const SearchState& state, int best, const Knob& knob, double step) {
+  const LegSearchPoint& b = state.points[best];
+  double below = b.value - 2 * step, above = b.value + 2 * step;
+  for (const LegSearchPoint& p : state.points) {
+    if (p.knob_index != b.knob_index) continue;
+    if (p.value < b.value) below = std::max(below, p.value);
+    if (p.value > b.value) above = std::min(above, p.value);
+  }
+  std::vector<std::pair<int, double>> out;
+  for (double v : {0.5 * (b.value + below), 0.5 * (b.value + above)}) {
+    if (v >= knob.lo && v <= knob.hi) out.push_back({b.knob_index, v});
+  }
+  return out;
+}
+
+// Names the best point's leg, or says why not.
+void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
+            const LegSearchOptions& options, SearchState* state, LegSearch* out) {
+  out->points = state->points;
+  out->best = BestPoint(*state);
+  out->named = false;
+  if (out->best < 0) {
+    out->why = "every recording of a weak leg lost most of its placements (the robot fell)";
+    return;
+  }
+  std::vector<Eigen::VectorXd> rows;
+  for (const Scored& s : state->scored) rows.push_back(s.rows);
+  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, out->best, in.real.episode, options.z);
+  const LegSearchPoint& b = state->points[out->best];
+  out->legs_as_well.clear();
+  for (size_t j = 0; j < rows.size(); ++j) {
+    out->points[j].fits_as_well = as_well[j];
+    const std::string& leg = state->points[j].leg;
+    if (as_well[j] && leg != b.leg &&
+        std::find(out->legs_as_well.begin(), out->legs_as_well.end(), leg) == out->legs_as_well.end()) {
+      out->legs_as_well.push_back(leg);
+    }
+  }
+  out->z_vs_nominal = PairedZ(state->scored[out->best].rows, state->nominal.rows, in.real.episode);
+  out->leg = b.leg, out->knob = b.knob, out->knob_index = b.knob_index, out->value = b.value;
+  const Knob& knob = knobs[b.knob_index];
+  out->nominal = knob.nominal, out->lo = knob.lo, out->hi = knob.hi;
+  std::vector<double> values;
+  std::vector<Eigen::VectorXd> leg_rows;
+  int leg_best = 0;
+  for (size_t j = 0; j < rows.size(); ++j) {
+    if (state->points[j].knob_index != b.knob_index) continue;
+    if (static_cast<int>(j) == out->best) leg_best = static_cast<int>(values.size());
+    values.push_back(state->points[j].value);
+    leg_rows.push_back(rows[j]);
+  }
+  out->as_well = FitAsWellSpan(leg_rows, leg_best, values, {}, in.real.episode, options.z);
+  const std::string at = b.leg + Fmt(" at gain %.3g", b.value);
+  if (out->z_vs_nominal < options.z) {
+    out->why = "the best point (" + at + Fmt(") fits the real samples no better than the nominal (z %.2f)", out->z_vs_nominal);
+  } else if (!out->legs_as_well.empty()) {
+    out->why = "the best point is " + at + ", but weak " + out->legs_as_well[0] +
+               (out->legs_as_well.size() > 1 ? Fmt(" (and %.0f more legs)", out->legs_as_well.size() - 1.0) : "") +
+               " fits the real samples as well: these data do not tell which leg";
+  } else {
+    out->named = true;
+    out->why = "";
+  }
+  out->best_model = state->scored[out->best].model;
+  out->best_plain = out->best_model.LogLikelihood(in.real).mean();
+  out->log_var = (state->scored[out->best].residual_var.array() / state->nominal.residual_var.array()).log().matrix();
+}
+
+// Does the best point remove enough of the nominal's misfit? Else the leg is not named.
+void CheckMisfit(const AnalysisInputs& in, const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
+  out->nominal_misfit = Misfit(state.nominal.samples, in, options);
+  out->best_misfit = Misfit(state.scored[out->best].samples, in, options);
+  out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
+  if (out->gap_closed >= options.min_gap_closed) return;
+  out->named = false;
+  out->why = "the best point (" + out->leg + Fmt(" at gain %.3g", out->value) +
+             Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against the recording's own "
+                 "unseen samples, %.3g nats per sample; the best's: %.3g)", 100 * out->gap_closed, out->nominal_misfit,
+                 out->best_misfit) +
+             ": the mismatch is not a weak leg alone";
+}
+
+}  // namespace
+
+bool LegSearchOptions::IsValid(std::string* error) const {
+  if (factors.empty() || std::any_of(factors.begin(), factors.end(), [](double f) { return !(f > 0); })) {
+    *error = "leg search: factors must be positive";
+    return false;
+  }
+  if (!(outlier_share > 0 && outlier_share < 1) || !(outlier_scale > 1)) {
+    *error = "leg search: outlier_share in (0, 1) and outlier_scale > 1 expected";
+    return false;
+  }
+  if (refine_steps < 0 || executions_per_placement < 0 || !(z > 0) || !(min_gap_closed >= 0 && min_gap_closed <= 1)) {
+    *error = "leg search: refine_steps >= 0, executions_per_placement >= 0, z > 0 and min_gap_closed in [0, 1] expected";
+    return false;
+  }
+  return model.IsValid(error);
+}
+
+std::vector<int> LegGainKnobs(const KnobSimulator& simulator) {
+  std::vector<int> out;
+  const auto& knobs = simulator.knobs();
+  for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
+    if (knobs[k].family == "actuator_gain" && !knobs[k].leg.empty() && knobs[k].role == Knob::Role::kShift) {
+      out.push_back(k);
+    }
+  }
+  return out;
+}
+
+LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                         const CandidateSet& set, const CandidateOptions& recording, const LegSearchOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "leg search options", error);
+  const auto start = Clock::now();
+  LegSearch out;
+  const std::vector<int> legs = LegGainKnobs(simulator);
+  if (legs.empty()) {
+    out.why = "the simulator has no per-leg gain knobs";
+    return out;
+  }
+  out.ran = true;
+  const auto& knobs = simulator.knobs();
+  SearchState state;
+  std::vector<std::pair<int, double>> grid;
+  for (int k : legs) {
+    for (double v : GridValues(knobs[k], options.factors)) grid.push_back({k, v});
+  }
+  RecordPoints(simulator, in, set, recording, options, grid, &state, &out);
+  out.nominal_model = state.nominal.model;
+  out.nominal_score = state.nominal.rows.mean();
+  Decide(in, knobs, options, &state, &out);
+  const double step = options.factors.size() > 1
+                          ? std::fabs(options.factors[0] - options.factors[1]) * std::fabs(out.nominal)
+                          : 0.1 * std::fabs(out.nominal);
+  for (int round = 0; out.named && round < options.refine_steps; ++round) {
+    const auto more = HalfSteps(state, out.best, knobs[out.knob_index], step / (1 << round));
+    if (more.empty()) break;
+    RecordPoints(simulator, in, set, recording, options, more, &state, &out);
+    Decide(in, knobs, options, &state, &out);
+  }
+  if (out.named) CheckMisfit(in, state, options, &out);
+  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+Correction LegSearchCorrection(const LegSearch& search) {
+  Correction out;
+  if (!search.named) return out;
+  auto best = std::make_shared<LinearGaussianModel>(search.best_model);
+  auto nominal = std::make_shared<LinearGaussianModel>(search.nominal_model);
+  out.shift = [best, nominal](int c, const Eigen::VectorXd& z, double f) {
+    return Eigen::VectorXd(best->Predict(c, z, f).mean - nominal->Predict(c, z, f).mean);
+  };
+  out.log_var = search.log_var;
+  out.terms.push_back({search.knob + "@leg_search", Eigen::VectorXd::Constant(1, search.value)});
+  return out;
+}
+
+}  // namespace dgmm::sim2real

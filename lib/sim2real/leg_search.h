@@ -1,0 +1,97 @@
+#pragma once
+// Stage 8b of the analysis (analysis.h): a search of every leg's gain, run when the stages before
+// named nothing for a located mismatch. A weak leg that the robot sags onto now and then changes
+// how the outcomes spread (falls in some executions) more than their means, so a probe's mean shift
+// (signatures.h) does not describe it, and at the probe's gain a leg that the gait barely loads may
+// change nothing. Here each leg's gain is recorded at `factors` of its nominal, every recording
+// gets a model of its own (the reference family, linear_gaussian.h: its spread included), and a
+// point's score is the real samples' log-likelihood under that model,
+//   l(leg, g) = sum_i log p_{leg,g}(x_i | c_i, z_i, f_i).
+// The best point names its leg when it fits better than the nominal re-recording by z standard
+// errors, no point of another leg fits as well (placements as the units, refine_search.h), and it
+// removes at least `min_gap_closed` of the nominal's misfit (how much worse the real samples fit a
+// recording's model than the recording's own unseen samples; the real-trained ceiling of locate
+// is no ceiling here: a recording's model learns from far more samples than the real set has);
+// then the best gain is refined by `refine_steps` rounds of half-steps either side of it.
+#include <string>
+#include <vector>
+
+#include "sim2real/candidates.h"
+#include "sim2real/correction.h"
+#include "sim2real/linear_gaussian.h"
+#include "sim2real/search_span.h"
+#include "sim2real/verdict.h"
+
+namespace dgmm::sim2real {
+
+struct LegSearchOptions {
+  // Opt-in (`dgmm sim2real --leg-search`): on fresh hexapod pairs it named no leg (docs/sim2real.md),
+  // at 6 to 7 minutes of recordings per run.
+  bool enabled = false;
+  std::vector<double> factors = {0.5, 0.4, 0.3};  // of each leg's nominal gain, clipped to its range
+  int refine_steps = 1;          // rounds of half-steps around the best gain of the named leg
+  double z = 2.0;                // better than the nominal, and no other leg as good, by z SE
+  double min_gap_closed = 0.25;  // share of the nominal's misfit the best point removes
+  // Executions per placement of its recordings (0: the sim set's protocol's own, the paper's 5): a
+  // weak leg's sag builds up over a placement's executions, which two signature executions miss.
+  int executions_per_placement = 0;
+  // A recording's model scores each real sample as a mixture with a broad component,
+  //   p = (1 - e) N(x; m, S) + e N(x; m, k^2 S),  e = outlier_share, k = outlier_scale:
+  // a fall the model never saw then costs tens of nats, not thousands, so a few placements with
+  // falls cannot decide a comparison alone and the placements' SE measures agreement across them.
+  double outlier_share = 0.01;
+  double outlier_scale = 10.0;
+  // Run only when the located mismatch is in the residual's tails (a leg the robot sags onto now
+  // and then); a mismatch in the means is what the probes' signatures describe.
+  bool only_with_tails = true;
+  LinearGaussianOptions model;   // each recording's own model (the analysis copies the baseline's)
+  bool IsValid(std::string* error) const;
+};
+
+struct LegSearchPoint {
+  std::string leg, knob;
+  int knob_index = -1;
+  double value = 0;   // the gain recorded
+  double score = 0;   // mean log-likelihood per real sample under the recording's own model
+  bool fits_as_well = false;  // within z SE of the best
+};
+
+struct LegSearch {
+  bool ran = false;
+  std::string why;                    // why it did not run, or what it found, in words
+  std::vector<LegSearchPoint> points; // every leg and gain scored
+  double nominal_score = NAN;         // the nominal re-recording's own model, per real sample
+  double best_plain = NAN;            // the best's plain (not robust) log-likelihood per real sample,
+                                      // comparable with locate's sim model and ceiling
+  double nominal_misfit = NAN, best_misfit = NAN;  // own unseen samples minus real, per sample (leg_search.cc)
+  int best = -1;                      // index into points
+  bool named = false;
+  std::string leg, knob;              // the named leg and its gain knob
+  int knob_index = -1;
+  double value = NAN, nominal = NAN, lo = NAN, hi = NAN;
+  SearchSpan as_well;                 // the named leg's gains that fit as well as the best
+  std::vector<std::string> legs_as_well;  // other legs with a point within z SE of the best
+  double gap_closed = NAN;            // 1 - best_misfit / nominal_misfit
+  double z_vs_nominal = 0;            // the best's gain over the nominal in SEs (placements)
+  LinearGaussianModel nominal_model, best_model;  // the correction's two ends
+  Eigen::VectorXd log_var;            // per axis log(residual variance best / nominal)
+  int recorded = 0, from_cache = 0;
+  double seconds = 0;
+};
+
+// The per-leg gain knobs of `simulator` (family actuator_gain, a leg's name, a shift role).
+std::vector<int> LegGainKnobs(const KnobSimulator& simulator);
+
+LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                         const CandidateSet& set, const CandidateOptions& recording, const LegSearchOptions& options);
+
+// The named leg as a correction of the sim model: the best recording's own means minus the
+// nominal's, and the per-axis ratio of their residual variances.
+Correction LegSearchCorrection(const LegSearch& search);
+
+// The verdict with the search's answer (leg_search_verdict.cc): a named leg replaces an
+// `unexplained` verdict that named nothing (status partly_explained, with the doubts of a search
+// without bootstrap); otherwise the sentence says what the search found and why it names nothing.
+void AddLegSearch(const LegSearch& search, Verdict* verdict);
+
+}  // namespace dgmm::sim2real

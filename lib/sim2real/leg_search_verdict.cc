@@ -1,0 +1,53 @@
+// The leg search's answer in the verdict (leg_search.h, AddLegSearch).
+#include "sim2real/leg_search.h"
+#include "sim2real/sentence_format.h"
+#include "sim2real/verdict_stage.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+VerdictNamed NamedLeg(const LegSearch& s) {
+  VerdictNamed n;
+  n.family = "actuator_gain";
+  n.knob = s.knob;
+  n.value = n.fitted = s.value;
+  n.nominal = s.nominal;
+  n.lo = s.lo, n.hi = s.hi;
+  n.as_well = s.as_well;
+  if (s.value <= s.lo) n.flags.push_back("pinned_low");
+  if (s.value >= s.hi) n.flags.push_back("pinned_high");
+  n.doubts.push_back(Fmt("found by a search of every leg's gain (%.0f recordings, each scored by a model of its own, ",
+                         static_cast<double>(s.points.size())) +
+                     "its spread and falls included) after the probes' mean shifts named nothing: no bootstrap, its "
+                     "range is the gains that fit as well");
+  if (s.gap_closed < 0.9) {
+    n.doubts.push_back(Fmt("the weak leg removes %.0f%% of the nominal's misfit: some mismatch remains", 100 * s.gap_closed));
+  }
+  return n;
+}
+
+}  // namespace
+
+void AddLegSearch(const LegSearch& s, Verdict* v) {
+  if (!s.ran) return;
+  if (!s.named) {
+    v->sentence += Fmt(" A search of every leg's gain (%.0f recordings, each scored by a model of its own) names no leg: ",
+                       static_cast<double>(s.points.size())) +
+                   s.why + ".";
+    return;
+  }
+  const VerdictNamed n = NamedLeg(s);
+  v->status = "partly_explained";
+  v->named = {n};
+  v->doubts = n.doubts;
+  v->weak.clear();
+  v->gap_closed = s.gap_closed;
+  v->unexplained_present = s.gap_closed < 0.9;
+  v->sentence = VerdictSentence(*v, nullptr, nullptr, nullptr);
+  v->sentence += " The weak " + s.leg +
+                 Fmt(" leg fits the real samples %.3g nats per sample better than the nominal (z %.1f); ",
+                     s.points[s.best].score - s.nominal_score, s.z_vs_nominal) +
+                 "no other leg's gain fits as well.";
+}
+
+}  // namespace dgmm::sim2real

@@ -1,0 +1,120 @@
+// The search of every leg's gain (leg_search.h), on the fake simulator's four legs: a planted weak
+// leg is named with its gain, a nominal "real" robot or physics of another kind names none, the
+// verdict says one thing either way, and the answer does not depend on the thread count.
+#include "sim2real/leg_search.h"
+
+#include <gtest/gtest.h>
+
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real::test {
+namespace {
+
+LegSearchOptions Options(const Stages& s) {
+  LegSearchOptions o;
+  o.model = s.options.locate.model;
+  return o;
+}
+
+LegSearch Search(const Stages& s, int threads = 1) {
+  CandidateOptions recording = s.options.candidates;
+  recording.recording.threads = threads;
+  return SearchLegGains(SharedFake(), s.in, s.base, s.set, recording, Options(s));
+}
+
+TEST(LegSearch, FindsOnlyThePerLegGainKnobs) {
+  const std::vector<int> legs = LegGainKnobs(SharedFake());
+  EXPECT_EQ(legs, (std::vector<int>{kLeg0Gain, kLeg1Gain, kLeg2Gain, kLeg3Gain}));
+}
+
+TEST(LegSearch, NamesAPlantedWeakLegWithItsGain) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  const LegSearch r = Search(s);
+  ASSERT_TRUE(r.ran);
+  ASSERT_TRUE(r.named) << r.why;
+  EXPECT_EQ(r.leg, "leg1");
+  EXPECT_EQ(r.knob_index, kLeg1Gain);
+  EXPECT_NEAR(r.value, 0.38, 0.25 * 0.38);
+  EXPECT_GT(r.z_vs_nominal, 2.0);
+  EXPECT_TRUE(r.legs_as_well.empty());
+  EXPECT_GE(r.gap_closed, 0.5) << "the weak leg removes most of the nominal's misfit";
+  EXPECT_GT(r.nominal_misfit, r.best_misfit);
+  EXPECT_LE(r.as_well.lower, r.value);
+  EXPECT_GE(r.as_well.upper, r.value);
+  EXPECT_GT(r.points.size(), 12u) << "four legs at three gains, then half-steps around the best";
+  const Correction c = LegSearchCorrection(r);
+  ASSERT_TRUE(static_cast<bool>(c.shift));
+  EXPECT_GT(c.Shift(0, s.in.real.z.row(0).transpose(), 0, s.in.real.pose_dim()).norm(), 0);
+}
+
+TEST(LegSearch, ANominalRobotNamesNoLeg) {
+  const Stages s = RunStages({}, 3);
+  const LegSearch r = Search(s);
+  ASSERT_TRUE(r.ran);
+  EXPECT_FALSE(r.named) << "named " << r.leg << " at " << r.value;
+  EXPECT_FALSE(r.why.empty());
+  EXPECT_FALSE(static_cast<bool>(LegSearchCorrection(r).shift));
+}
+
+TEST(LegSearch, PhysicsOfAnotherKindNamesNoLeg) {
+  FakeExtras extras;
+  extras.geometry = 0.04;  // no knob describes it
+  const Stages s = RunStages({}, 3, extras);
+  const LegSearch r = Search(s);
+  EXPECT_FALSE(r.named) << "named " << r.leg << " at " << r.value;
+}
+
+TEST(LegSearch, TheAnswerDoesNotDependOnTheThreadCount) {
+  const Stages s = RunStages({{kLeg2Gain, 0.4}}, 3);
+  const LegSearch one = Search(s, 1), two = Search(s, 2);
+  ASSERT_EQ(one.points.size(), two.points.size());
+  for (size_t j = 0; j < one.points.size(); ++j) EXPECT_EQ(one.points[j].score, two.points[j].score);
+  EXPECT_EQ(one.value, two.value);
+}
+
+TEST(LegSearch, ANamedLegIsTheVerdictsOneStory) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  const LegSearch r = Search(s);
+  ASSERT_TRUE(r.named);
+  Verdict v;
+  v.status = "unexplained";
+  v.doubts = {"mismatch left in 12 regions"};
+  v.sentence = "Unexplained mismatch: no simulator knob or measurement effect fits.";
+  AddLegSearch(r, &v);
+  EXPECT_EQ(v.status, "partly_explained");
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "actuators.leg1.gain");
+  EXPECT_EQ(v.named[0].value, r.value);
+  EXPECT_EQ(v.sentence.find("Unexplained"), std::string::npos) << v.sentence;
+  EXPECT_NE(v.sentence.find("actuators.leg1.gain"), std::string::npos) << v.sentence;
+  EXPECT_NE(v.sentence.find("search of every leg's gain"), std::string::npos) << v.sentence;
+  for (const std::string& d : v.doubts) EXPECT_EQ(d.find("regions"), std::string::npos) << "the old doubt stays: " << d;
+}
+
+TEST(LegSearch, ALegNamedByNoneIsSaidWithWhy) {
+  const Stages s = RunStages({}, 3);
+  const LegSearch r = Search(s);
+  Verdict v;
+  v.status = "unexplained";
+  v.sentence = "Unexplained mismatch: no simulator knob or measurement effect fits.";
+  AddLegSearch(r, &v);
+  EXPECT_EQ(v.status, "unexplained");
+  EXPECT_TRUE(v.named.empty());
+  EXPECT_NE(v.sentence.find("names no leg: " + r.why), std::string::npos) << v.sentence;
+}
+
+TEST(LegSearch, RejectsOptionsThatCannotSearch) {
+  LegSearchOptions o;
+  std::string error;
+  o.factors = {};
+  EXPECT_FALSE(o.IsValid(&error));
+  o.factors = {0.5, -0.1};
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("leg search"), std::string::npos);
+  o.factors = {0.5};
+  o.min_gap_closed = 2;
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real::test
