@@ -90,7 +90,7 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
     stage("leg search (every leg's gain)");
     LegSearchOptions legs = options.legs;
     legs.model = options.locate.model;
-    a.leg_search = SearchLegGains(*simulator, a.inputs, a.baseline, a.candidates, options.candidates, legs);
+    a.leg_search = SearchLegGains(*simulator, a.inputs, a.candidates, options.candidates, legs);
     AddLegSearch(a.leg_search, &a.verdict);
     a.seconds.legs = Since(t);
   }

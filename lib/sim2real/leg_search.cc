@@ -269,8 +269,8 @@ std::vector<int> LegGainKnobs(const KnobSimulator& simulator) {
   return out;
 }
 
-LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
-                         const CandidateSet& set, const CandidateOptions& recording, const LegSearchOptions& options) {
+LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                         const CandidateOptions& recording, const LegSearchOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "leg search options", error);
   const auto start = Clock::now();

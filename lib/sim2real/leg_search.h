@@ -82,8 +82,8 @@ struct LegSearch {
 // The per-leg gain knobs of `simulator` (family actuator_gain, a leg's name, a shift role).
 std::vector<int> LegGainKnobs(const KnobSimulator& simulator);
 
-LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
-                         const CandidateSet& set, const CandidateOptions& recording, const LegSearchOptions& options);
+LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                         const CandidateOptions& recording, const LegSearchOptions& options);
 
 // The named leg as a correction of the sim model: the best recording's own means minus the
 // nominal's, and the per-axis ratio of their residual variances.

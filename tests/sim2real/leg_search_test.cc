@@ -19,7 +19,7 @@ LegSearchOptions Options(const Stages& s) {
 LegSearch Search(const Stages& s, int threads = 1) {
   CandidateOptions recording = s.options.candidates;
   recording.recording.threads = threads;
-  return SearchLegGains(SharedFake(), s.in, s.base, s.set, recording, Options(s));
+  return SearchLegGains(SharedFake(), s.in, s.set, recording, Options(s));
 }
 
 TEST(LegSearch, FindsOnlyThePerLegGainKnobs) {
