@@ -5,6 +5,8 @@
 #include <map>
 #include <random>
 
+#include "sim2real/units.h"
+
 namespace dgmm::sim2real {
 namespace {
 
@@ -33,17 +35,14 @@ EffectDrift TestEffectDrift(const Eigen::MatrixXd& r, const Eigen::MatrixXd& s, 
   EffectDrift out;
   const int n = static_cast<int>(r.rows());
   // Episodes in recording order (ascending id), with their per-episode sums.
-  std::map<int, int> unit_of;
-  for (int i = 0; i < n; ++i) unit_of.emplace(episode[i], 0);
-  int u = 0;
-  for (auto& [id, k] : unit_of) k = u++;
-  const int units = u;
+  const UnitIds ids = NumberUnitsAscending(episode);
+  const int units = ids.count;
   out.episodes = units;
   if (units < 2) return out;
   std::vector<double> a(units, 0), b(units, 0), count(units, 0);
   std::vector<int> unit_cmd(units, -1);
   for (int i = 0; i < n; ++i) {
-    const int e = unit_of[episode[i]];
+    const int e = ids.unit[i];
     a[e] += r.row(i).dot(s.row(i));
     b[e] += s.row(i).squaredNorm();
     count[e] += 1;

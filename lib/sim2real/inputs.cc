@@ -62,9 +62,7 @@ AnalysisInputs PrepareInputs(const SampleSet& sim_in, const SampleSet& real_in, 
   in.sim_set = ToRawUnits(sim_in, "--sim");
   in.real_set = ToRawUnits(real_in, "--real");
   const std::vector<int> real_map = AlignCommands(in.sim_set, in.real_set);
-  std::vector<int> identity(in.sim_set.num_commands());
-  for (int c = 0; c < in.sim_set.num_commands(); ++c) identity[c] = c;
-  in.sim = MakeSamples(in.sim_set, identity);
+  in.sim = MakeSamples(in.sim_set);
   in.real = MakeSamples(in.real_set, real_map);
   KeepSharedCommands(&in, real_map);
   if (in.real.size() < 10) {

@@ -16,13 +16,11 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A recording with its own model: the real samples' log-likelihood per sample under it, and the
-// per-axis variance of its own residuals.
+// A recording with its own model and the real samples' log-likelihood per sample under it.
 struct Scored {
   Samples samples;
   Eigen::VectorXd rows;
   LinearGaussianModel model;
-  Eigen::VectorXd residual_var;
   bool walkable = true;
 };
 
@@ -60,10 +58,8 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
 
 Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, const LegSearchOptions& options,
                       int nominal_size) {
-  std::vector<int> identity(recording.num_commands());
-  for (int c = 0; c < recording.num_commands(); ++c) identity[c] = c;
   Scored out;
-  out.samples = MakeSamples(recording, identity);
+  out.samples = MakeSamples(recording);
   const Samples& s = out.samples;
   // A recording that lost most of its samples (the robot fell in most placements) is no model of a robot that walked.
   out.walkable = s.size() >= nominal_size / 2 && s.size() > 0;
@@ -73,24 +69,23 @@ Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, cons
   }
   out.model = LinearGaussianModel::Fit(s, options.model);
   out.rows = RobustLogLikelihood(out.model, in.real, options.outlier_share, options.outlier_scale);
+  return out;
+}
+
+// The per-axis variance of a recording's residuals under its own model.
+Eigen::VectorXd ResidualVariance(const Scored& scored) {
+  const Samples& s = scored.samples;
   Eigen::MatrixXd r(s.size(), s.pose_dim());
   for (int i = 0; i < s.size(); ++i) {
-    const double first = s.has_sequence ? s.first_execution[i] : 0.0;
-    r.row(i) = s.x.row(i) - out.model.Predict(s.command[i], s.z.row(i).transpose(), first).mean.transpose();
+    r.row(i) = s.x.row(i) - scored.model.Predict(s.command[i], s.z.row(i).transpose(), s.first_execution[i]).mean.transpose();
   }
-  out.residual_var = (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, s.size() - 1.0);
-  return out;
+  return (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, s.size() - 1.0);
 }
 
 // (sum of a - b) / SE, per-placement sums as the independent units (refine_search.h).
 double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement) {
-  const UnitIds units = NumberUnits(placement);
-  if (units.count < 2 || a.size() != b.size()) return 0;
-  Eigen::VectorXd sums = Eigen::VectorXd::Zero(units.count);
-  for (int i = 0; i < a.size(); ++i) sums(units.unit[i]) += a(i) - b(i);
-  const double d = sums.sum();
-  const double se = std::sqrt(units.count / (units.count - 1.0) * (sums.array() - d / units.count).square().sum());
-  return se > 0 && std::isfinite(d) ? d / se : 0;
+  const PairedSum d = PairedDifference(a, b, NumberUnits(placement));
+  return d.se > 0 && std::isfinite(d.sum) ? d.sum / d.se : 0;
 }
 
 // The values to record for one knob: `factors` of its nominal, inside its range, distinct.
@@ -223,7 +218,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
   }
   out->best_model = state->scored[out->best].model;
   out->best_plain = out->best_model.LogLikelihood(in.real).mean();
-  out->log_var = (state->scored[out->best].residual_var.array() / state->nominal.residual_var.array()).log().matrix();
+  out->log_var =
+      (ResidualVariance(state->scored[out->best]).array() / ResidualVariance(state->nominal).array()).log().matrix();
 }
 
 // Does the best point remove enough of the nominal's misfit? Else the leg is not named.

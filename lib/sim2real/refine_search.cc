@@ -33,22 +33,29 @@ double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateS
   return fit.train_log_likelihood;
 }
 
+PairedSum PairedDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const UnitIds& placements) {
+  PairedSum out;
+  const int g = placements.count;
+  if (a.size() != b.size() || g < 2) return out;
+  Eigen::VectorXd sums = Eigen::VectorXd::Zero(g);
+  for (int i = 0; i < a.size(); ++i) sums(placements.unit[i]) += a(i) - b(i);
+  out.sum = sums.sum();
+  out.se = std::sqrt(g / (g - 1.0) * (sums.array() - out.sum / g).square().sum());
+  return out;
+}
+
 std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
                                      const std::vector<int>& placement, double z) {
   const UnitIds units = NumberUnits(placement);
-  const int g = units.count;
   std::vector<bool> out(rows.size(), false);
   for (size_t k = 0; k < rows.size(); ++k) {
     if (static_cast<int>(k) == best) {
       out[k] = true;
       continue;
     }
-    if (rows[k].size() != rows[best].size() || g < 2) continue;
-    Eigen::VectorXd sums = Eigen::VectorXd::Zero(g);
-    for (int i = 0; i < rows[k].size(); ++i) sums(units.unit[i]) += rows[best](i) - rows[k](i);
-    const double deficit = sums.sum();
-    const double se = std::sqrt(g / (g - 1.0) * (sums.array() - deficit / g).square().sum());
-    out[k] = std::isfinite(deficit) && deficit < z * se;
+    if (rows[k].size() != rows[best].size() || units.count < 2) continue;
+    const PairedSum deficit = PairedDifference(rows[best], rows[k], units);
+    out[k] = std::isfinite(deficit.sum) && deficit.sum < z * deficit.se;
   }
   return out;
 }

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sim2real/refine.h"
+#include "sim2real/units.h"
 
 namespace dgmm::sim2real {
 
@@ -19,10 +20,18 @@ double FaceValueScore(const AnalysisInputs& in, const Baseline& base, CandidateS
                       const std::vector<int>& shifts, const std::vector<int>& skip, const RefineOptions& options,
                       Eigen::VectorXd* rows = nullptr);
 
-// Which searched points fit the real samples as well as the best one (`best`, included): those
-// whose deficit D = sum_i (l_best,i - l_i) is below z times its standard error, the per-placement
-// sums of the differences taken as independent (placements are, samples of a placement are not):
+// D = sum_i (a_i - b_i) and its standard error, the per-placement sums S_g of the differences taken
+// as independent (placements are, samples of a placement are not):
 //   SE(D)^2 = G / (G - 1) sum_g (S_g - D / G)^2.
+// se is 0 when there are fewer than 2 placements or the lengths differ.
+struct PairedSum {
+  double sum = 0;
+  double se = 0;
+};
+PairedSum PairedDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const UnitIds& placements);
+
+// Which searched points fit the real samples as well as the best one (`best`, included): those
+// whose deficit D = sum_i (l_best,i - l_i) is below z times its standard error (PairedDifference).
 // The recordings' own simulation noise is not counted, so the set errs on the narrow side.
 std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
                                      const std::vector<int>& placement, double z);

@@ -153,9 +153,17 @@ std::string PhysicsSection(const Analysis& a) {
     << Escape(a.candidates.legs_note) << ". A candidate is named when selected by held-out real likelihood, constant "
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
+  const LegSearch& leg = a.leg_search;
+  if (leg.named) {
+    o << "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named "
+      << Escape(leg.knob) << F(" = %.4g", leg.value) << ": its recording fits the real samples "
+      << F("%.1f", leg.z_vs_nominal) << " standard errors better than the nominal's, no other leg's as well, and it "
+      << "removes " << F("%.0f%%", 100 * leg.gap_closed) << " of the nominal's misfit. It has no bootstrap: inclusion "
+      << "is not computed.</p>\n";
+  }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
   else o << NamedTable(a.verdict);
-  o << "<h3>Forward selection (held-out gain per real sample over the model of the previous step)</h3>";
+  o << "<h3>Forward selection of the knob path (held-out gain per real sample over the model of the previous step)</h3>";
   for (size_t s = 0; s < a.refinement.selection.steps.size(); ++s) {
     const auto& step = a.refinement.selection.steps[s];
     o << "<p>Step " << s + 1 << " (threshold z &gt; " << F("%.2f", step.threshold_z) << "): ";
@@ -308,7 +316,7 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   }
   o << ", ceiling " << F("%.3f", a.baseline.ll_ceiling);
   if (leg.named) {
-    o << " (" << F("%.0f%%", 100 * leg.gap_closed) << " of the gap closed)";
+    o << " (" << F("%.0f%%", 100 * leg.gap_closed) << " of the nominal recording's misfit removed)";
   } else if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
     o << " (" << F("%.0f%%", 100 * a.adequacy.gap_closed) << " of the gap closed, SE " << F("%.0f%%", 100 * a.adequacy.gap_closed_se)
       << ")";

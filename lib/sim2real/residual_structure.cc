@@ -57,10 +57,9 @@ double ExcessKurtosis(const Eigen::MatrixXd& r) {
 }
 
 double ExcessKurtosisSe(const Eigen::MatrixXd& r, const std::vector<int>& episode, int resamples, std::uint64_t seed) {
-  std::map<int, std::vector<int>> rows_of;
-  for (size_t i = 0; i < episode.size(); ++i) rows_of[episode[i]].push_back(static_cast<int>(i));
+  const std::vector<std::vector<int>> rows_of = RowsOfUnits(NumberUnitsAscending(episode));  // ascending episode id
   std::vector<const std::vector<int>*> units;
-  for (const auto& [e, rows] : rows_of) units.push_back(&rows);
+  for (const auto& rows : rows_of) units.push_back(&rows);
   if (units.size() < 2 || resamples < 2) return NAN;
   std::mt19937_64 rng(seed);
   std::uniform_int_distribution<size_t> pick(0, units.size() - 1);

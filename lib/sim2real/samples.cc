@@ -60,6 +60,12 @@ void DetectTerrainColumns(const SampleSet& set, int* pitch, int* roll) {
   }
 }
 
+Samples MakeSamples(const SampleSet& set) {
+  std::vector<int> identity(set.num_commands());
+  for (int c = 0; c < set.num_commands(); ++c) identity[c] = c;
+  return MakeSamples(set, identity);
+}
+
 Samples MakeSamples(const SampleSet& set, const std::vector<int>& command_map) {
   std::vector<int> rows;
   for (int i = 0; i < set.size(); ++i) {

@@ -39,6 +39,8 @@ void DetectTerrainColumns(const SampleSet& set, int* pitch, int* roll);
 // Flattens `set`; command ids are mapped through `command_map` (set row -> shared id, -1 drops
 // the sample).
 Samples MakeSamples(const SampleSet& set, const std::vector<int>& command_map);
+// Every sample, command ids as in `set` (the identity map).
+Samples MakeSamples(const SampleSet& set);
 
 // Maps the real set's command rows onto the sim set's (by label, then by command values).
 // Returns, per real row, the sim row or -1. Throws InputError when x or z dimensions differ.

@@ -8,11 +8,8 @@
 #include "sim2real/sentence_format.h"
 
 namespace dgmm::sim2real {
-namespace {
 
 using json = nlohmann::json;
-
-}  // namespace
 
 std::string DescribeExperiment(const VerdictExperiment& e) {
   if (e.commands.empty() || e.terrain.empty()) return "";

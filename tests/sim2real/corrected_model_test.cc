@@ -236,9 +236,7 @@ TEST(CorrectedModel, WithoutTerrainEachCommandIsItsFlagMixture) {
     set->z_names.clear();
     set->z_units.clear();
   }
-  std::vector<int> identity(sim.num_commands());
-  for (int c = 0; c < sim.num_commands(); ++c) identity[c] = c;
-  const LinearGaussianModel model = LinearGaussianModel::Fit(MakeSamples(sim, identity), {});
+  const LinearGaussianModel model = LinearGaussianModel::Fit(MakeSamples(sim), {});
   Correction correction;
   correction.log_tau = 0.1;
   correction.shift = [](int c, const Eigen::VectorXd&, double f) {

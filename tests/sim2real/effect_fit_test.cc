@@ -26,9 +26,7 @@ Fixture Make() {
   w.slip_creep = 0.03;
   SampleSet sim = GenerateSynthetic(SyntheticWorld{}, "paper-830", 3);
   SampleSet real = GenerateSynthetic(w, "paper", 4);
-  std::vector<int> id(sim.num_commands());
-  for (int c = 0; c < sim.num_commands(); ++c) id[c] = c;
-  f.sim = MakeSamples(sim, id);
+  f.sim = MakeSamples(sim);
   f.real = MakeSamples(real, AlignCommands(sim, real));
   f.model = LinearGaussianModel::Fit(f.sim, LinearGaussianOptions{});
   // Designs: a constant offset (tracker bias), a yaw per execution (heading drift), the sim

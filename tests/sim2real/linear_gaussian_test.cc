@@ -10,10 +10,7 @@ namespace dgmm::sim2real {
 namespace {
 
 Samples Make(const SyntheticWorld& w, const std::string& protocol, std::uint64_t seed) {
-  SampleSet s = GenerateSynthetic(w, protocol, seed);
-  std::vector<int> id(s.num_commands());
-  for (int c = 0; c < s.num_commands(); ++c) id[c] = c;
-  return MakeSamples(s, id);
+  return MakeSamples(GenerateSynthetic(w, protocol, seed));
 }
 
 TEST(LinearGaussianModel, HeldOutLikelihoodBeatsAShiftedTruth) {

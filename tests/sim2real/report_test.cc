@@ -7,7 +7,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim2real/leg_search.h"
 #include "tests/sim2real/fake_simulator.h"
+#include "tests/sim2real/stage_fixture.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -76,6 +78,36 @@ TEST(Report, TheHtmlTableShowsWhatTheSearchCouldNotTellApart) {
   EXPECT_EQ(ReportHtml(a, ctx, ".").find("fit as well"), std::string::npos);
   n.as_well.lower = 0.4;
   EXPECT_NE(ReportHtml(a, ctx, ".").find("fit as well: 0.4 to 0.64"), std::string::npos);
+}
+
+// When the search of every leg's gain names a leg, every output tells that story: the HTML's
+// physics section says the knob path named nothing and the leg search named the leg, the fit rows
+// are the leg's, and the summary speaks of the misfit removed, not of the knob path's gap.
+TEST(Report, ALegNamedByTheLegSearchIsOneStoryInEveryOutput) {
+  const test::Stages s = test::RunStages({{test::kLeg1Gain, 0.38}}, 3);
+  LegSearchOptions options;
+  options.model = s.options.locate.model;
+  const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
+  a.leg_search = SearchLegGains(test::SharedFake(), s.in, s.set, s.options.candidates, options);
+  ASSERT_TRUE(a.leg_search.named) << a.leg_search.why;
+  a.verdict.status = "unexplained";
+  a.verdict.named.clear();
+  AddLegSearch(a.leg_search, &a.verdict);
+  ReportContext ctx;
+  const std::string html = ReportHtml(a, ctx, ".");
+  const std::string summary = ReportSummary(a, ctx, "out/report.html");
+  const auto json = nlohmann::json::parse(ReportJson(a, ctx));
+  EXPECT_EQ(json["verdict"]["status"], "partly_explained");
+  EXPECT_EQ(json["fit"]["corrected_by"], "leg_search");
+  EXPECT_EQ(json["verdict"]["gap_closed"], json["fit"]["gap_closed"]);
+  EXPECT_EQ(Count(html, Escaped(a.verdict.sentence)), 1u);
+  EXPECT_NE(html.find("the search of every leg's gain (section 5) named actuators.leg1.gain"), std::string::npos);
+  EXPECT_NE(html.find("(b) corrected (the weak leg"), std::string::npos);
+  EXPECT_EQ(html.find("the knob correction)"), std::string::npos);
+  EXPECT_NE(summary.find("corrected (weak leg1)"), std::string::npos) << summary;
+  EXPECT_NE(summary.find("misfit removed"), std::string::npos) << summary;
+  EXPECT_EQ(summary.find("of the gap closed"), std::string::npos) << summary;
 }
 
 }  // namespace
