@@ -41,6 +41,8 @@ struct Sim2RealArgs {
   bool spread_signatures = false;
   bool every_leg = false;
   bool leg_search = false;
+  std::string leg_search_score = "sag";
+  std::string leg_search_on = "tails";
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -137,6 +139,8 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
+  o.legs.sag_mode = args.leg_search_score == "sag";
+  o.legs.only_with_tails = args.leg_search_on == "tails";
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -279,6 +283,14 @@ void Setup(CLI::App& root) {
                 "experimental: when nothing is named and the residual has heavy tails, search every leg's gain with "
                 "recordings scored by their own model (three per leg and two more, 5 executions per placement; "
                 "docs/sim2real.md)");
+  cmd->add_option("--leg-search-score", args->leg_search_score,
+                  "how the leg search scores a recording: sag (its sags as a mode of their own beside its core) or "
+                  "robust (its own model with a broad component; docs/sim2real.md)")
+      ->capture_default_str()->check(CLI::IsMember({"robust", "sag"}));
+  cmd->add_option("--leg-search-on", args->leg_search_on,
+                  "when the leg search runs (nothing named either way): tails (the residual has heavy tails) or "
+                  "unexplained (any located mismatch left)")
+      ->capture_default_str()->check(CLI::IsMember({"tails", "unexplained"}));
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
                "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");

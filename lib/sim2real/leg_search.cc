@@ -5,8 +5,10 @@
 #include <cmath>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "sim2real/refine_search.h"
+#include "sim2real/sag_mode.h"
 #include "sim2real/sentence_format.h"
 #include "sim2real/units.h"
 #include "util/error.h"
@@ -45,11 +47,17 @@ Eigen::VectorXd RobustLogLikelihood(const LinearGaussianModel& model, const Samp
 // command and heading, so every cell keeps samples on both sides), then per sample
 //   misfit = mean robust l(odd executions) - mean robust l(real).
 // About 0 when the real robot is that simulation; the nominal's misfit is the whole mismatch.
-double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearchOptions& options) {
+double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearchOptions& options,
+              const SagReference* ref) {
   std::map<int, int> executions;  // per placement, seen so far
   std::vector<int> fit_rows, held;
   for (int i = 0; i < recording.size(); ++i) (executions[recording.episode[i]]++ % 2 == 0 ? fit_rows : held).push_back(i);
   if (fit_rows.empty() || held.empty()) return NAN;
+  if (ref) {
+    const SagModel m = FitSagModel(recording, fit_rows, *ref, options.model, options.sag);
+    return SagLogLikelihood(m, *ref, SubsetSamples(recording, held), options.sag).mean() -
+           SagLogLikelihood(m, *ref, in.real, options.sag).mean();
+  }
   const LinearGaussianModel m = LinearGaussianModel::Fit(recording, options.model, fit_rows);
   const double self =
       RobustLogLikelihood(m, SubsetSamples(recording, held), options.outlier_share, options.outlier_scale).mean();
@@ -57,7 +65,7 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
 }
 
 Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, const LegSearchOptions& options,
-                      int nominal_size) {
+                      int nominal_size, const SagReference* ref) {
   Scored out;
   out.samples = MakeSamples(recording);
   const Samples& s = out.samples;
@@ -65,6 +73,12 @@ Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, cons
   out.walkable = s.size() >= nominal_size / 2 && s.size() > 0;
   if (!out.walkable) {
     out.rows = Eigen::VectorXd::Constant(in.real.size(), -INFINITY);
+    return out;
+  }
+  if (ref) {
+    SagModel m = FitSagModel(s, {}, *ref, options.model, options.sag);
+    out.rows = SagLogLikelihood(m, *ref, in.real, options.sag);
+    out.model = std::move(m.core);
     return out;
   }
   out.model = LinearGaussianModel::Fit(s, options.model);
@@ -106,6 +120,7 @@ struct SearchState {
   std::vector<Scored> scored;
   Scored nominal;
   int nominal_size = 0;
+  std::optional<SagReference> ref;  // with options.sag_mode
 };
 
 Recording SearchRecording(const CandidateSet& set, const LegSearchOptions& options) {
@@ -125,7 +140,7 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
   for (const auto& [k, v] : wanted) requests.push_back({{k, v}});
   RecordingBatch batch = RecordBatch(simulator, SearchRecording(set, options), requests, recording.recording);
   if (need_nominal) {
-    state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size());
+    state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size(), state->ref ? &*state->ref : nullptr);
     state->nominal_size = batch.sets[0].size();
     batch.sets.erase(batch.sets.begin());
   }
@@ -134,7 +149,8 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
   const auto& knobs = simulator.knobs();
   for (size_t j = 0; j < wanted.size(); ++j) {
     const Knob& knob = knobs[wanted[j].first];
-    state->scored.push_back(ScoreRecording(batch.sets[j], in, options, state->nominal_size));
+    state->scored.push_back(
+        ScoreRecording(batch.sets[j], in, options, state->nominal_size, state->ref ? &*state->ref : nullptr));
     const Scored& s = state->scored.back();
     state->points.push_back({knob.leg, knob.name, wanted[j].first, wanted[j].second,
                              s.walkable ? s.rows.mean() : -INFINITY, false});
@@ -224,8 +240,9 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
 
 // Does the best point remove enough of the nominal's misfit? Else the leg is not named.
 void CheckMisfit(const AnalysisInputs& in, const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
-  out->nominal_misfit = Misfit(state.nominal.samples, in, options);
-  out->best_misfit = Misfit(state.scored[out->best].samples, in, options);
+  const SagReference* ref = state.ref ? &*state.ref : nullptr;
+  out->nominal_misfit = Misfit(state.nominal.samples, in, options, ref);
+  out->best_misfit = Misfit(state.scored[out->best].samples, in, options, ref);
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
   if (out->gap_closed >= options.min_gap_closed) return;
   out->named = false;
@@ -249,6 +266,10 @@ bool LegSearchOptions::IsValid(std::string* error) const {
   }
   if (refine_steps < 0 || executions_per_placement < 0 || !(z > 0) || !(min_gap_closed >= 0 && min_gap_closed <= 1)) {
     *error = "leg search: refine_steps >= 0, executions_per_placement >= 0, z > 0 and min_gap_closed in [0, 1] expected";
+    return false;
+  }
+  if (!(sag.broad_share > 0 && sag.broad_share < 0.5) || !(sag.broad_scale > 1) || !(sag.floor >= 0)) {
+    *error = "leg search: sag broad_share in (0, 0.5), broad_scale > 1 and floor >= 0 expected";
     return false;
   }
   return model.IsValid(error);
@@ -277,8 +298,10 @@ LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& i
     return out;
   }
   out.ran = true;
+  out.score = options.sag_mode ? "sag" : "robust";
   const auto& knobs = simulator.knobs();
   SearchState state;
+  if (options.sag_mode) state.ref = MakeSagReference(in.sim, options.model);
   std::vector<std::pair<int, double>> grid;
   for (int k : legs) {
     for (double v : GridValues(knobs[k], options.factors)) grid.push_back({k, v});

@@ -170,7 +170,7 @@ json LegSearchJson(const LegSearch& l) {
     points.push_back({{"leg", p.leg}, {"knob", p.knob}, {"value", p.value}, {"score", JsonNumber(p.score)},
                       {"fits_as_well", p.fits_as_well}});
   }
-  return {{"named", l.named}, {"why", l.why}, {"leg", l.best >= 0 ? json(l.leg) : json(nullptr)},
+  return {{"named", l.named}, {"score", l.score}, {"why", l.why}, {"leg", l.best >= 0 ? json(l.leg) : json(nullptr)},
           {"knob", l.best >= 0 ? json(l.knob) : json(nullptr)}, {"value", JsonNumber(l.value)},
           {"nominal_score", JsonNumber(l.nominal_score)}, {"nominal_misfit", JsonNumber(l.nominal_misfit)},
           {"best_misfit", JsonNumber(l.best_misfit)},

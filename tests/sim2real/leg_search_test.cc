@@ -1,6 +1,7 @@
-// The search of every leg's gain (leg_search.h), on the fake simulator's four legs: a planted weak
-// leg is named with its gain, a nominal "real" robot or physics of another kind names none, the
-// verdict says one thing either way, and the answer does not depend on the thread count.
+// The search of every leg's gain (leg_search.h), on the fake simulator's four legs, with its default
+// score (the sag mode): a planted weak leg is named with its gain, a nominal "real" robot or physics
+// of another kind names none, the verdict says one thing either way, and the answer does not
+// depend on the thread count.
 #include "sim2real/leg_search.h"
 
 #include <gtest/gtest.h>
@@ -103,6 +104,28 @@ TEST(LegSearch, ALegNamedByNoneIsSaidWithWhy) {
   EXPECT_NE(v.sentence.find("names no leg: " + r.why), std::string::npos) << v.sentence;
 }
 
+// The other score (a broad component instead of the default sag mode) on the same fake: a planted
+// weak leg is named with its gain, a nominal robot names none, and the answer does not depend on
+// the thread count.
+TEST(LegSearch, TheRobustScoreNamesAPlantedWeakLegAndNoLegOfANominalRobot) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  LegSearchOptions o = Options(s);
+  o.sag_mode = false;
+  CandidateOptions recording = s.options.candidates;
+  const LegSearch r = SearchLegGains(SharedFake(), s.in, s.set, recording, o);
+  ASSERT_TRUE(r.named) << r.why;
+  EXPECT_EQ(r.score, "robust");
+  EXPECT_EQ(r.leg, "leg1");
+  EXPECT_NEAR(r.value, 0.38, 0.25 * 0.38);
+  recording.recording.threads = 2;
+  const LegSearch two = SearchLegGains(SharedFake(), s.in, s.set, recording, o);
+  EXPECT_EQ(two.value, r.value);
+  EXPECT_EQ(two.points.back().score, r.points.back().score);
+  const Stages null = RunStages({}, 3);
+  const LegSearch n = SearchLegGains(SharedFake(), null.in, null.set, null.options.candidates, o);
+  EXPECT_FALSE(n.named) << "named " << n.leg << " at " << n.value;
+}
+
 TEST(LegSearch, RejectsOptionsThatCannotSearch) {
   LegSearchOptions o;
   std::string error;
@@ -114,6 +137,11 @@ TEST(LegSearch, RejectsOptionsThatCannotSearch) {
   o.factors = {0.5};
   o.min_gap_closed = 2;
   EXPECT_FALSE(o.IsValid(&error));
+  o.min_gap_closed = 0.25;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  o.sag.broad_scale = 0.5;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("sag"), std::string::npos);
 }
 
 }  // namespace
