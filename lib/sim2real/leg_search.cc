@@ -42,6 +42,28 @@ Eigen::VectorXd RobustLogLikelihood(const LinearGaussianModel& model, const Samp
   return out;
 }
 
+// A recording's own model, fitted on some of its rows: the sag mode (sag_mode.h) when the search has
+// a reference, else one model scored with a broad component.
+struct OwnModel {
+  std::optional<SagModel> sag;
+  LinearGaussianModel plain;
+  const LinearGaussianModel& model() const { return sag ? sag->core : plain; }
+};
+
+OwnModel FitOwnModel(const Samples& s, const std::vector<int>& rows, const LegSearchOptions& options,
+                     const SagReference* ref) {
+  OwnModel out;
+  if (ref) out.sag = FitSagModel(s, rows, *ref, options.model, options.sag);
+  else out.plain = LinearGaussianModel::Fit(s, options.model, rows);
+  return out;
+}
+
+Eigen::VectorXd OwnLogLikelihood(const OwnModel& m, const Samples& s, const LegSearchOptions& options,
+                                 const SagReference* ref) {
+  if (m.sag) return SagLogLikelihood(*m.sag, *ref, s, options.sag);
+  return RobustLogLikelihood(m.plain, s, options.outlier_share, options.outlier_scale);
+}
+
 // How much worse the real samples fit a recording's model than the recording's own unseen samples:
 // the model fitted on the even executions of every placement (each placement stands for one
 // command and heading, so every cell keeps samples on both sides), then per sample
@@ -53,15 +75,9 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
   std::vector<int> fit_rows, held;
   for (int i = 0; i < recording.size(); ++i) (executions[recording.episode[i]]++ % 2 == 0 ? fit_rows : held).push_back(i);
   if (fit_rows.empty() || held.empty()) return NAN;
-  if (ref) {
-    const SagModel m = FitSagModel(recording, fit_rows, *ref, options.model, options.sag);
-    return SagLogLikelihood(m, *ref, SubsetSamples(recording, held), options.sag).mean() -
-           SagLogLikelihood(m, *ref, in.real, options.sag).mean();
-  }
-  const LinearGaussianModel m = LinearGaussianModel::Fit(recording, options.model, fit_rows);
-  const double self =
-      RobustLogLikelihood(m, SubsetSamples(recording, held), options.outlier_share, options.outlier_scale).mean();
-  return self - RobustLogLikelihood(m, in.real, options.outlier_share, options.outlier_scale).mean();
+  const OwnModel m = FitOwnModel(recording, fit_rows, options, ref);
+  return OwnLogLikelihood(m, SubsetSamples(recording, held), options, ref).mean() -
+         OwnLogLikelihood(m, in.real, options, ref).mean();
 }
 
 Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, const LegSearchOptions& options,
@@ -75,14 +91,9 @@ Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, cons
     out.rows = Eigen::VectorXd::Constant(in.real.size(), -INFINITY);
     return out;
   }
-  if (ref) {
-    SagModel m = FitSagModel(s, {}, *ref, options.model, options.sag);
-    out.rows = SagLogLikelihood(m, *ref, in.real, options.sag);
-    out.model = std::move(m.core);
-    return out;
-  }
-  out.model = LinearGaussianModel::Fit(s, options.model);
-  out.rows = RobustLogLikelihood(out.model, in.real, options.outlier_share, options.outlier_scale);
+  const OwnModel m = FitOwnModel(s, {}, options, ref);
+  out.rows = OwnLogLikelihood(m, in.real, options, ref);
+  out.model = m.model();
   return out;
 }
 
@@ -121,6 +132,7 @@ struct SearchState {
   Scored nominal;
   int nominal_size = 0;
   std::optional<SagReference> ref;  // with options.sag_mode
+  const SagReference* Ref() const { return ref ? &*ref : nullptr; }
 };
 
 Recording SearchRecording(const CandidateSet& set, const LegSearchOptions& options) {
@@ -140,7 +152,7 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
   for (const auto& [k, v] : wanted) requests.push_back({{k, v}});
   RecordingBatch batch = RecordBatch(simulator, SearchRecording(set, options), requests, recording.recording);
   if (need_nominal) {
-    state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size(), state->ref ? &*state->ref : nullptr);
+    state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size(), state->Ref());
     state->nominal_size = batch.sets[0].size();
     batch.sets.erase(batch.sets.begin());
   }
@@ -149,8 +161,7 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
   const auto& knobs = simulator.knobs();
   for (size_t j = 0; j < wanted.size(); ++j) {
     const Knob& knob = knobs[wanted[j].first];
-    state->scored.push_back(
-        ScoreRecording(batch.sets[j], in, options, state->nominal_size, state->ref ? &*state->ref : nullptr));
+    state->scored.push_back(ScoreRecording(batch.sets[j], in, options, state->nominal_size, state->Ref()));
     const Scored& s = state->scored.back();
     state->points.push_back({knob.leg, knob.name, wanted[j].first, wanted[j].second,
                              s.walkable ? s.rows.mean() : -INFINITY, false});
@@ -240,9 +251,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
 
 // Does the best point remove enough of the nominal's misfit? Else the leg is not named.
 void CheckMisfit(const AnalysisInputs& in, const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
-  const SagReference* ref = state.ref ? &*state.ref : nullptr;
-  out->nominal_misfit = Misfit(state.nominal.samples, in, options, ref);
-  out->best_misfit = Misfit(state.scored[out->best].samples, in, options, ref);
+  out->nominal_misfit = Misfit(state.nominal.samples, in, options, state.Ref());
+  out->best_misfit = Misfit(state.scored[out->best].samples, in, options, state.Ref());
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
   if (out->gap_closed >= options.min_gap_closed) return;
   out->named = false;

@@ -47,10 +47,7 @@ Gaussian SagGaussian(const Eigen::MatrixXd& r, const std::vector<int>& sags, con
 SagReference MakeSagReference(const Samples& sim, const LinearGaussianOptions& options) {
   SagReference ref;
   ref.model = LinearGaussianModel::Fit(sim, options);
-  Eigen::MatrixXd r(sim.size(), sim.pose_dim());
-  for (int i = 0; i < sim.size(); ++i) {
-    r.row(i) = sim.x.row(i) - ref.model.Predict(sim.command[i], sim.z.row(i).transpose(), sim.first_execution[i]).mean.transpose();
-  }
+  const Eigen::MatrixXd r = Deviate(ref, sim).r;
   ref.spread = r.transpose() * r / std::max(1.0, sim.size() - 1.0);
   const double d = sim.pose_dim();
   ref.cut = d + 4 * std::sqrt(2 * d);
