@@ -40,9 +40,9 @@ struct Sim2RealArgs {
   bool no_figures = false;
   bool spread_signatures = false;
   bool every_leg = false;
-  bool leg_search = false;
+  bool leg_search = true;
   std::string leg_search_score = "sag";
-  std::string leg_search_on = "tails";
+  std::string leg_search_on = "unexplained";
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -232,6 +232,10 @@ void Run(const Sim2RealArgs& args) {
               " sim samples");
   const sim2real::Analysis a =
       AnalyseOrLocate(sim, real, args, config && config->terrain.has_value(), &simulator, &why, &ctx);
+  if (const std::string note = sim2real::SmallSimSetNote(a.inputs, args.sim); !note.empty()) {
+    Warn(note);
+    ctx.notes.push_back(note);
+  }
   if (a.baseline.permute_placements) {
     ctx.notes.push_back("locate's tests permute whole placements (" + a.baseline.permute_why +
                         "), so a region needs several placements on each side to be found");
@@ -279,10 +283,10 @@ void Setup(CLI::App& root) {
       ->capture_default_str()->check(CLI::Range(2, 100));
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
-  cmd->add_flag("--leg-search", args->leg_search,
-                "experimental: when nothing is named and the residual has heavy tails, search every leg's gain with "
-                "recordings scored by their own model (three per leg and two more, 5 executions per placement; "
-                "docs/sim2real.md)");
+  cmd->add_flag("--leg-search,!--no-leg-search", args->leg_search,
+                "when nothing is named and a mismatch is left, search every leg's gain with recordings scored by "
+                "their own model (three per leg and two more, 5 executions per placement; on by default, "
+                "--no-leg-search turns it off; docs/sim2real.md)");
   cmd->add_option("--leg-search-score", args->leg_search_score,
                   "how the leg search scores a recording: sag (its sags as a mode of their own beside its core) or "
                   "robust (its own model with a broad component; docs/sim2real.md)")

@@ -1,21 +1,31 @@
 #!/usr/bin/env python3
 """sim2real on a robot described by a robot block: pairs with a planted knob the shipped octopod
-never had, drawn at random from a seed range. For each seed s: the kind of planted physics is
-s mod 3 (0: one leg's servo gain, named by leg name, drawn in [0.3, 0.6]; 1: a friction factor on
-every geom in [0.35, 0.6]; 2: a payload of 15-30% of the robot's mass on the torso, offset
-forward by up to 15% of the leg reach), the values from random.Random(s). Friction and payload are planted through the
-config (robot.overwrite_physics with friction.sliding; payload). The sim set is the
-nominal robot (protocol paper, seed 2 s), the real set the planted robot (seed 2 s + 1); then
-`dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
-what was named, the value and whether it lies within 25% of the truth, the values its likelihood
-search found to fit the real samples as well (verdict.named[].fits_as_well), the status and wall
-time.
+never had, drawn at random from a seed range. For each seed s the kind of planted physics is
+KINDS[s mod len(KINDS)], KINDS from --kinds (default leg,friction,payload):
+  leg:      one leg's servo gain, named by leg name, drawn in [0.3, 0.6] of its nominal;
+  friction: a friction factor on every geom in [0.35, 0.6];
+  payload:  a payload of 15-30% of the robot's mass on the torso, offset forward by up to 15% of
+            the leg reach;
+  null:     nothing (the real set is the nominal robot at another seed);
+  leg_mass: out of the knob list: a mass of 3-8% of the robot's on one leg's lowest body (an MJCF
+            edit: a sphere on a child body of the body holding the leg's foot geom);
+  short_tibia: out of the knob list: one leg's lowest body shortened to 55-75% (every geom of the
+            body holding the foot geom scaled towards its joint; the gait's IK sees the short leg);
+the values from random.Random(s). Friction and payload are planted through the config
+(robot.overwrite_physics with friction.sliding; payload), the out-of-library kinds through an
+edited copy of the MJCF. The sim set is the nominal robot (protocol paper with 166 placements,
+twice the real set's 78 and more, as the octopod's pairs have; seed 2 s, or one sim set for every
+pair with --sim-seed, as a user with one simulator and many real logs: recordings are then shared
+through the cache), the real set the planted robot (protocol paper, seed 2 s + 1); then `dgmm
+sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted, what
+was named, the value and whether it lies within 25% of the truth, the values its likelihood search
+found to fit the real samples as well (verdict.named[].fits_as_well), the status and wall time.
 
 Usage: scripts/sim2real_robots.py [--build build] [--config datasets/robots/hexapod.json]
                                   [--seeds 13000-13002] [--threads 2] [--out DIR]
                                   [--sim2real-args 'ARGS']
 """
-import argparse, json, os, random, subprocess, sys, tempfile, time
+import argparse, json, os, random, re, subprocess, sys, tempfile, time
 
 import h5py
 
@@ -24,22 +34,67 @@ import h5py
 MODEL_MAX_FRICTION = 1.0
 
 
-def planted(seed, cfg, mass_kg, reach_m):
+def foot_body_block(xml, foot_geom):
+    """(start, end) of the innermost <body ...> ... </body> holding the geom named foot_geom."""
+    at = xml.find(f'name="{foot_geom}"')
+    if at < 0:
+        raise ValueError(f"MJCF: expected a geom named {foot_geom}")
+    start = xml.rfind("<body", 0, at)
+    end = xml.find("</body>", at)
+    if start < 0 or end < 0 or xml.find("<body", start + 1, at) >= 0:
+        raise ValueError(f"MJCF: the foot geom {foot_geom} must sit in its leg's lowest body, after its child bodies")
+    return start, end
+
+
+def edit_leg(xml, foot_geom, kind, value):
+    """The MJCF with one leg's lowest body edited: 'leg_mass' adds `value` kg on a child body,
+    'short_tibia' scales every geom position (pos, fromto) of that body by `value`."""
+    start, end = foot_body_block(xml, foot_geom)
+    block = xml[start:end]
+    if kind == "leg_mass":
+        head = block.index(">") + 1
+        block = (block[:head] + f'<body name="dgmm_added_mass" pos="0 0 -0.02"><geom type="sphere" size="0.01" '
+                 f'mass="{value:.6g}" contype="0" conaffinity="0"/></body>' + block[head:])
+    else:
+        def scale(m):
+            return f'{m.group(1)}="' + " ".join(f"{float(v) * value:.6g}" for v in m.group(2).split()) + '"'
+        def scale_element(m):  # geoms and sites only: the body's and its joint's positions stay
+            return re.sub(r'\b(pos|fromto)="([^"]*)"', scale, m.group(0))
+        head = block.index(">") + 1
+        block = block[:head] + re.sub(r'<(geom|site)\b[^>]*>', scale_element, block[head:])
+    return xml[:start] + block + xml[end:]
+
+
+def planted(seed, cfg, mass_kg, reach_m, kinds, pair_dir):
     """Plants the seed's physics into the config `cfg`; returns (knob that should be named, truth)."""
     r = random.Random(seed)
-    kind = seed % 3
-    if kind == 0:
+    kind = kinds[seed % len(kinds)]
+    if kind == "null":
+        return "-", 0.0
+    if kind in ("leg_mass", "short_tibia"):
+        leg = r.choice(cfg["robot"]["legs"])
+        value = r.uniform(0.03, 0.08) * mass_kg if kind == "leg_mass" else r.uniform(0.55, 0.75)
+        foot = leg["foot"].get("geom")
+        if foot is None:
+            raise ValueError(f"{kind}: leg {leg['name']} needs a foot geom")
+        xml = edit_leg(open(cfg["mjcf_path"]).read(), foot, kind, value)
+        cfg["mjcf_path"] = os.path.join(pair_dir, "real.xml")
+        open(cfg["mjcf_path"], "w").write(xml)
+        return f"{kind}:{leg['name']}", value
+    if kind == "leg":
         leg = r.choice([l["name"] for l in cfg["robot"]["legs"]])
         gain = r.uniform(0.3, 0.6)
         cfg["robot"].setdefault("leg_gain", {})[leg] = gain
         return f"actuators.{leg}.gain", gain
-    if kind == 1:
+    if kind == "friction":
         # Every geom's friction overwritten (robot.overwrite_physics); MuJoCo takes the larger of
         # the two geoms' coefficients per contact, so the factor is relative to the model's largest.
         factor = r.uniform(0.35, 0.6)
         cfg["robot"]["overwrite_physics"] = True
         cfg["friction"] = {"sliding": factor * MODEL_MAX_FRICTION, "torsional": 0.01, "rolling": 0.0001}
         return "geoms.friction_scale", factor
+    if kind != "payload":
+        raise ValueError(f"unknown kind {kind}")
     share = r.uniform(0.15, 0.30)
     cfg["payload"] = {"mass_kg": share * mass_kg, "position_body_m": [r.uniform(-0.15, 0.15) * reach_m, 0, 0]}
     return "payload.mass_kg", share * mass_kg
@@ -65,7 +120,15 @@ def main():
                     help="more options of every dgmm sim2real call, e.g. '--leg-search'")
     ap.add_argument("--model-friction", type=float, default=1.0,
                     help="largest sliding friction coefficient among the model's geoms")
+    ap.add_argument("--kinds", default="leg,friction,payload",
+                    help="planted kinds by seed mod their count: leg, friction, payload, null, leg_mass, short_tibia")
+    ap.add_argument("--sim-seed", type=int, default=None, help="one sim set (this protocol seed) for every pair")
+    ap.add_argument("--sim-placements", type=int, default=166,
+                    help="placements of the sim set (the real set has the paper's 78; until 2026-11-28 the sim "
+                         "set had 78 too, and nulls came out unexplained: docs/sim2real.md)")
+    ap.add_argument("--cache", default=None, help="dgmm sim2real --cache (default its own)")
     a = ap.parse_args()
+    kinds = a.kinds.split(",")
     global MODEL_MAX_FRICTION
     MODEL_MAX_FRICTION = a.model_friction
     lo, hi = (int(v) for v in a.seeds.split("-"))
@@ -83,21 +146,23 @@ def main():
         os.makedirs(d, exist_ok=True)
         nominal = os.path.join(d, "nominal.json")
         json.dump(base, open(nominal, "w"))
-        sim = os.path.join(d, "sim.h5")
-        dgmm(a.build, "simulate", "--config", nominal, "--protocol", "paper", "--seed", str(2 * seed), "-o", sim)
+        sim = os.path.join(out if a.sim_seed is not None else d, "sim.h5")
+        if a.sim_seed is None or not os.path.exists(sim):
+            dgmm(a.build, "simulate", "--config", nominal, "--protocol", "paper", "--placements", str(a.sim_placements),
+                 "--seed", str(2 * seed if a.sim_seed is None else a.sim_seed), "-o", sim)
         cfg = json.loads(json.dumps(base))
-        knob, truth = planted(seed, cfg, metadata(sim, "robot_mass_kg"), metadata(sim, "robot_leg_reach_m"))
+        knob, truth = planted(seed, cfg, metadata(sim, "robot_mass_kg"), metadata(sim, "robot_leg_reach_m"), kinds, d)
         real_cfg = os.path.join(d, "real.json")
         json.dump(cfg, open(real_cfg, "w"))
         real = os.path.join(d, "real.h5")
         dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--seed", str(2 * seed + 1), "-o", real)
         start = time.time()
         dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", os.path.join(d, "report"), "--no-figures",
-             "--threads", a.threads, *a.sim2real_args.split())
+             "--threads", a.threads, *(["--cache", a.cache] if a.cache else []), *a.sim2real_args.split())
         wall = time.time() - start
         v = json.load(open(os.path.join(d, "report", "report.json")))["verdict"]
         named = [n for n in v["named"]]
-        hit = next((n for n in named if n["knob"] == knob), None)
+        hit = next((n for n in named if n["knob"] == knob or n["knob"].startswith(knob + "@")), None)
         value = hit["value"] if hit else float("nan")
         ok = hit is not None and abs(value - truth) <= 0.25 * abs(truth)
         names = ", ".join(f"{n['knob']}" for n in named) or "-"

@@ -1,7 +1,10 @@
 #include "sim2real/inputs.h"
 
+#include <algorithm>
+#include <map>
 #include <set>
 
+#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -81,6 +84,28 @@ AnalysisInputs PrepareInputs(const SampleSet& sim_in, const SampleSet& real_in, 
   in.recording = SimRecording(in.sim_set, fallback_seed, &in.recording_from_metadata);
   DetectTerrainColumns(in.real_set, &in.pitch_col, &in.roll_col);
   return in;
+}
+
+PlacementsPerCommand CountPlacementsPerCommand(const AnalysisInputs& in) {
+  auto median = [&](const Samples& s) {
+    std::map<int, std::set<int>> placements;  // per command
+    for (int i = 0; i < s.size(); ++i) placements[s.command[i]].insert(s.episode[i]);
+    std::vector<double> counts;
+    for (int c : in.real_commands) counts.push_back(placements.count(c) ? placements[c].size() : 0.0);
+    if (counts.empty()) return 0.0;
+    std::nth_element(counts.begin(), counts.begin() + counts.size() / 2, counts.end());
+    return counts[counts.size() / 2];
+  };
+  return {median(in.sim), median(in.real)};
+}
+
+std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_path) {
+  const PlacementsPerCommand n = CountPlacementsPerCommand(in);
+  if (n.sim > n.real) return "";
+  return sim_path + Fmt(": %g placements per command (median), no more than the real set's %g", n.sim, n.real) +
+         ": locate compares the real residuals with the sim set's cross-fitted ones, which hold whole placements "
+         "out, and with as few sim placements it finds mismatch between two recordings of the same robot; record "
+         "the sim set with more placements (e.g. dgmm simulate --protocol paper --placements 166)";
 }
 
 }  // namespace dgmm::sim2real

@@ -32,4 +32,17 @@ struct AnalysisInputs {
 // than 10 real samples share a command with the sim set.
 AnalysisInputs PrepareInputs(const SampleSet& sim, const SampleSet& real, std::uint64_t fallback_seed);
 
+// Placements (episodes) per command, the median over the real set's commands, of each set.
+struct PlacementsPerCommand {
+  double sim = 0, real = 0;
+};
+PlacementsPerCommand CountPlacementsPerCommand(const AnalysisInputs& in);
+
+// A warning when the sim set has no more placements per command than the real set (else ""). The
+// sim residuals that locate compares with the real ones are cross-fitted with whole placements
+// held out: with one sim placement per setting (the paper protocol's headings, shared by both
+// sets) a held-out sim sample meets a setting its model never saw, while every real sample's is
+// in the sim model, and locate then finds mismatch in pairs of the same robot (docs/sim2real.md).
+std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_path);
+
 }  // namespace dgmm::sim2real

@@ -99,12 +99,8 @@ Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, cons
 
 // The per-axis variance of a recording's residuals under its own model.
 Eigen::VectorXd ResidualVariance(const Scored& scored) {
-  const Samples& s = scored.samples;
-  Eigen::MatrixXd r(s.size(), s.pose_dim());
-  for (int i = 0; i < s.size(); ++i) {
-    r.row(i) = s.x.row(i) - scored.model.Predict(s.command[i], s.z.row(i).transpose(), s.first_execution[i]).mean.transpose();
-  }
-  return (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, s.size() - 1.0);
+  const Eigen::MatrixXd r = scored.model.Residuals(scored.samples);
+  return (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, r.rows() - 1.0);
 }
 
 // (sum of a - b) / SE, per-placement sums as the independent units (refine_search.h).

@@ -242,6 +242,14 @@ Eigen::VectorXd LinearGaussianModel::LogLikelihood(const Samples& s) const {
   return ll;
 }
 
+Eigen::MatrixXd LinearGaussianModel::Residuals(const Samples& s) const {
+  Eigen::MatrixXd r(s.size(), s.pose_dim());
+  for (int i = 0; i < s.size(); ++i) {
+    r.row(i) = s.x.row(i) - Predict(s.command[i], s.z.row(i).transpose(), s.first_execution[i]).mean.transpose();
+  }
+  return r;
+}
+
 Eigen::MatrixXd LinearGaussianModel::WhitenedResiduals(const Samples& s) const {
   Eigen::MatrixXd r(s.size(), s.pose_dim());
   for (int i = 0; i < s.size(); ++i) {

@@ -59,6 +59,8 @@ class LinearGaussianModel {
   Prediction Predict(int command, const Eigen::Ref<const Eigen::VectorXd>& z, double first = 0.0) const;
   // log N(x; mean, Sigma) for every row of s.
   Eigen::VectorXd LogLikelihood(const Samples& s) const;
+  // Residuals x - mean, one row per sample of s.
+  Eigen::MatrixXd Residuals(const Samples& s) const;
   // Whitened residuals L^-1 (x - mean), one row per sample of s.
   Eigen::MatrixXd WhitenedResiduals(const Samples& s) const;
   // The command's fitted terrain distribution N(m_z, S_z) (for the joint export).

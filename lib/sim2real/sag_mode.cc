@@ -13,13 +13,7 @@ struct Deviations {
 };
 
 Deviations Deviate(const SagReference& ref, const Samples& s) {
-  Deviations out{Eigen::MatrixXd(s.size(), s.pose_dim()), Eigen::VectorXd(s.size())};
-  for (int i = 0; i < s.size(); ++i) {
-    const Prediction p = ref.model.Predict(s.command[i], s.z.row(i).transpose(), s.first_execution[i]);
-    out.r.row(i) = s.x.row(i) - p.mean.transpose();
-    out.m(i) = p.chol.triangularView<Eigen::Lower>().solve(out.r.row(i).transpose()).squaredNorm();
-  }
-  return out;
+  return {ref.model.Residuals(s), ref.model.WhitenedResiduals(s).rowwise().squaredNorm()};
 }
 
 Gaussian Broad(const SagReference& ref, const SagOptions& options) {

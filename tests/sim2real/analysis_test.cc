@@ -61,26 +61,24 @@ TEST(Analysis, AWeakLegImplicatesASideAndIsNamed) {
   EXPECT_FALSE(a.leg_search.ran) << "the probes named the leg: no search of every leg";
 }
 
-// The leg search is opt-in and runs only for an unexplained mismatch with heavy tails; allowed for
-// any structure, what it found is the verdict's one story either way.
+// The leg search runs by default on any mismatch nothing was named for (only on heavy tails when
+// asked); what it found is the verdict's one story either way.
 TEST(Analysis, TheLegSearchRunsOnlyWhenNothingIsNamed) {
   FakeExtras extras;
   extras.geometry = 0.03;
   const auto pair = test::MakeFakePair(Fake(), {}, extras);
   AnalysisOptions options = test::FastOptions();
-  EXPECT_FALSE(Analyse(pair.sim, pair.real, &Fake(), options).leg_search.ran) << "opt-in";
-  options.legs.enabled = true;
+  ASSERT_TRUE(options.legs.enabled && !options.legs.only_with_tails) << "on by default, for any unexplained mismatch";
+  const Analysis any = Analyse(pair.sim, pair.real, &Fake(), options);
+  ASSERT_TRUE(any.naming.named.empty() && any.verdict.status != "clean") << any.verdict.sentence;
+  ASSERT_TRUE(any.leg_search.ran) << any.verdict.sentence;
+  EXPECT_EQ(any.leg_search.named, any.verdict.status == "partly_explained") << any.verdict.sentence;
+  EXPECT_NE(any.verdict.sentence.find("leg"), std::string::npos) << any.verdict.sentence;
+  options.legs.only_with_tails = true;
   const Analysis tails_only = Analyse(pair.sim, pair.real, &Fake(), options);
   const bool tails = std::count(tails_only.adequacy.residual.structured_in.begin(),
                                 tails_only.adequacy.residual.structured_in.end(), "tails") > 0;
   EXPECT_EQ(tails_only.leg_search.ran, tails && tails_only.naming.named.empty()) << tails_only.verdict.sentence;
-  options.legs.only_with_tails = false;
-  const Analysis any = Analyse(pair.sim, pair.real, &Fake(), options);
-  if (any.naming.named.empty() && any.verdict.status != "clean") {
-    ASSERT_TRUE(any.leg_search.ran) << any.verdict.sentence;
-    EXPECT_EQ(any.leg_search.named, any.verdict.status == "partly_explained") << any.verdict.sentence;
-    EXPECT_NE(any.verdict.sentence.find("leg"), std::string::npos) << any.verdict.sentence;
-  }
   options.legs.enabled = false;
   EXPECT_FALSE(Analyse(pair.sim, pair.real, &Fake(), options).leg_search.ran);
 }

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/sim2real/fake_simulator.h"
+#include "tests/sim2real/synthetic.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -38,6 +39,19 @@ TEST(Inputs, SetsThatShareNoCommandAreRefused) {
   pair.real.commands.array() += 0.125;
   for (auto& l : pair.real.command_labels) l += "x";
   EXPECT_THROW(PrepareInputs(pair.sim, pair.real, 1), InputError);
+}
+
+TEST(Inputs, ASimSetNoLargerThanTheRealSetIsWarnedAbout) {
+  const SampleSet paper = GenerateSynthetic(SyntheticWorld{}, "paper", 1);      // 3 placements per command
+  const SampleSet paper830 = GenerateSynthetic(SyntheticWorld{}, "paper-830", 2);  // 6 or 7
+  const AnalysisInputs small = PrepareInputs(paper, GenerateSynthetic(SyntheticWorld{}, "paper", 3), 1);
+  EXPECT_EQ(CountPlacementsPerCommand(small).sim, 3);
+  EXPECT_EQ(CountPlacementsPerCommand(small).real, 3);
+  const std::string note = SmallSimSetNote(small, "sim.h5");
+  EXPECT_EQ(note.rfind("sim.h5: 3 placements per command (median), no more than the real set's 3", 0), 0u) << note;
+  const AnalysisInputs large = PrepareInputs(paper830, GenerateSynthetic(SyntheticWorld{}, "paper", 3), 1);
+  EXPECT_GT(CountPlacementsPerCommand(large).sim, 5);
+  EXPECT_EQ(SmallSimSetNote(large, "sim.h5"), "");
 }
 
 }  // namespace

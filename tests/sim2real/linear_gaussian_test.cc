@@ -36,6 +36,19 @@ TEST(LinearGaussianModel, PredictionsAreCalibrated) {
   EXPECT_LT(ms, 1.25);
 }
 
+TEST(LinearGaussianModel, ResidualsWhitenToTheWhitenedResiduals) {
+  Samples train = Make(SyntheticWorld{}, "paper-830", 7);
+  Samples test = Make(SyntheticWorld{}, "paper", 8);
+  LinearGaussianModel m = LinearGaussianModel::Fit(train, LinearGaussianOptions{});
+  const Eigen::MatrixXd r = m.Residuals(test), w = m.WhitenedResiduals(test);
+  ASSERT_EQ(r.rows(), test.size());
+  for (int i : {0, test.size() / 2, test.size() - 1}) {
+    const Prediction p = m.Predict(test.command[i], test.z.row(i).transpose(), test.first_execution[i]);
+    EXPECT_LT((p.chol.triangularView<Eigen::Lower>() * w.row(i).transpose() - r.row(i).transpose()).norm(), 1e-9);
+    EXPECT_LT((test.x.row(i).transpose() - p.mean - r.row(i).transpose()).norm(), 1e-12);
+  }
+}
+
 TEST(LinearGaussianModel, StrongPriorReproducesThePrior) {
   Samples sim = Make(SyntheticWorld{}, "paper-830", 5);
   Samples real = Make(SyntheticWorld{}, "paper", 6);
