@@ -23,7 +23,8 @@ found to fit the real samples as well (verdict.named[].fits_as_well), the status
 
 Usage: scripts/sim2real_robots.py [--build build] [--config datasets/robots/hexapod.json]
                                   [--seeds 13000-13002] [--threads 2] [--out DIR]
-                                  [--sim2real-args 'ARGS']
+                                  [--sim2real-args 'ARGS'] [--kinds leg,friction,payload]
+                                  [--sim-seed N] [--sim-placements 166] [--cache DIR]
 """
 import argparse, json, os, random, re, subprocess, sys, tempfile, time
 
@@ -32,17 +33,20 @@ import h5py
 # The largest sliding friction among the geoms of the robot (the hexapod's floor: 1.0); with
 # --config for another robot, pass its value with --model-friction.
 MODEL_MAX_FRICTION = 1.0
+KINDS = ("leg", "friction", "payload", "null", "leg_mass", "short_tibia")
 
 
 def foot_body_block(xml, foot_geom):
-    """(start, end) of the innermost <body ...> ... </body> holding the geom named foot_geom."""
+    """(start, end) of the <body ...> ... </body> holding the geom named foot_geom, which must have no
+    child bodies (the leg's lowest body)."""
     at = xml.find(f'name="{foot_geom}"')
     if at < 0:
         raise ValueError(f"MJCF: expected a geom named {foot_geom}")
     start = xml.rfind("<body", 0, at)
     end = xml.find("</body>", at)
-    if start < 0 or end < 0 or xml.find("<body", start + 1, at) >= 0:
-        raise ValueError(f"MJCF: the foot geom {foot_geom} must sit in its leg's lowest body, after its child bodies")
+    # No child body closed before the foot, none opened after it: the span is the whole body.
+    if start < 0 or end < 0 or xml.find("</body>", start, at) >= 0 or xml.find("<body", at, end) >= 0:
+        raise ValueError(f"MJCF: the foot geom {foot_geom} must sit in its leg's lowest body (one without child bodies)")
     return start, end
 
 
@@ -51,8 +55,8 @@ def edit_leg(xml, foot_geom, kind, value):
     'short_tibia' scales every geom position (pos, fromto) of that body by `value`."""
     start, end = foot_body_block(xml, foot_geom)
     block = xml[start:end]
+    head = block.index(">") + 1  # after the body's opening tag
     if kind == "leg_mass":
-        head = block.index(">") + 1
         block = (block[:head] + f'<body name="dgmm_added_mass" pos="0 0 -0.02"><geom type="sphere" size="0.01" '
                  f'mass="{value:.6g}" contype="0" conaffinity="0"/></body>' + block[head:])
     else:
@@ -60,7 +64,6 @@ def edit_leg(xml, foot_geom, kind, value):
             return f'{m.group(1)}="' + " ".join(f"{float(v) * value:.6g}" for v in m.group(2).split()) + '"'
         def scale_element(m):  # geoms and sites only: the body's and its joint's positions stay
             return re.sub(r'\b(pos|fromto)="([^"]*)"', scale, m.group(0))
-        head = block.index(">") + 1
         block = block[:head] + re.sub(r'<(geom|site)\b[^>]*>', scale_element, block[head:])
     return xml[:start] + block + xml[end:]
 
@@ -129,6 +132,9 @@ def main():
     ap.add_argument("--cache", default=None, help="dgmm sim2real --cache (default its own)")
     a = ap.parse_args()
     kinds = a.kinds.split(",")
+    unknown = sorted(set(kinds) - set(KINDS))
+    if unknown:
+        ap.error(f"--kinds: unknown {', '.join(unknown)}; expected some of {', '.join(KINDS)}")
     global MODEL_MAX_FRICTION
     MODEL_MAX_FRICTION = a.model_friction
     lo, hi = (int(v) for v in a.seeds.split("-"))

@@ -38,6 +38,13 @@ class EditLeg(unittest.TestCase):
         self.assertEqual(out.rfind("<body name=", 0, at - 20), out.index('<body name="rear_right_tibia"'))
         self.assertIn('mass="0.123"', out)
 
+    def test_a_foot_in_a_body_with_child_bodies_is_refused(self):
+        child = '<body name="child"><geom name="x" type="sphere" size="0.01"/></body>'
+        foot = '<geom name="foot" type="sphere" size="0.01"/>'
+        for inner in (child + foot, foot + child):  # either order: the span would not be the whole body
+            with self.assertRaises(ValueError):
+                robots.edit_leg(f'<body name="tibia">{inner}</body>', "foot", "short_tibia", 0.6)
+
     def test_a_missing_foot_is_refused(self):
         with self.assertRaises(ValueError):
             robots.edit_leg(self.xml, "no_such_foot", "leg_mass", 0.1)
