@@ -1,8 +1,11 @@
 #include "sim2real/inputs.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <set>
+#include <utility>
+#include <vector>
 
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
@@ -86,26 +89,64 @@ AnalysisInputs PrepareInputs(const SampleSet& sim_in, const SampleSet& real_in, 
   return in;
 }
 
-PlacementsPerCommand CountPlacementsPerCommand(const AnalysisInputs& in) {
-  auto median = [&](const Samples& s) {
-    std::map<int, std::set<int>> placements;  // per command
-    for (int i = 0; i < s.size(); ++i) placements[s.command[i]].insert(s.episode[i]);
-    std::vector<double> counts;
-    for (int c : in.real_commands) counts.push_back(placements.count(c) ? placements[c].size() : 0.0);
-    if (counts.empty()) return 0.0;
-    std::nth_element(counts.begin(), counts.begin() + counts.size() / 2, counts.end());
-    return counts[counts.size() / 2];
-  };
-  return {median(in.sim), median(in.real)};
+namespace {
+
+// Per command: the mean z of each placement (episode) of s.
+std::map<int, std::vector<Eigen::VectorXd>> PlacementSettings(const Samples& s) {
+  std::map<int, std::map<int, std::pair<Eigen::VectorXd, int>>> sums;  // command -> episode -> (sum, n)
+  for (int i = 0; i < s.size(); ++i) {
+    auto& [sum, n] = sums[s.command[i]][s.episode[i]];
+    if (n++ == 0) sum = Eigen::VectorXd::Zero(s.z.cols());
+    sum += s.z.row(i).transpose();
+  }
+  std::map<int, std::vector<Eigen::VectorXd>> out;
+  for (const auto& [c, episodes] : sums) {
+    for (const auto& [e, sn] : episodes) out[c].push_back(sn.first / sn.second);
+  }
+  return out;
 }
 
-std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_path) {
-  const PlacementsPerCommand n = CountPlacementsPerCommand(in);
-  if (n.sim > n.real) return "";
-  return sim_path + Fmt(": %g placements per command (median), no more than the real set's %g", n.sim, n.real) +
+// Distance from z to the nearest of `points`, skipping index `skip`; infinite when none is left.
+double Nearest(const Eigen::VectorXd& z, const std::vector<Eigen::VectorXd>& points, int skip = -1) {
+  double best = INFINITY;
+  for (int j = 0; j < static_cast<int>(points.size()); ++j) {
+    if (j != skip) best = std::min(best, (points[j] - z).norm());
+  }
+  return best;
+}
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+}  // namespace
+
+SettingCoverage MeasureSettingCoverage(const AnalysisInputs& in) {
+  const auto sim = PlacementSettings(in.sim), real = PlacementSettings(in.real);
+  std::vector<double> sim_to_sim, real_to_sim;
+  for (int c : in.real_commands) {
+    const auto s = sim.find(c), r = real.find(c);
+    if (s == sim.end() || r == real.end()) continue;
+    for (int p = 0; p < static_cast<int>(s->second.size()); ++p) sim_to_sim.push_back(Nearest(s->second[p], s->second, p));
+    for (const Eigen::VectorXd& z : r->second) real_to_sim.push_back(Nearest(z, s->second));
+  }
+  return {Median(sim_to_sim), Median(real_to_sim)};
+}
+
+std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_path, double ratio) {
+  if (in.sim.z.cols() == 0) return "";  // no terrain: settings cannot be told apart
+  const SettingCoverage c = MeasureSettingCoverage(in);
+  if (!(c.sim_to_sim > ratio * c.real_to_sim)) return "";
+  const std::string sim_gap = std::isfinite(c.sim_to_sim)
+                                  ? Fmt("lies %.3g from its command's nearest other sim placement", c.sim_to_sim)
+                                  : "has no other sim placement of its command";
+  return sim_path + ": a sim placement's terrain z " + sim_gap +
+         Fmt(", a real placement's %.3g from the nearest sim one (medians)", c.real_to_sim) +
          ": locate compares the real residuals with the sim set's cross-fitted ones, which hold whole placements "
-         "out, and with as few sim placements it finds mismatch between two recordings of the same robot; record "
-         "the sim set with more placements (e.g. dgmm simulate --protocol paper --placements 166)";
+         "out, and then finds mismatch between two recordings of the same robot; record the sim set with more "
+         "placements (e.g. dgmm simulate --protocol paper --placements 166)";
 }
 
 }  // namespace dgmm::sim2real
