@@ -41,6 +41,7 @@ struct Sim2RealArgs {
   bool spread_signatures = false;
   bool every_leg = false;
   bool leg_search = true;
+  bool runoff = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "unexplained";
   bool locate_only = false;
@@ -139,6 +140,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
+  o.runoff.enabled = args.runoff;
   o.legs.sag_mode = args.leg_search_score == "sag";
   o.legs.only_with_tails = args.leg_search_on == "tails";
   o.candidates.recording.cache_dir = args.cache;
@@ -287,6 +289,10 @@ void Setup(CLI::App& root) {
                 "when nothing is named and a mismatch is left, search every leg's gain with recordings scored by "
                 "their own model (three per leg and two more, 5 executions per placement; on by default, "
                 "--no-leg-search turns it off; docs/sim2real.md)");
+  cmd->add_flag("--runoff,!--no-runoff", args->runoff,
+                "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
+                "selection step's contending knobs again and score each recording by its own model (on by default; "
+                "docs/sim2real.md)");
   cmd->add_option("--leg-search-score", args->leg_search_score,
                   "how the leg search scores a recording: sag (its sags as a mode of their own beside its core) or "
                   "robust (its own model with a broad component; docs/sim2real.md)")

@@ -14,7 +14,8 @@ null,stones,payload,leg: s mod 4), the values from random.Random(s):
   friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1).
 The real set is the planted config, protocol paper, the same placements count, seed s. Then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
-what was named, the value and whether it lies within 25% of the truth, the status, whether the
+what was named, the value, which stage named it (`knobs`: the mean shifts; `runoff`; `leg_search`)
+and whether it lies within 25% of the truth, the status, whether the
 located tests permuted whole placements, and the wall time.
 
 Usage: scripts/sim2real_rough_ground.py [--build build] [--config datasets/robots/rough_ground.json]
@@ -66,7 +67,8 @@ def row(seed, knob, truth, report, wall):
         value = hit["value"] if hit else float("nan")
         ok = hit is not None and named[0]["knob"] == knob and abs(value - truth) <= 0.25 * abs(truth)
     names = ", ".join(n["knob"] for n in named) or "-"
-    return (f"| {seed} | {knob or 'null'} | {truth:.3g} | {names} | {value:.3g} | {'yes' if ok else 'no'} | "
+    by = (j["fit"]["corrected_by"] or "-") if named else "-"
+    return (f"| {seed} | {knob or 'null'} | {truth:.3g} | {names} | {value:.3g} | {by} | {'yes' if ok else 'no'} | "
             f"{v['status']} | {permuted} | {wall:.0f} |")
 
 
@@ -96,8 +98,8 @@ def main():
              "--seed", str(a.sim_seed), "-o", sim)
     print(f"Rough ground {a.config}, sim set seed {a.sim_seed} ({a.sim_placements} placements), real seeds "
           f"{lo}-{hi} (kinds {a.kinds}), sim2real with --threads {a.threads}\n")
-    print("| seed | planted | truth | named | value | right | status | tests permute | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| seed | planted | truth | named | value | named by | right | status | tests permute | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)

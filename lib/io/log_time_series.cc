@@ -43,12 +43,6 @@ double Lerp(const std::vector<double>& v, std::pair<size_t, double> b) {
   return v[b.first] + b.second * (v[b.first + 1] - v[b.first]);
 }
 
-double Median(std::vector<double> d) {
-  if (d.empty()) return 0;
-  std::nth_element(d.begin(), d.begin() + d.size() / 2, d.end());
-  return d[d.size() / 2];
-}
-
 double MedianInterval(const std::vector<double>& t) {
   std::vector<double> d;
   for (size_t i = 1; i < t.size(); ++i) d.push_back(t[i] - t[i - 1]);

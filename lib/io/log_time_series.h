@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "util/median.h"
+
 namespace dgmm {
 
 using Interval = std::pair<double, double>;  // [begin, end] in seconds
@@ -27,9 +29,6 @@ std::pair<size_t, double> Bracket(const std::vector<double>& t, double time);
 
 // v at a bracket: v[i] + f (v[i+1] - v[i]).
 double Lerp(const std::vector<double>& v, std::pair<size_t, double> b);
-
-// The median (upper middle for an even count); 0 for none.
-double Median(std::vector<double> d);
 
 // Median of t[i] - t[i-1].
 double MedianInterval(const std::vector<double>& t);

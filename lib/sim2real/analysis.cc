@@ -38,11 +38,47 @@ bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
   return !options.only_with_tails || std::find(in.begin(), in.end(), "tails") != in.end();
 }
 
+// The runoff runs on uneven ground when the stages before left a mismatch: something named but
+// not explained, or nothing named for a located mismatch.
+bool WantRunoff(const Analysis& a, const RunoffOptions& options) {
+  if (!options.enabled || (options.only_on_uneven_ground && !a.baseline.permute_placements)) return false;
+  return a.verdict.status == "partly_explained" || a.verdict.status == "unexplained";
+}
+
+// Stages 8a and 8b: the runoff on uneven ground, then the leg search when still nothing is named.
+template <typename Stage>
+void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
+  if (WantRunoff(*a, options.runoff)) {
+    const auto t = Clock::now();
+    stage("runoff (contenders scored by models of their own)");
+    RunoffOptions runoff = options.runoff;
+    runoff.search.model = options.locate.model;
+    a->runoff = RunRunoff(simulator, a->inputs, a->candidates, a->refinement, options.candidates, runoff);
+    if (!a->verdict.named.empty()) a->runoff.named_before = a->verdict.named.front().knob;
+    AddRunoff(a->runoff, simulator, &a->verdict);
+    a->seconds.runoff = Since(t);
+  }
+  if (!a->runoff.search.named && WantLegSearch(*a, options.legs)) {
+    const auto t = Clock::now();
+    stage("leg search (every leg's gain)");
+    LegSearchOptions legs = options.legs;
+    legs.model = options.locate.model;
+    a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs);
+    AddLegSearch(a->leg_search, &a->verdict);
+    a->seconds.legs = Since(t);
+  }
+}
+
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
-         ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error);
+         ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
+         runoff.IsValid(error);
+}
+
+const LegSearch* NamedByOwnModels(const Analysis& a) {
+  return a.runoff.search.named ? &a.runoff.search : a.leg_search.named ? &a.leg_search : nullptr;
 }
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
@@ -85,18 +121,10 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   a.seconds.ties = Since(t);
   a.verdict = ComposeVerdict(a.baseline, a.candidates, a.refinement, a.confidence, a.adequacy, a.naming, a.ties,
                              options.verdict);
-  if (WantLegSearch(a, options.legs)) {
-    t = Clock::now();
-    stage("leg search (every leg's gain)");
-    LegSearchOptions legs = options.legs;
-    legs.model = options.locate.model;
-    a.leg_search = SearchLegGains(*simulator, a.inputs, a.candidates, options.candidates, legs);
-    AddLegSearch(a.leg_search, &a.verdict);
-    a.seconds.legs = Since(t);
-  }
-  if (a.leg_search.named) {
-    a.correction = LegSearchCorrection(a.leg_search);
-    a.named_values = {{a.leg_search.knob_index, a.leg_search.value}};
+  SearchByOwnModels(*simulator, options, stage, &a);
+  if (const LegSearch* own = NamedByOwnModels(a)) {
+    a.correction = LegSearchCorrection(*own);
+    a.named_values = {{own->knob_index, own->value}};
   } else {
     a.correction = MakeCorrection(a.inputs, a.baseline, a.candidates, a.refinement.selection.fit);
     a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);

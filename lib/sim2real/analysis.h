@@ -10,8 +10,10 @@
 //                                    values pinned or impossible, residual structure and drift;
 //   7. ties        (ties.h)          what the data cannot tell apart, and the experiment that would;
 //   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence;
-//      legs        (leg_search.h)    opt-in: when nothing is named and the residual has heavy tails,
-//                                    every leg's gain searched, each recording scored by its own model;
+//      runoff      (runoff.h)        on uneven ground with a mismatch left: the first step's contenders
+//                                    recorded again, each recording scored by its own model;
+//      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
+//                                    searched, each recording scored by its own model;
 //   9. report      (report.h)        report.json, report.html, the stdout summary (in the app).
 // Without a simulator the analysis stops after stage 2 and says so.
 #include <cstdint>
@@ -21,6 +23,7 @@
 
 #include "sim2real/correction.h"
 #include "sim2real/leg_search.h"
+#include "sim2real/runoff.h"
 #include "sim2real/verdict_stage.h"
 
 namespace dgmm::sim2real {
@@ -34,12 +37,13 @@ struct AnalysisOptions {
   TieOptions ties;
   VerdictOptions verdict;
   LegSearchOptions legs;   // its model options are the baseline's (locate.model)
+  RunoffOptions runoff;    // likewise
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };
 
 struct StageTimes {
-  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, legs = 0, total = 0;
+  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, total = 0;
 };
 
 struct Analysis {
@@ -54,6 +58,7 @@ struct Analysis {
   Naming naming;
   TieResult ties;
   Verdict verdict;
+  Runoff runoff;                   // ran only on uneven ground with a mismatch left (Runoff::ran)
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
   Correction correction;           // the knob correction (empty without a simulator)
   std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)
@@ -62,6 +67,10 @@ struct Analysis {
 
 // `simulator` null: locate only, `no_simulator_reason` saying why. Throws InputError for sets
 // that cannot be compared and for a simulator that cannot record the sim set's protocol.
+// The search that named the verdict's knob by recordings scored with their own models (the runoff,
+// else the leg search), or nullptr when the knob path's correction stands.
+const LegSearch* NamedByOwnModels(const Analysis& a);
+
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
                  const AnalysisOptions& options, const std::string& no_simulator_reason = "");
 

@@ -9,6 +9,7 @@
 
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
+#include "util/median.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -113,12 +114,6 @@ double Nearest(const Eigen::VectorXd& z, const std::vector<Eigen::VectorXd>& poi
     if (j != skip) best = std::min(best, (points[j] - z).norm());
   }
   return best;
-}
-
-double Median(std::vector<double> v) {
-  if (v.empty()) return 0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
 }
 
 }  // namespace

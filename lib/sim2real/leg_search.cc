@@ -159,7 +159,7 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
     const Knob& knob = knobs[wanted[j].first];
     state->scored.push_back(ScoreRecording(batch.sets[j], in, options, state->nominal_size, state->Ref()));
     const Scored& s = state->scored.back();
-    state->points.push_back({knob.leg, knob.name, wanted[j].first, wanted[j].second,
+    state->points.push_back({knob.leg.empty() ? knob.name : knob.leg, knob.name, wanted[j].first, wanted[j].second,
                              s.walkable ? s.rows.mean() : -INFINITY, false});
   }
 }
@@ -191,14 +191,19 @@ std::vector<std::pair<int, double>> HalfSteps(const SearchState& state, int best
   return out;
 }
 
-// Names the best point's leg, or says why not.
+// "leg3 at gain 0.3" or "floor.friction.sliding at 0.4".
+std::string PointName(const Knob& k, double value) {
+  return k.leg.empty() ? k.name + Fmt(" at %.3g", value) : k.leg + Fmt(" at gain %.3g", value);
+}
+
+// Names the best point's leg (or knob), or says why not.
 void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
             const LegSearchOptions& options, SearchState* state, LegSearch* out) {
   out->points = state->points;
   out->best = BestPoint(*state);
   out->named = false;
   if (out->best < 0) {
-    out->why = "every recording of a weak leg lost most of its placements (the robot fell)";
+    out->why = "every recording lost most of its placements (the robot fell)";
     return;
   }
   std::vector<Eigen::VectorXd> rows;
@@ -228,13 +233,14 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
     leg_rows.push_back(rows[j]);
   }
   out->as_well = FitAsWellSpan(leg_rows, leg_best, values, {}, in.real.episode, options.z);
-  const std::string at = b.leg + Fmt(" at gain %.3g", b.value);
+  const bool legs = !knobs[b.knob_index].leg.empty();
+  const std::string at = PointName(knobs[b.knob_index], b.value);
   if (out->z_vs_nominal < options.z) {
     out->why = "the best point (" + at + Fmt(") fits the real samples no better than the nominal (z %.2f)", out->z_vs_nominal);
   } else if (!out->legs_as_well.empty()) {
-    out->why = "the best point is " + at + ", but weak " + out->legs_as_well[0] +
+    out->why = "the best point is " + at + (legs ? ", but weak " : ", but ") + out->legs_as_well[0] +
                (out->legs_as_well.size() > 1 ? Fmt(" (and %.0f more legs)", out->legs_as_well.size() - 1.0) : "") +
-               " fits the real samples as well: these data do not tell which leg";
+               " fits the real samples as well: these data do not tell " + (legs ? "which leg" : "which knob");
   } else {
     out->named = true;
     out->why = "";
@@ -246,17 +252,29 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
 }
 
 // Does the best point remove enough of the nominal's misfit? Else the leg is not named.
-void CheckMisfit(const AnalysisInputs& in, const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
+void CheckMisfit(const AnalysisInputs& in, const SearchState& state, const LegSearchOptions& options,
+                 const Knob& knob, LegSearch* out) {
   out->nominal_misfit = Misfit(state.nominal.samples, in, options, state.Ref());
   out->best_misfit = Misfit(state.scored[out->best].samples, in, options, state.Ref());
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
   if (out->gap_closed >= options.min_gap_closed) return;
   out->named = false;
-  out->why = "the best point (" + out->leg + Fmt(" at gain %.3g", out->value) +
+  out->why = "the best point (" + PointName(knob, out->value) +
              Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against the recording's own "
                  "unseen samples, %.3g nats per sample; the best's: %.3g)", 100 * out->gap_closed, out->nominal_misfit,
                  out->best_misfit) +
-             ": the mismatch is not a weak leg alone";
+             (knob.leg.empty() ? ": the mismatch is not this knob alone" : ": the mismatch is not a weak leg alone");
+}
+
+// The spacing of knob k's values in `grid` (the refinement's step), else a tenth of its nominal.
+double GridStep(const std::vector<std::pair<int, double>>& grid, int k, double nominal) {
+  double step = INFINITY;
+  for (const auto& [ka, va] : grid) {
+    for (const auto& [kb, vb] : grid) {
+      if (ka == k && kb == k && va != vb) step = std::min(step, std::fabs(va - vb));
+    }
+  }
+  return std::isfinite(step) ? step : 0.1 * std::fabs(nominal);
 }
 
 }  // namespace
@@ -292,15 +310,15 @@ std::vector<int> LegGainKnobs(const KnobSimulator& simulator) {
   return out;
 }
 
-LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
-                         const CandidateOptions& recording, const LegSearchOptions& options) {
+LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                          const CandidateOptions& recording, const LegSearchOptions& options,
+                          const std::vector<std::pair<int, double>>& grid) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "leg search options", error);
   const auto start = Clock::now();
   LegSearch out;
-  const std::vector<int> legs = LegGainKnobs(simulator);
-  if (legs.empty()) {
-    out.why = "the simulator has no per-leg gain knobs";
+  if (grid.empty()) {
+    out.why = "no knob to search";
     return out;
   }
   out.ran = true;
@@ -308,26 +326,35 @@ LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& i
   const auto& knobs = simulator.knobs();
   SearchState state;
   if (options.sag_mode) state.ref = MakeSagReference(in.sim, options.model);
-  std::vector<std::pair<int, double>> grid;
-  for (int k : legs) {
-    for (double v : GridValues(knobs[k], options.factors)) grid.push_back({k, v});
-  }
   RecordPoints(simulator, in, set, recording, options, grid, &state, &out);
   out.nominal_model = state.nominal.model;
   out.nominal_score = state.nominal.rows.mean();
   Decide(in, knobs, options, &state, &out);
-  const double step = options.factors.size() > 1
-                          ? std::fabs(options.factors[0] - options.factors[1]) * std::fabs(out.nominal)
-                          : 0.1 * std::fabs(out.nominal);
+  const double step = out.best >= 0 ? GridStep(grid, out.knob_index, out.nominal) : 0;
   for (int round = 0; out.named && round < options.refine_steps; ++round) {
     const auto more = HalfSteps(state, out.best, knobs[out.knob_index], step / (1 << round));
     if (more.empty()) break;
     RecordPoints(simulator, in, set, recording, options, more, &state, &out);
     Decide(in, knobs, options, &state, &out);
   }
-  if (out.named) CheckMisfit(in, state, options, &out);
+  if (out.named) CheckMisfit(in, state, options, knobs[out.knob_index], &out);
   out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return out;
+}
+
+LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                         const CandidateOptions& recording, const LegSearchOptions& options) {
+  const std::vector<int> legs = LegGainKnobs(simulator);
+  if (legs.empty()) {
+    LegSearch out;
+    out.why = "the simulator has no per-leg gain knobs";
+    return out;
+  }
+  std::vector<std::pair<int, double>> grid;
+  for (int k : legs) {
+    for (double v : GridValues(simulator.knobs()[k], options.factors)) grid.push_back({k, v});
+  }
+  return SearchOwnModels(simulator, in, set, recording, options, grid);
 }
 
 Correction LegSearchCorrection(const LegSearch& search) {

@@ -95,6 +95,13 @@ std::vector<int> LegGainKnobs(const KnobSimulator& simulator);
 LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                          const CandidateOptions& recording, const LegSearchOptions& options);
 
+// The same search over any (knob, value) points (the runoff on uneven ground, runoff.h): a point's
+// group (LegSearchPoint::leg) is its knob's leg, else the knob's name; the best's refinement steps
+// by the spacing of its knob's values in `grid`.
+LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                          const CandidateOptions& recording, const LegSearchOptions& options,
+                          const std::vector<std::pair<int, double>>& grid);
+
 // The named leg as a correction of the sim model: the best recording's own means minus the
 // nominal's, and the per-axis ratio of their residual variances.
 Correction LegSearchCorrection(const LegSearch& search);

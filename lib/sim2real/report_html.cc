@@ -153,13 +153,15 @@ std::string PhysicsSection(const Analysis& a) {
     << Escape(a.candidates.legs_note) << ". A candidate is named when selected by held-out real likelihood, constant "
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
-  const LegSearch& leg = a.leg_search;
-  if (leg.named) {
-    o << "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named "
-      << Escape(leg.knob) << F(" = %.4g", leg.value) << ": its recording fits the real samples "
-      << F("%.1f", leg.z_vs_nominal) << " standard errors better than the nominal's, no other leg's as well, and it "
-      << "removes " << F("%.0f%%", 100 * leg.gap_closed) << " of the nominal's misfit. It has no bootstrap: inclusion "
-      << "is not computed.</p>\n";
+  if (const LegSearch* own = NamedByOwnModels(a)) {
+    const bool runoff = own == &a.runoff.search;
+    o << (runoff ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
+                   "each recorded again and scored by a model of its own (section 5), named "
+                 : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
+      << Escape(own->knob) << F(" = %.4g", own->value) << ": its recording fits the real samples "
+      << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, no other "
+      << (runoff ? "contender's" : "leg's") << " as well, and it removes " << F("%.0f%%", 100 * own->gap_closed)
+      << " of the nominal's misfit. It has no bootstrap: inclusion is not computed.</p>\n";
   }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
   else o << NamedTable(a.verdict);
@@ -197,10 +199,10 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   std::ostringstream o;
   o << "<h2>4. The fit (adequacy of the correction)</h2><table><tr><th>model</th><th>held-out real log-likelihood per "
        "sample</th></tr><tr><td>(a) sim-trained</td><td>" << F("%.3f", b.ll_sim) << "</td></tr>";
-  const LegSearch& leg = a.leg_search;
-  if (leg.named) {
-    o << "<tr><td>(b) corrected (the weak leg of the leg search, its recording's own model)</td><td>"
-      << F("%.3f", leg.best_plain) << "</td></tr>";
+  const LegSearch* own = NamedByOwnModels(a);
+  if (own) {
+    o << "<tr><td>(b) corrected (" << (own == &a.runoff.search ? "the runoff's named knob" : "the weak leg of the leg search")
+      << ", its recording's own model)</td><td>" << F("%.3f", own->best_plain) << "</td></tr>";
   } else if (a.knobs_analysed) {
     o << "<tr><td>(b) corrected (the knob correction)</td><td>" << F("%.3f", a.adequacy.ll_corrected) << "</td></tr>";
   }
@@ -208,10 +210,10 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
     << F("%.3f", b.ll_ceiling) << "</td></tr><tr><td>real-trained from real data alone</td><td>" << F("%.3f", b.ll_real_only)
     << "</td></tr></table>\n";
   if (!a.knobs_analysed) return o.str();
-  if (leg.named) {
-    o << "<p>Share of the nominal recording's misfit (" << F("%.3f", leg.nominal_misfit)
-      << " nats per sample: the real samples against the recording's own unseen samples) removed by the weak leg: "
-      << F("%.0f%%", 100 * leg.gap_closed) << ". The corrected model is written as <code>"
+  if (own) {
+    o << "<p>Share of the nominal recording's misfit (" << F("%.3f", own->nominal_misfit)
+      << " nats per sample: the real samples against the recording's own unseen samples) removed by "
+      << Escape(own->knob) << ": " << F("%.0f%%", 100 * own->gap_closed) << ". The corrected model is written as <code>"
       << Escape(ctx.corrected_model_file) << "</code>.</p>\n";
     return o.str();
   }
@@ -234,16 +236,19 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   return o.str();
 }
 
-std::string LegSearchTable(const LegSearch& l) {
+// The leg search's or the runoff's points (`title`; the runoff's rows are knobs, not legs).
+std::string LegSearchTable(const LegSearch& l, const std::string& title, bool legs) {
   std::ostringstream o;
-  o << "<h3>Search of every leg's gain</h3><p>" << (l.named ? "Named " + Escape(l.knob) + F(" = %.4g", l.value) + "."
-                                                            : "Names no leg: " + Escape(l.why) + ".")
+  o << "<h3>" << Escape(title) << "</h3><p>"
+    << (l.named ? "Named " + Escape(l.knob) + F(" = %.4g", l.value) + "."
+                : std::string(legs ? "Names no leg: " : "Names no knob: ") + Escape(l.why) + ".")
     << " Nominal recording's own model: " << F("%.4f", l.nominal_score) << " nats per real sample (misfit "
     << F("%.4f", l.nominal_misfit) << "; the best point's " << F("%.4f", l.best_misfit) << "); " << l.recorded << " recordings (" << l.from_cache << " from the cache), "
-    << F("%.0f s", l.seconds) << ".</p><table><tr><th>leg</th><th>gain</th><th>log-likelihood per real sample (own model)</th>"
+    << F("%.0f s", l.seconds) << ".</p><table><tr><th>" << (legs ? "leg</th><th>gain" : "knob</th><th>value")
+    << "</th><th>log-likelihood per real sample (own model)</th>"
     << "<th>fits as well as the best</th></tr>";
   for (const LegSearchPoint& p : l.points) {
-    o << "<tr><td>" << Escape(p.leg) << "</td><td>" << F("%.4g", p.value) << "</td><td>"
+    o << "<tr><td>" << Escape(legs ? p.leg : p.knob) << "</td><td>" << F("%.4g", p.value) << "</td><td>"
       << (std::isfinite(p.score) ? F("%.4f", p.score) : std::string("fell")) << "</td><td>" << (p.fits_as_well ? "yes" : "")
       << "</td></tr>";
   }
@@ -266,7 +271,11 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
       << " from the cache), " << a.refinement.recorded << " for the refinement; " << a.ties.experiment_checks
       << " experiment checks.</p>\n";
   }
-  if (a.leg_search.ran) o << LegSearchTable(a.leg_search);
+  if (a.runoff.ran) {
+    o << LegSearchTable(a.runoff.search, "Runoff of the first step's contenders on uneven ground (each recording scored "
+                                         "by a model of its own)", false);
+  }
+  if (a.leg_search.ran) o << LegSearchTable(a.leg_search, "Search of every leg's gain", true);
   if (!ctx.recalibrated_config_file.empty()) {
     o << "<p>The simulator config at the named values: <code>" << Escape(ctx.recalibrated_config_file)
       << "</code> (<code>dgmm simulate --config</code>).</p>\n";
@@ -308,15 +317,15 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   if (!s.significant.empty()) o << " (worst: " << s.significant.front().label << ")";
   o << "\n";
   o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
-  const LegSearch& leg = a.leg_search;
-  if (leg.named) {
-    o << ", corrected (weak " << leg.leg << ") " << F("%.3f", leg.best_plain);
+  const LegSearch* own = NamedByOwnModels(a);
+  if (own) {
+    o << ", corrected (" << (own == &a.runoff.search ? own->knob : "weak " + own->leg) << ") " << F("%.3f", own->best_plain);
   } else if (a.knobs_analysed) {
     o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);
   }
   o << ", ceiling " << F("%.3f", a.baseline.ll_ceiling);
-  if (leg.named) {
-    o << " (" << F("%.0f%%", 100 * leg.gap_closed) << " of the nominal recording's misfit removed)";
+  if (own) {
+    o << " (" << F("%.0f%%", 100 * own->gap_closed) << " of the nominal recording's misfit removed)";
   } else if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
     o << " (" << F("%.0f%%", 100 * a.adequacy.gap_closed) << " of the gap closed, SE " << F("%.0f%%", 100 * a.adequacy.gap_closed_se)
       << ")";

@@ -145,20 +145,22 @@ json AdequacyJson(const Analysis& a) {
           {"doubts", q.doubts}};
 }
 
-// The fit of what the verdict names: the leg search's correction when it named a leg (its
-// recordings' own models score real samples they never saw, so there is no SE of folds), else the
-// knob correction's held-out fit.
+// The fit of what the verdict names: the runoff's or the leg search's correction when it named a
+// knob (its recordings' own models score real samples they never saw, so there is no SE of
+// folds), else the knob correction's held-out fit.
 json FitJson(const Analysis& a) {
   const Baseline& b = a.baseline;
-  const LegSearch& l = a.leg_search;
-  const bool leg = l.named;
+  const bool by_runoff = a.runoff.search.named;
+  const LegSearch* own = NamedByOwnModels(a);
+  const LegSearch& l = own ? *own : a.leg_search;
+  const bool leg = own != nullptr;
   const json corrected = leg ? JsonNumber(l.best_plain)
                              : a.knobs_analysed ? JsonNumber(a.adequacy.ll_corrected) : json(nullptr);
   return {{"heldout_log_likelihood_per_sample",
            {{"sim", b.ll_sim}, {"corrected", corrected},
             {"real_trained_ceiling", b.ll_ceiling}, {"real_only", b.ll_real_only},
             {"ceiling_sim_prior_count", b.ceiling_prior_count}}},
-          {"corrected_by", !a.knobs_analysed ? json(nullptr) : json(leg ? "leg_search" : "knobs")},
+          {"corrected_by", !a.knobs_analysed ? json(nullptr) : json(by_runoff ? "runoff" : leg ? "leg_search" : "knobs")},
           {"gap_closed", leg ? JsonNumber(l.gap_closed) : a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed) : json(nullptr)},
           {"gap_closed_se", !leg && a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed_se) : json(nullptr)}};
 }
@@ -180,6 +182,16 @@ json LegSearchJson(const LegSearch& l) {
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 
+json RunoffJson(const Runoff& r) {
+  if (!r.ran && r.why_not.empty()) return nullptr;
+  if (!r.ran) return {{"ran", false}, {"why_not", r.why_not}};
+  json out = LegSearchJson(r.search);
+  out["ran"] = true;
+  out["contenders"] = r.contenders;
+  out["named_before"] = r.named_before.empty() ? json(nullptr) : json(r.named_before);
+  return out;
+}
+
 }  // namespace
 
 std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
@@ -192,6 +204,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"locate", LocateJson(a)},
               {"knobs", a.knobs_analysed ? KnobsJson(a) : json(nullptr)},
               {"adequacy", a.knobs_analysed ? AdequacyJson(a) : json(nullptr)},
+              {"runoff", RunoffJson(a.runoff)},
               {"leg_search", LegSearchJson(a.leg_search)},
               {"fit", FitJson(a)},
               {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},
@@ -206,7 +219,8 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"dropped_real_commands", in.dropped_commands}, {"dropped_real_samples", in.dropped_samples},
               {"seconds", {{"locate", a.seconds.locate}, {"candidates", a.seconds.candidates},
                            {"refine", a.seconds.refine}, {"confidence", a.seconds.confidence},
-                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"leg_search", a.seconds.legs},
+                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"runoff", a.seconds.runoff},
+                           {"leg_search", a.seconds.legs},
                            {"total", a.seconds.total}}}};
   for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});
   return out.dump(2) + "\n";

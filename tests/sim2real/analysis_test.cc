@@ -83,6 +83,40 @@ TEST(Analysis, TheLegSearchRunsOnlyWhenNothingIsNamed) {
   EXPECT_FALSE(Analyse(pair.sim, pair.real, &Fake(), options).leg_search.ran);
 }
 
+// On uneven ground a mismatch left after the mean shifts gets a runoff of the first step's
+// contenders, on a plane never; what it names is the verdict's and the correction's one story.
+TEST(Analysis, TheRunoffRunsOnUnevenGroundWhenAMismatchIsLeft) {
+  FakeSimulator rough;
+  rough.ground_sd = 1.5;
+  FakeExtras extras;
+  extras.geometry = 0.03;
+  const std::vector<KnobValue> planted = {{test::kFriction, 0.5}};
+  const auto pair = test::MakeFakePair(rough, planted, extras);
+  AnalysisOptions options = test::FastOptions();
+  ASSERT_TRUE(options.runoff.enabled) << "on by default";
+  const Analysis a = Analyse(pair.sim, pair.real, &rough, options);
+  ASSERT_TRUE(a.baseline.permute_placements);
+  ASSERT_TRUE(a.verdict.status == "partly_explained" || a.verdict.status == "unexplained") << a.verdict.sentence;
+  ASSERT_TRUE(a.runoff.ran) << a.runoff.why_not;
+  EXPECT_FALSE(a.runoff.contenders.empty());
+  if (a.runoff.search.named) {
+    ASSERT_EQ(a.verdict.named.size(), 1u);
+    EXPECT_EQ(a.verdict.named[0].knob, rough.knobs()[a.runoff.search.knob_index].name);
+    ASSERT_EQ(a.named_values.size(), 1u);
+    EXPECT_EQ(a.named_values[0].knob, a.runoff.search.knob_index);
+    EXPECT_EQ(a.named_values[0].value, a.runoff.search.value);
+    EXPECT_FALSE(a.leg_search.ran) << "the runoff named a knob: no leg search";
+  } else {
+    EXPECT_NE(a.verdict.sentence.find("runoff"), std::string::npos) << a.verdict.sentence;
+  }
+  options.runoff.enabled = false;
+  EXPECT_FALSE(Analyse(pair.sim, pair.real, &rough, options).runoff.ran);
+  const auto plane = test::MakeFakePair(Fake(), planted, extras);
+  const Analysis flat = Analyse(plane.sim, plane.real, &Fake(), test::FastOptions());
+  EXPECT_FALSE(flat.baseline.permute_placements);
+  EXPECT_FALSE(flat.runoff.ran) << "a plane has no runoff";
+}
+
 TEST(Analysis, PhysicsNoKnobDescribesIsDoubted) {
   FakeExtras extras;
   extras.geometry = 0.03;
