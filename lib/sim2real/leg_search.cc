@@ -366,7 +366,7 @@ Correction LegSearchCorrection(const LegSearch& search) {
     return Eigen::VectorXd(best->Predict(c, z, f).mean - nominal->Predict(c, z, f).mean);
   };
   out.log_var = search.log_var;
-  out.terms.push_back({search.knob + "@leg_search", Eigen::VectorXd::Constant(1, search.value)});
+  out.terms.push_back({search.knob + "@" + search.by, Eigen::VectorXd::Constant(1, search.value)});
   return out;
 }
 

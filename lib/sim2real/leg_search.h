@@ -67,6 +67,7 @@ struct LegSearchPoint {
 
 struct LegSearch {
   bool ran = false;
+  std::string by = "leg_search";      // which stage searched: "leg_search" or "runoff" (runoff.h)
   std::string score;                  // "sag" or "robust" (LegSearchOptions::sag_mode)
   std::string why;                    // why it did not run, or what it found, in words
   std::vector<LegSearchPoint> points; // every leg and gain scored

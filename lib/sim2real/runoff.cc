@@ -97,6 +97,7 @@ Runoff RunRunoff(const KnobSimulator& simulator, const AnalysisInputs& in, const
   }
   out.ran = true;
   out.search = SearchOwnModels(simulator, in, set, recording, options.search, grid);
+  out.search.by = "runoff";
   return out;
 }
 

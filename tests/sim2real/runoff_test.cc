@@ -41,6 +41,9 @@ TEST(Runoff, NamesAPlantedKnobAndReplacesAnotherName) {
   ASSERT_TRUE(r.search.named) << r.search.why;
   EXPECT_EQ(r.search.knob_index, kFriction);
   EXPECT_NEAR(r.search.value, 0.6, 0.25 * 0.6);
+  const Correction c = LegSearchCorrection(r.search);
+  ASSERT_EQ(c.terms.size(), 1u);
+  EXPECT_EQ(c.terms[0].key, SharedFake().knobs()[kFriction].name + "@runoff") << "the model file says which stage named it";
   Verdict v;
   v.status = "partly_explained";
   VerdictNamed latency;
