@@ -54,8 +54,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     RunoffOptions runoff = options.runoff;
     runoff.search.model = options.locate.model;
     a->runoff = RunRunoff(simulator, a->inputs, a->candidates, a->refinement, options.candidates, runoff);
-    if (!a->verdict.named.empty()) a->runoff.named_before = a->verdict.named.front().knob;
-    AddRunoff(a->runoff, simulator, &a->verdict);
+    AddRunoff(simulator, &a->runoff, &a->verdict);
     a->seconds.runoff = Since(t);
   }
   if (!a->runoff.search.named && WantLegSearch(*a, options.legs)) {

@@ -107,6 +107,14 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
 // nominal's, and the per-axis ratio of their residual variances.
 Correction LegSearchCorrection(const LegSearch& search);
 
+// A search's named knob as a verdict entry (no doubts yet): its value, range, the values that fit as
+// well and the pinned flags.
+VerdictNamed SearchNamed(const LegSearch& search, const std::string& family, const std::string& unit);
+
+// The verdict's one story when a search named a knob: `named` alone, status partly_explained, its
+// doubts the verdict's, the gap closed the search's, the sentence written again.
+void ReplaceNamed(const LegSearch& search, const VerdictNamed& named, Verdict* verdict);
+
 // The verdict with the search's answer (leg_search_verdict.cc): a named leg replaces an
 // `unexplained` verdict that named nothing (status partly_explained, with the doubts of a search
 // without bootstrap); otherwise the sentence says what the search found and why it names nothing.

@@ -1,4 +1,5 @@
-// The leg search's answer in the verdict (leg_search.h, AddLegSearch).
+// The leg search's answer in the verdict (leg_search.h: AddLegSearch, and SearchNamed and
+// ReplaceNamed, which the runoff shares).
 #include "sim2real/leg_search.h"
 #include "sim2real/sentence_format.h"
 #include "sim2real/verdict_stage.h"
@@ -7,15 +8,7 @@ namespace dgmm::sim2real {
 namespace {
 
 VerdictNamed NamedLeg(const LegSearch& s) {
-  VerdictNamed n;
-  n.family = "actuator_gain";
-  n.knob = s.knob;
-  n.value = n.fitted = s.value;
-  n.nominal = s.nominal;
-  n.lo = s.lo, n.hi = s.hi;
-  n.as_well = s.as_well;
-  if (s.value <= s.lo) n.flags.push_back("pinned_low");
-  if (s.value >= s.hi) n.flags.push_back("pinned_high");
+  VerdictNamed n = SearchNamed(s, "actuator_gain", "");
   n.doubts.push_back(Fmt("found by a search of every leg's gain (%.0f recordings, each scored by a model of its own, ",
                          static_cast<double>(s.points.size())) +
                      "its spread and falls included) after the probes' mean shifts named nothing: no bootstrap, its "
@@ -28,6 +21,30 @@ VerdictNamed NamedLeg(const LegSearch& s) {
 
 }  // namespace
 
+VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const std::string& unit) {
+  VerdictNamed n;
+  n.family = family;
+  n.knob = s.knob;
+  n.unit = unit;
+  n.value = n.fitted = s.value;
+  n.nominal = s.nominal;
+  n.lo = s.lo, n.hi = s.hi;
+  n.as_well = s.as_well;
+  if (s.value <= s.lo) n.flags.push_back("pinned_low");
+  if (s.value >= s.hi) n.flags.push_back("pinned_high");
+  return n;
+}
+
+void ReplaceNamed(const LegSearch& s, const VerdictNamed& n, Verdict* v) {
+  v->status = "partly_explained";
+  v->named = {n};
+  v->doubts = n.doubts;
+  v->weak.clear();
+  v->gap_closed = s.gap_closed;
+  v->unexplained_present = s.gap_closed < 0.9;
+  v->sentence = VerdictSentence(*v, nullptr, nullptr, nullptr);
+}
+
 void AddLegSearch(const LegSearch& s, Verdict* v) {
   if (!s.ran) return;
   if (!s.named) {
@@ -36,14 +53,7 @@ void AddLegSearch(const LegSearch& s, Verdict* v) {
                    s.why + ".";
     return;
   }
-  const VerdictNamed n = NamedLeg(s);
-  v->status = "partly_explained";
-  v->named = {n};
-  v->doubts = n.doubts;
-  v->weak.clear();
-  v->gap_closed = s.gap_closed;
-  v->unexplained_present = s.gap_closed < 0.9;
-  v->sentence = VerdictSentence(*v, nullptr, nullptr, nullptr);
+  ReplaceNamed(s, NamedLeg(s), v);
   v->sentence += " The weak " + s.leg +
                  Fmt(" leg fits the real samples %.3g nats per sample better than the nominal (z %.1f); ",
                      s.points[s.best].score - s.nominal_score, s.z_vs_nominal) +

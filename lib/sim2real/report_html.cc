@@ -154,7 +154,7 @@ std::string PhysicsSection(const Analysis& a) {
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
   if (const LegSearch* own = NamedByOwnModels(a)) {
-    const bool runoff = own == &a.runoff.search;
+    const bool runoff = own->by == "runoff";
     o << (runoff ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
                    "each recorded again and scored by a model of its own (section 5), named "
                  : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
@@ -201,7 +201,7 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
        "sample</th></tr><tr><td>(a) sim-trained</td><td>" << F("%.3f", b.ll_sim) << "</td></tr>";
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
-    o << "<tr><td>(b) corrected (" << (own == &a.runoff.search ? "the runoff's named knob" : "the weak leg of the leg search")
+    o << "<tr><td>(b) corrected (" << (own->by == "runoff" ? "the runoff's named knob" : "the weak leg of the leg search")
       << ", its recording's own model)</td><td>" << F("%.3f", own->best_plain) << "</td></tr>";
   } else if (a.knobs_analysed) {
     o << "<tr><td>(b) corrected (the knob correction)</td><td>" << F("%.3f", a.adequacy.ll_corrected) << "</td></tr>";
@@ -319,7 +319,7 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
-    o << ", corrected (" << (own == &a.runoff.search ? own->knob : "weak " + own->leg) << ") " << F("%.3f", own->best_plain);
+    o << ", corrected (" << (own->by == "runoff" ? own->knob : "weak " + own->leg) << ") " << F("%.3f", own->best_plain);
   } else if (a.knobs_analysed) {
     o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);
   }

@@ -150,7 +150,6 @@ json AdequacyJson(const Analysis& a) {
 // folds), else the knob correction's held-out fit.
 json FitJson(const Analysis& a) {
   const Baseline& b = a.baseline;
-  const bool by_runoff = a.runoff.search.named;
   const LegSearch* own = NamedByOwnModels(a);
   const LegSearch& l = own ? *own : a.leg_search;
   const bool leg = own != nullptr;
@@ -160,7 +159,7 @@ json FitJson(const Analysis& a) {
            {{"sim", b.ll_sim}, {"corrected", corrected},
             {"real_trained_ceiling", b.ll_ceiling}, {"real_only", b.ll_real_only},
             {"ceiling_sim_prior_count", b.ceiling_prior_count}}},
-          {"corrected_by", !a.knobs_analysed ? json(nullptr) : json(by_runoff ? "runoff" : leg ? "leg_search" : "knobs")},
+          {"corrected_by", !a.knobs_analysed ? json(nullptr) : json(leg ? own->by : "knobs")},
           {"gap_closed", leg ? JsonNumber(l.gap_closed) : a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed) : json(nullptr)},
           {"gap_closed_se", !leg && a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed_se) : json(nullptr)}};
 }

@@ -43,8 +43,6 @@ double ProbeOnTheReadingsSide(const CandidateSet& set, const Refinement& r, int 
   return 2 * knob.nominal - knob.probes.front();
 }
 
-std::string NamedKnob(const Verdict& v) { return v.named.empty() ? "" : v.named.front().knob; }
-
 std::string Join(const std::vector<std::string>& words) {
   std::string out;
   for (size_t j = 0; j < words.size(); ++j) out += (j == 0 ? "" : j + 1 == words.size() ? " and " : ", ") + words[j];
@@ -101,11 +99,12 @@ Runoff RunRunoff(const KnobSimulator& simulator, const AnalysisInputs& in, const
   return out;
 }
 
-void AddRunoff(const Runoff& runoff, const KnobSimulator& simulator, Verdict* v) {
-  if (!runoff.ran) return;
-  const LegSearch& s = runoff.search;
+void AddRunoff(const KnobSimulator& simulator, Runoff* runoff, Verdict* v) {
+  if (!runoff->ran) return;
+  runoff->named_before = v->named.empty() ? "" : v->named.front().knob;
+  const LegSearch& s = runoff->search;
   const std::string list = Fmt("%.0f recordings of ", static_cast<double>(s.points.size())) +
-                           Join(runoff.contenders) + ", each scored by a model of its own";
+                           Join(runoff->contenders) + ", each scored by a model of its own";
   if (!s.named) {
     const std::string doubt = "on this uneven ground a runoff (" + list + ") names no knob: " + s.why;
     if (!v->named.empty()) {
@@ -117,28 +116,16 @@ void AddRunoff(const Runoff& runoff, const KnobSimulator& simulator, Verdict* v)
     return;
   }
   const Knob& k = simulator.knobs()[s.knob_index];
-  VerdictNamed n;
-  n.family = k.family, n.knob = k.name, n.unit = k.unit;
-  n.value = n.fitted = s.value;
-  n.nominal = s.nominal, n.lo = s.lo, n.hi = s.hi;
-  n.as_well = s.as_well;
-  if (s.value <= s.lo) n.flags.push_back("pinned_low");
-  if (s.value >= s.hi) n.flags.push_back("pinned_high");
-  const std::string before = NamedKnob(*v);
+  VerdictNamed n = SearchNamed(s, k.family, k.unit);
+  const std::string& before = runoff->named_before;
   n.doubts.push_back("found by a runoff on uneven ground (" + list +
                      ") after the probes' mean shifts: no bootstrap, its range is the values that fit as well" +
                      (before.empty() || before == k.name ? "" : "; the mean shifts had named " + before));
   if (s.gap_closed < 0.9) {
     n.doubts.push_back(Fmt("it removes %.0f%% of the nominal's misfit: some mismatch remains", 100 * s.gap_closed));
   }
-  v->status = "partly_explained";
-  v->named = {n};
   v->ties.clear();
-  v->doubts = n.doubts;
-  v->weak.clear();
-  v->gap_closed = s.gap_closed;
-  v->unexplained_present = s.gap_closed < 0.9;
-  v->sentence = VerdictSentence(*v, nullptr, nullptr, nullptr);
+  ReplaceNamed(s, n, v);
   v->sentence += " " + k.name + Fmt(" at %.3g fits the real samples %.3g nats per sample better than the nominal ",
                                     s.value, s.points[s.best].score - s.nominal_score) +
                  Fmt("(z %.1f); no other contender fits as well.", s.z_vs_nominal);

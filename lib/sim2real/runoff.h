@@ -32,7 +32,7 @@ struct Runoff {
   bool ran = false;
   std::string why_not;                  // why it did not run
   std::vector<std::string> contenders;  // "knob@probe", in order of their first-step gain
-  std::string named_before;             // the knob the mean shifts named first ("" for none)
+  std::string named_before;             // the knob the mean shifts named first ("" for none; AddRunoff)
   LegSearch search;
 };
 
@@ -49,6 +49,7 @@ Runoff RunRunoff(const KnobSimulator& simulator, const AnalysisInputs& in, const
 // The runoff's answer in the verdict: a named knob replaces the verdict's (status partly_explained,
 // with the doubts of a search without bootstrap); otherwise a named knob keeps its place with the
 // runoff's doubt, and the sentence says what the runoff could not tell apart.
-void AddRunoff(const Runoff& runoff, const KnobSimulator& simulator, Verdict* verdict);
+// Records in `runoff` what the verdict named before (Runoff::named_before).
+void AddRunoff(const KnobSimulator& simulator, Runoff* runoff, Verdict* verdict);
 
 }  // namespace dgmm::sim2real

@@ -36,7 +36,7 @@ TEST(Runoff, ContendersAreTheFirstStepsSignificantKnobsRecordedTowardsTheirProbe
 
 TEST(Runoff, NamesAPlantedKnobAndReplacesAnotherName) {
   const Stages s = RunStages({{kFriction, 0.6}}, 4);
-  const Runoff r = RunRunoff(SharedFake(), s.in, s.set, s.refinement, s.options.candidates, Options(s));
+  Runoff r = RunRunoff(SharedFake(), s.in, s.set, s.refinement, s.options.candidates, Options(s));
   ASSERT_TRUE(r.ran) << r.why_not;
   ASSERT_TRUE(r.search.named) << r.search.why;
   EXPECT_EQ(r.search.knob_index, kFriction);
@@ -50,7 +50,7 @@ TEST(Runoff, NamesAPlantedKnobAndReplacesAnotherName) {
   latency.knob = "actuators.latency_s";
   v.named = {latency};
   v.sentence = "Partly explained: latency.";
-  AddRunoff(r, SharedFake(), &v);
+  AddRunoff(SharedFake(), &r, &v);
   EXPECT_EQ(v.status, "partly_explained");
   ASSERT_EQ(v.named.size(), 1u);
   EXPECT_EQ(v.named[0].knob, SharedFake().knobs()[kFriction].name);
@@ -72,7 +72,7 @@ TEST(Runoff, ARunoffThatNamesNothingLeavesTheNameWithItsDoubt) {
   VerdictNamed a;
   a.knob = "a";
   v.named = {a};
-  AddRunoff(r, SharedFake(), &v);
+  AddRunoff(SharedFake(), &r, &v);
   EXPECT_EQ(v.status, "partly_explained") << "a doubt the runoff raised is not explained";
   ASSERT_EQ(v.named.size(), 1u);
   ASSERT_FALSE(v.named[0].doubts.empty());
