@@ -30,6 +30,10 @@ std::string F(const char* fmt, double v) {
   return buf;
 }
 
+// The share of the nominal's misfit a named point removes. Above 1 the real samples fit the point's
+// model better than its recording's own unseen samples do: all of the misfit, not more than all.
+std::string MisfitRemoved(double share) { return share > 1 ? "all" : F("%.0f%%", 100 * share); }
+
 std::string Base64(const std::string& in) {
   static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -160,7 +164,7 @@ std::string PhysicsSection(const Analysis& a) {
                  : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
       << Escape(own->knob) << F(" = %.4g", own->value) << ": its recording fits the real samples "
       << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, no other "
-      << (runoff ? "contender's" : "leg's") << " as well, and it removes " << F("%.0f%%", 100 * own->gap_closed)
+      << (runoff ? "contender's" : "leg's") << " as well, and it removes " << MisfitRemoved(own->gap_closed)
       << " of the nominal's misfit. It has no bootstrap: inclusion is not computed.</p>\n";
   }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
@@ -213,7 +217,9 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   if (own) {
     o << "<p>Share of the nominal recording's misfit (" << F("%.3f", own->nominal_misfit)
       << " nats per sample: the real samples against the recording's own unseen samples) removed by "
-      << Escape(own->knob) << ": " << F("%.0f%%", 100 * own->gap_closed) << ". The corrected model is written as <code>"
+      << Escape(own->knob) << ": " << MisfitRemoved(own->gap_closed)
+      << (own->gap_closed > 1 ? " (the real samples fit its model better than its recording's own unseen samples)" : "")
+      << ". The corrected model is written as <code>"
       << Escape(ctx.corrected_model_file) << "</code>.</p>\n";
     return o.str();
   }
@@ -325,7 +331,7 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   }
   o << ", ceiling " << F("%.3f", a.baseline.ll_ceiling);
   if (own) {
-    o << " (" << F("%.0f%%", 100 * own->gap_closed) << " of the nominal recording's misfit removed)";
+    o << " (" << MisfitRemoved(own->gap_closed) << " of the nominal recording's misfit removed)";
   } else if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
     o << " (" << F("%.0f%%", 100 * a.adequacy.gap_closed) << " of the gap closed, SE " << F("%.0f%%", 100 * a.adequacy.gap_closed_se)
       << ")";

@@ -108,6 +108,15 @@ TEST(Report, ALegNamedByTheLegSearchIsOneStoryInEveryOutput) {
   EXPECT_NE(summary.find("corrected (weak leg1)"), std::string::npos) << summary;
   EXPECT_NE(summary.find("misfit removed"), std::string::npos) << summary;
   EXPECT_EQ(summary.find("of the gap closed"), std::string::npos) << summary;
+  // A point whose model fits the real samples better than its own recording's unseen samples
+  // removes all of the misfit, not 209% of it.
+  a.leg_search.gap_closed = 2.09;
+  const std::string html_all = ReportHtml(a, ctx, ".");
+  const std::string summary_all = ReportSummary(a, ctx, "out/report.html");
+  EXPECT_EQ(html_all.find("209%"), std::string::npos);
+  EXPECT_EQ(summary_all.find("209%"), std::string::npos) << summary_all;
+  EXPECT_NE(summary_all.find("(all of the nominal recording's misfit removed)"), std::string::npos) << summary_all;
+  EXPECT_NE(html_all.find("removes all of the nominal's misfit"), std::string::npos);
 }
 
 }  // namespace
