@@ -111,6 +111,10 @@ Correction LegSearchCorrection(const LegSearch& search);
 // well and the pinned flags.
 VerdictNamed SearchNamed(const LegSearch& search, const std::string& family, const std::string& unit);
 
+// When the named point removes under 90% of the nominal's misfit, the doubt that some mismatch
+// remains ("<subject> removes N% ..."); the same share marks the verdict's unexplained_present.
+void AddRemainingMismatchDoubt(const LegSearch& search, const std::string& subject, VerdictNamed* named);
+
 // The verdict's one story when a search named a knob: `named` alone, status partly_explained, its
 // doubts the verdict's, the gap closed the search's, the sentence written again.
 void ReplaceNamed(const LegSearch& search, const VerdictNamed& named, Verdict* verdict);

@@ -7,15 +7,16 @@
 namespace dgmm::sim2real {
 namespace {
 
+// Under this share of the nominal's misfit removed, some mismatch remains.
+constexpr double kMostOfTheMisfit = 0.9;
+
 VerdictNamed NamedLeg(const LegSearch& s) {
   VerdictNamed n = SearchNamed(s, "actuator_gain", "");
   n.doubts.push_back(Fmt("found by a search of every leg's gain (%.0f recordings, each scored by a model of its own, ",
                          static_cast<double>(s.points.size())) +
                      "its spread and falls included) after the probes' mean shifts named nothing: no bootstrap, its "
                      "range is the gains that fit as well");
-  if (s.gap_closed < 0.9) {
-    n.doubts.push_back(Fmt("the weak leg removes %.0f%% of the nominal's misfit: some mismatch remains", 100 * s.gap_closed));
-  }
+  AddRemainingMismatchDoubt(s, "the weak leg", &n);
   return n;
 }
 
@@ -35,13 +36,19 @@ VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const st
   return n;
 }
 
+void AddRemainingMismatchDoubt(const LegSearch& s, const std::string& subject, VerdictNamed* n) {
+  if (s.gap_closed < kMostOfTheMisfit) {
+    n->doubts.push_back(subject + Fmt(" removes %.0f%% of the nominal's misfit: some mismatch remains", 100 * s.gap_closed));
+  }
+}
+
 void ReplaceNamed(const LegSearch& s, const VerdictNamed& n, Verdict* v) {
   v->status = "partly_explained";
   v->named = {n};
   v->doubts = n.doubts;
   v->weak.clear();
   v->gap_closed = s.gap_closed;
-  v->unexplained_present = s.gap_closed < 0.9;
+  v->unexplained_present = s.gap_closed < kMostOfTheMisfit;
   v->sentence = VerdictSentence(*v, nullptr, nullptr, nullptr);
 }
 

@@ -121,9 +121,7 @@ void AddRunoff(const KnobSimulator& simulator, Runoff* runoff, Verdict* v) {
   n.doubts.push_back("found by a runoff on uneven ground (" + list +
                      ") after the probes' mean shifts: no bootstrap, its range is the values that fit as well" +
                      (before.empty() || before == k.name ? "" : "; the mean shifts had named " + before));
-  if (s.gap_closed < 0.9) {
-    n.doubts.push_back(Fmt("it removes %.0f%% of the nominal's misfit: some mismatch remains", 100 * s.gap_closed));
-  }
+  AddRemainingMismatchDoubt(s, "it", &n);
   v->ties.clear();
   ReplaceNamed(s, n, v);
   v->sentence += " " + k.name + Fmt(" at %.3g fits the real samples %.3g nats per sample better than the nominal ",
