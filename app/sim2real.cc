@@ -43,7 +43,7 @@ struct Sim2RealArgs {
   bool leg_search = true;
   bool runoff = true;
   std::string leg_search_score = "sag";
-  std::string leg_search_on = "unexplained";
+  std::string leg_search_on = "remaining";
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -143,6 +143,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.runoff.enabled = args.runoff;
   o.legs.sag_mode = args.leg_search_score == "sag";
   o.legs.only_with_tails = args.leg_search_on == "tails";
+  o.legs.challenge_named = args.leg_search_on == "remaining";
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -298,9 +299,11 @@ void Setup(CLI::App& root) {
                   "robust (its own model with a broad component; docs/sim2real.md)")
       ->capture_default_str()->check(CLI::IsMember({"robust", "sag"}));
   cmd->add_option("--leg-search-on", args->leg_search_on,
-                  "when the leg search runs (nothing named either way): tails (the residual has heavy tails) or "
-                  "unexplained (any located mismatch left)")
-      ->capture_default_str()->check(CLI::IsMember({"tails", "unexplained"}));
+                  "when the leg search runs: remaining (nothing named and a located mismatch left, or, on a plane, "
+                  "knobs but no leg named and the corrected model below the ceiling: a leg then replaces them only "
+                  "when it fits better), unexplained (only when nothing is named) or tails (only when nothing is "
+                  "named and the residual has heavy tails)")
+      ->capture_default_str()->check(CLI::IsMember({"tails", "unexplained", "remaining"}));
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
                "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");

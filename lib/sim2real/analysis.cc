@@ -30,10 +30,22 @@ std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement
   return out;
 }
 
+// A challenge of named knobs (LegSearchOptions::challenge_named): on a plane (on uneven ground the
+// runoff scores contenders by their own models), knobs named, none of them a leg's, and the
+// corrected model still below the real-trained ceiling.
+bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
+  if (!options.challenge_named || a.baseline.permute_placements) return false;
+  if (a.verdict.status == "explained" || !a.adequacy.below_ceiling) return false;
+  return std::none_of(a.naming.named.begin(), a.naming.named.end(),
+                      [&](int c) { return !a.candidates.candidates[c].leg.empty(); });
+}
+
 // The leg search runs when the stages before named nothing for a located mismatch whose residual
 // has heavy tails (or any residual structure, when the options do not ask for tails).
 bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
-  if (!options.enabled || !a.naming.named.empty() || a.verdict.status != "unexplained") return false;
+  if (!options.enabled) return false;
+  if (!a.naming.named.empty()) return WantChallenge(a, options);
+  if (a.verdict.status != "unexplained") return false;
   const auto& in = a.adequacy.residual.structured_in;
   return !options.only_with_tails || std::find(in.begin(), in.end(), "tails") != in.end();
 }
@@ -63,6 +75,11 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     LegSearchOptions legs = options.legs;
     legs.model = options.locate.model;
     a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs);
+    if (!a->naming.named.empty()) {
+      std::vector<std::string> named;
+      for (const VerdictNamed& n : a->verdict.named) named.push_back(n.knob);
+      LegSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, legs, &a->leg_search);
+    }
     AddLegSearch(a->leg_search, &a->verdict);
     a->seconds.legs = Since(t);
   }

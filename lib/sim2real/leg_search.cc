@@ -246,6 +246,7 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
     out->why = "";
   }
   out->best_model = state->scored[out->best].model;
+  out->best_rows = state->scored[out->best].rows;
   out->best_plain = out->best_model.LogLikelihood(in.real).mean();
   out->log_var =
       (ResidualVariance(state->scored[out->best]).array() / ResidualVariance(state->nominal).array()).log().matrix();
@@ -355,6 +356,25 @@ LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& i
     for (double v : GridValues(simulator.knobs()[k], options.factors)) grid.push_back({k, v});
   }
   return SearchOwnModels(simulator, in, set, recording, options, grid);
+}
+
+void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named, const Eigen::VectorXd& corrected,
+                        const LegSearchOptions& options, LegSearch* s) {
+  s->challenged = named;
+  if (!s->ran || s->best < 0 || corrected.size() != in.real.size() || s->best_rows.size() != in.real.size()) return;
+  // The correction with the floor the search's score gives every sample: its broad component.
+  const double e = options.sag.broad_share;
+  const Eigen::VectorXd broad = BroadLogDensity(MakeSagReference(in.sim, options.model), in.real, options.sag);
+  Eigen::VectorXd floored(corrected.size());
+  for (int i = 0; i < corrected.size(); ++i) {
+    const double a = std::log1p(-e) + corrected(i), b = std::log(e) + broad(i), top = std::max(a, b);
+    floored(i) = top + std::log(std::exp(a - top) + std::exp(b - top));
+  }
+  s->z_vs_named = PairedZ(s->best_rows, floored, in.real.episode);
+  if (!s->named || s->z_vs_named >= options.z) return;
+  s->named = false;
+  s->why = "its best point (" + s->leg + Fmt(" at gain %.3g) fits the real samples no better than the named knobs' ", s->value) +
+           Fmt("correction (%.3g against %.3g nats per sample, z %.2f)", s->best_rows.mean(), floored.mean(), s->z_vs_named);
 }
 
 Correction LegSearchCorrection(const LegSearch& search) {

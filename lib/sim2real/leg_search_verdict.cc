@@ -12,10 +12,13 @@ constexpr double kMostOfTheMisfit = 0.9;
 
 VerdictNamed NamedLeg(const LegSearch& s) {
   VerdictNamed n = SearchNamed(s, "actuator_gain", "");
+  const std::string after = s.challenged.empty()
+                                ? "after the probes' mean shifts named nothing"
+                                : "after the probes' mean shifts named " + JoinWords(s.challenged) +
+                                      Fmt(", which it fits the real samples better than (z %.1f)", s.z_vs_named);
   n.doubts.push_back(Fmt("found by a search of every leg's gain (%.0f recordings, each scored by a model of its own, ",
                          static_cast<double>(s.points.size())) +
-                     "its spread and falls included) after the probes' mean shifts named nothing: no bootstrap, its "
-                     "range is the gains that fit as well");
+                     "its spread and falls included) " + after + ": no bootstrap, its range is the gains that fit as well");
   AddRemainingMismatchDoubt(s, "the weak leg", &n);
   return n;
 }

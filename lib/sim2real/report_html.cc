@@ -206,7 +206,8 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
     o << "<tr><td>(b) corrected (" << (own->by == "runoff" ? "the runoff's named knob" : "the weak leg of the leg search")
-      << ", its recording's own model)</td><td>" << F("%.3f", own->best_plain) << "</td></tr>";
+      << ", its recording's own model under the search's score: sags and a broad floor included)</td><td>"
+      << F("%.3f", BestScore(*own)) << "</td></tr>";
   } else if (a.knobs_analysed) {
     o << "<tr><td>(b) corrected (the knob correction)</td><td>" << F("%.3f", a.adequacy.ll_corrected) << "</td></tr>";
   }
@@ -325,7 +326,7 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
-    o << ", corrected (" << (own->by == "runoff" ? own->knob : "weak " + own->leg) << ") " << F("%.3f", own->best_plain);
+    o << ", corrected (" << (own->by == "runoff" ? own->knob : "weak " + own->leg) << ") " << F("%.3f", BestScore(*own));
   } else if (a.knobs_analysed) {
     o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);
   }

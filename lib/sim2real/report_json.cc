@@ -153,7 +153,7 @@ json FitJson(const Analysis& a) {
   const LegSearch* own = NamedByOwnModels(a);
   const LegSearch& l = own ? *own : a.leg_search;
   const bool leg = own != nullptr;
-  const json corrected = leg ? JsonNumber(l.best_plain)
+  const json corrected = leg ? JsonNumber(BestScore(l))
                              : a.knobs_analysed ? JsonNumber(a.adequacy.ll_corrected) : json(nullptr);
   return {{"heldout_log_likelihood_per_sample",
            {{"sim", b.ll_sim}, {"corrected", corrected},
@@ -176,8 +176,8 @@ json LegSearchJson(const LegSearch& l) {
           {"nominal_score", JsonNumber(l.nominal_score)}, {"nominal_misfit", JsonNumber(l.nominal_misfit)},
           {"best_misfit", JsonNumber(l.best_misfit)},
           {"best_plain_score", JsonNumber(l.best_plain)}, {"z_vs_nominal", JsonNumber(l.z_vs_nominal)},
-          {"gap_closed", JsonNumber(l.gap_closed)},
-          {"legs_as_well", l.legs_as_well}, {"fits_as_well", SearchSpanJson(l.as_well)}, {"points", points},
+          {"gap_closed", JsonNumber(l.gap_closed)}, {"challenged", l.challenged},
+          {"z_vs_named", JsonNumber(l.z_vs_named)}, {"legs_as_well", l.legs_as_well}, {"fits_as_well", SearchSpanJson(l.as_well)}, {"points", points},
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 

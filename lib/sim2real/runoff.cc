@@ -43,12 +43,6 @@ double ProbeOnTheReadingsSide(const CandidateSet& set, const Refinement& r, int 
   return 2 * knob.nominal - knob.probes.front();
 }
 
-std::string Join(const std::vector<std::string>& words) {
-  std::string out;
-  for (size_t j = 0; j < words.size(); ++j) out += (j == 0 ? "" : j + 1 == words.size() ? " and " : ", ") + words[j];
-  return out;
-}
-
 }  // namespace
 
 bool RunoffOptions::IsValid(std::string* error) const {
@@ -104,7 +98,7 @@ void AddRunoff(const KnobSimulator& simulator, Runoff* runoff, Verdict* v) {
   runoff->named_before = v->named.empty() ? "" : v->named.front().knob;
   const LegSearch& s = runoff->search;
   const std::string list = Fmt("%.0f recordings of ", static_cast<double>(s.points.size())) +
-                           Join(runoff->contenders) + ", each scored by a model of its own";
+                           JoinWords(runoff->contenders) + ", each scored by a model of its own";
   if (!s.named) {
     const std::string doubt = "on this uneven ground a runoff (" + list + ") names no knob: " + s.why;
     if (!v->named.empty()) {

@@ -83,4 +83,12 @@ Eigen::VectorXd SagLogLikelihood(const SagModel& m, const SagReference& ref, con
   return out;
 }
 
+Eigen::VectorXd BroadLogDensity(const SagReference& ref, const Samples& s, const SagOptions& options) {
+  const Deviations dev = Deviate(ref, s);
+  const Gaussian broad = Broad(ref, options);
+  Eigen::VectorXd out(s.size());
+  for (int i = 0; i < s.size(); ++i) out(i) = broad.LogDensity(dev.r.row(i).transpose());
+  return out;
+}
+
 }  // namespace dgmm::sim2real

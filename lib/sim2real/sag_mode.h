@@ -50,4 +50,8 @@ SagModel FitSagModel(const Samples& s, const std::vector<int>& rows, const SagRe
 Eigen::VectorXd SagLogLikelihood(const SagModel& m, const SagReference& ref, const Samples& s,
                                  const SagOptions& options);
 
+// The broad component alone, log N(x_i - ref(c_i, z_i); 0, k^2 S) per sample of s: the floor that
+// SagLogLikelihood gives every sample, for scoring another model with the same floor.
+Eigen::VectorXd BroadLogDensity(const SagReference& ref, const Samples& s, const SagOptions& options);
+
 }  // namespace dgmm::sim2real

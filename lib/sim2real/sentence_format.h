@@ -1,8 +1,9 @@
 #pragma once
 // Internal to dgmm_sim2real: printf-style formatting of up to three numbers for the sentences of
-// the conclusion and the verdict (one definition for pipeline.cc, knob_analysis.cc, verdict.cc).
+// the conclusion and the verdict and lists of words.
 #include <cstdio>
 #include <string>
+#include <vector>
 
 namespace dgmm::sim2real {
 
@@ -11,6 +12,13 @@ inline std::string Fmt(const char* f, double a, double b = 0, double c = 0) {
   char buf[400];
   std::snprintf(buf, sizeof buf, f, a, b, c);
   return buf;
+}
+
+// "a", "a and b", "a, b and c".
+inline std::string JoinWords(const std::vector<std::string>& words) {
+  std::string out;
+  for (size_t j = 0; j < words.size(); ++j) out += (j == 0 ? "" : j + 1 == words.size() ? " and " : ", ") + words[j];
+  return out;
 }
 
 }  // namespace dgmm::sim2real

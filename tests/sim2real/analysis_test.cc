@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include <nlohmann/json.hpp>
 
@@ -81,6 +82,38 @@ TEST(Analysis, TheLegSearchRunsOnlyWhenNothingIsNamed) {
   EXPECT_EQ(tails_only.leg_search.ran, tails && tails_only.naming.named.empty()) << tails_only.verdict.sentence;
   options.legs.enabled = false;
   EXPECT_FALSE(Analyse(pair.sim, pair.real, &Fake(), options).leg_search.ran);
+}
+
+// With challenge_named (the default; --leg-search-on remaining) the leg search also runs when knobs
+// but no leg were named and the correction stays below the ceiling; the named knobs give way only
+// to a leg that fits better, and the verdict tells one story either way.
+TEST(Analysis, TheLegSearchChallengesNamedKnobsWhenAMismatchIsLeft) {
+  FakeExtras extras;
+  extras.geometry = 0.03;
+  const auto pair = test::MakeFakePair(Fake(), {{test::kFriction, 0.6}}, extras);
+  AnalysisOptions options = test::FastOptions();
+  ASSERT_TRUE(options.legs.challenge_named) << "on by default";
+  options.legs.challenge_named = false;
+  const Analysis plain = Analyse(pair.sim, pair.real, &Fake(), options);
+  ASSERT_FALSE(plain.naming.named.empty()) << plain.verdict.sentence;
+  ASSERT_TRUE(plain.adequacy.below_ceiling) << plain.verdict.sentence;
+  EXPECT_FALSE(plain.leg_search.ran) << "knobs were named: no search without the challenge";
+  options.legs.challenge_named = true;
+  const Analysis a = Analyse(pair.sim, pair.real, &Fake(), options);
+  ASSERT_TRUE(a.leg_search.ran) << a.verdict.sentence;
+  std::vector<std::string> before;
+  for (const VerdictNamed& n : plain.verdict.named) before.push_back(n.knob);
+  EXPECT_EQ(a.leg_search.challenged, before);
+  EXPECT_TRUE(std::isfinite(a.leg_search.z_vs_named)) << a.leg_search.why;
+  if (a.leg_search.named) {
+    EXPECT_GE(a.leg_search.z_vs_named, options.legs.z);
+    ASSERT_EQ(a.verdict.named.size(), 1u);
+    EXPECT_EQ(a.verdict.named[0].knob, a.leg_search.knob);
+  } else {
+    EXPECT_EQ(a.verdict.named.size(), plain.verdict.named.size()) << a.verdict.sentence;
+    EXPECT_EQ(a.verdict.named[0].knob, plain.verdict.named[0].knob);
+    EXPECT_NE(a.verdict.sentence.find("names no leg"), std::string::npos) << a.verdict.sentence;
+  }
 }
 
 // On uneven ground a mismatch left after the mean shifts gets a runoff of the first step's

@@ -104,6 +104,45 @@ TEST(LegSearch, ALegNamedByNoneIsSaidWithWhy) {
   EXPECT_NE(v.sentence.find("names no leg: " + r.why), std::string::npos) << v.sentence;
 }
 
+// A challenge of knobs named before the search (LegSearchOptions::challenge_named): the weak leg
+// keeps its name only when its recording fits the real samples better than their correction did.
+TEST(LegSearch, AChallengedNameGivesWayOnlyToALegThatFitsBetter) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  const std::vector<std::string> before = {"tracker.yaw_drift", "bodies.mass_scale"};
+  LegSearch poor = Search(s);
+  ASSERT_TRUE(poor.named) << poor.why;
+  // A correction no better than the nominal recording's model: the leg wins, and the verdict says
+  // what it replaced.
+  LegSearchChallenge(s.in, before, poor.nominal_model.LogLikelihood(s.in.real), Options(s), &poor);
+  EXPECT_TRUE(poor.named) << poor.why;
+  EXPECT_GT(poor.z_vs_named, 2.0);
+  EXPECT_EQ(poor.challenged, before);
+  Verdict v;
+  v.status = "partly_explained";
+  v.sentence = "Simulator knobs and measurement effects, in order of evidence: (1) heading_drift.";
+  AddLegSearch(poor, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "actuators.leg1.gain");
+  EXPECT_EQ(v.sentence.find("heading_drift ("), std::string::npos) << "one story: " << v.sentence;
+  EXPECT_NE(v.named[0].doubts[0].find("named tracker.yaw_drift and bodies.mass_scale"), std::string::npos)
+      << v.named[0].doubts[0];
+  // A correction that fits every real sample better than the leg's recording: the leg gives way.
+  LegSearch good = Search(s);
+  const Eigen::VectorXd better = good.best_rows.array() + 1.0;
+  LegSearchChallenge(s.in, before, better, Options(s), &good);
+  EXPECT_FALSE(good.named);
+  EXPECT_LT(good.z_vs_named, 0);
+  EXPECT_NE(good.why.find("no better than the named knobs' correction"), std::string::npos) << good.why;
+  Verdict kept;
+  kept.status = "partly_explained";
+  kept.named.resize(1);
+  kept.named[0].knob = "tracker.yaw_drift";
+  AddLegSearch(good, &kept);
+  ASSERT_EQ(kept.named.size(), 1u);
+  EXPECT_EQ(kept.named[0].knob, "tracker.yaw_drift");
+  EXPECT_NE(kept.sentence.find("names no leg: " + good.why), std::string::npos) << kept.sentence;
+}
+
 // The other score (a broad component instead of the default sag mode) on the same fake: a planted
 // weak leg is named with its gain, a nominal robot names none, and the answer does not depend on
 // the thread count.
