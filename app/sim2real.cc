@@ -287,9 +287,9 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
   cmd->add_flag("--leg-search,!--no-leg-search", args->leg_search,
-                "when nothing is named and a mismatch is left, search every leg's gain with recordings scored by "
-                "their own model (three per leg and two more, 5 executions per placement; on by default, "
-                "--no-leg-search turns it off; docs/sim2real.md)");
+                "when a mismatch is left that no leg explains (see --leg-search-on), search every leg's gain with "
+                "recordings scored by their own model (three per leg and two more, 5 executions per placement; on "
+                "by default, --no-leg-search turns it off; docs/sim2real.md)");
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "
