@@ -41,7 +41,8 @@ bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
 }
 
 // The leg search runs when the stages before named nothing for a located mismatch whose residual
-// has heavy tails (or any residual structure, when the options do not ask for tails).
+// has heavy tails (or any residual structure, when the options do not ask for tails), or, as a
+// challenge, when they named knobs but no leg (WantChallenge).
 bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
   if (!options.enabled) return false;
   if (!a.naming.named.empty()) return WantChallenge(a, options);

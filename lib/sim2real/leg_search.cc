@@ -26,6 +26,12 @@ struct Scored {
   bool walkable = true;
 };
 
+// log(exp(a) + exp(b)) without overflow.
+double LogAddExp(double a, double b) {
+  const double top = std::max(a, b);
+  return top + std::log(std::exp(a - top) + std::exp(b - top));
+}
+
 // log of (1 - e) N(x; m, S) + e N(x; m, k^2 S) for every sample of s.
 Eigen::VectorXd RobustLogLikelihood(const LinearGaussianModel& model, const Samples& s, double e, double k) {
   Eigen::VectorXd out(s.size());
@@ -36,8 +42,7 @@ Eigen::VectorXd RobustLogLikelihood(const LinearGaussianModel& model, const Samp
     const double base = -0.5 * (d * std::log(2 * M_PI) + p.log_det);
     const double core = std::log1p(-e) + base - 0.5 * m;
     const double broad = std::log(e) + base - d * std::log(k) - 0.5 * m / (k * k);
-    const double top = std::max(core, broad);
-    out(i) = top + std::log(std::exp(core - top) + std::exp(broad - top));
+    out(i) = LogAddExp(core, broad);
   }
   return out;
 }
@@ -366,10 +371,7 @@ void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>
   const double e = options.sag.broad_share;
   const Eigen::VectorXd broad = BroadLogDensity(MakeSagReference(in.sim, options.model), in.real, options.sag);
   Eigen::VectorXd floored(corrected.size());
-  for (int i = 0; i < corrected.size(); ++i) {
-    const double a = std::log1p(-e) + corrected(i), b = std::log(e) + broad(i), top = std::max(a, b);
-    floored(i) = top + std::log(std::exp(a - top) + std::exp(b - top));
-  }
+  for (int i = 0; i < corrected.size(); ++i) floored(i) = LogAddExp(std::log1p(-e) + corrected(i), std::log(e) + broad(i));
   s->z_vs_named = PairedZ(s->best_rows, floored, in.real.episode);
   if (!s->named || s->z_vs_named >= options.z) return;
   s->named = false;
