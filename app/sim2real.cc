@@ -32,6 +32,7 @@ struct Sim2RealArgs {
   std::string sim, real, out, sim_config, cache;
   int signature_placements = sim2real::CandidateOptions{}.placements;  // the library's defaults
   int signature_executions = sim2real::CandidateOptions{}.executions_per_placement;
+  bool step_drift_recheck = sim2real::AnalysisOptions{}.every_execution_on_step_drift;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
@@ -137,6 +138,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.locate.locate.mmd.permutations = args.permutations;
   o.candidates.placements = args.signature_placements;
   o.candidates.executions_per_placement = args.signature_executions;
+  o.every_execution_on_step_drift = args.step_drift_recheck;
   o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
@@ -284,6 +286,10 @@ void Setup(CLI::App& root) {
                   "executions per placement of a signature recording (2: 0.44 of the paper protocol's 5 in "
                   "time; 5 decides near-ties between knobs better, docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(2, 100));
+  cmd->add_flag("--step-drift-recheck,!--no-step-drift-recheck", args->step_drift_recheck,
+                "when an effect fits on average but its size varies with the execution index and the signatures "
+                "recorded fewer executions per placement than the real set has, record them again with every "
+                "execution and analyse once more (on by default; docs/sim2real.md)");
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
   cmd->add_flag("--leg-search,!--no-leg-search", args->leg_search,

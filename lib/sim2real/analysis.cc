@@ -51,6 +51,31 @@ bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
   return !options.only_with_tails || std::find(in.begin(), in.end(), "tails") != in.end();
 }
 
+// Stages 3 to 8 (candidates to verdict) on the inputs and baseline in `a`.
+template <typename Stage>
+void KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
+  auto t = Clock::now();
+  stage("candidates (knob signatures)");
+  a->candidates = BuildCandidates(simulator, a->inputs, a->baseline, options.candidates);
+  a->seconds.candidates += Since(t), t = Clock::now();
+  stage("selection and refinement");
+  a->refinement = SelectAndRefine(simulator, a->inputs, a->baseline, options.candidates, options.refine, &a->candidates);
+  a->seconds.refine += Since(t), t = Clock::now();
+  stage("confidence (bootstrap)");
+  std::mt19937_64 rng(options.seed + 1);
+  a->confidence = AssessConfidence(a->candidates, a->refinement, rng);
+  a->seconds.confidence += Since(t), t = Clock::now();
+  stage("adequacy");
+  a->adequacy = AssessAdequacy(a->inputs, a->baseline, a->candidates, a->refinement, options.adequacy);
+  a->naming = DecideNamed(a->candidates, a->refinement, a->confidence, a->adequacy, options.verdict);
+  a->seconds.adequacy += Since(t), t = Clock::now();
+  stage("ties and experiment checks");
+  a->ties = FindTies(&simulator, a->inputs, a->baseline, a->candidates, a->refinement, a->naming.named, options.ties);
+  a->seconds.ties += Since(t);
+  a->verdict = ComposeVerdict(a->baseline, a->candidates, a->refinement, a->confidence, a->adequacy, a->naming,
+                              a->ties, options.verdict);
+}
+
 // The runoff runs on uneven ground when the stages before left a mismatch: something named but
 // not explained, or nothing named for a located mismatch.
 bool WantRunoff(const Analysis& a, const RunoffOptions& options) {
@@ -98,6 +123,26 @@ const LegSearch* NamedByOwnModels(const Analysis& a) {
   return a.runoff.search.named ? &a.runoff.search : a.leg_search.named ? &a.leg_search : nullptr;
 }
 
+// The largest execution index of a placement in the real set, plus one (0 without sequence data).
+int RealExecutionsPerPlacement(const AnalysisInputs& in) {
+  if (!in.real.has_sequence || !in.real_set.has_sequence()) return 0;
+  int most = -1;
+  for (int i = 0; i < in.real.size(); ++i) most = std::max(most, in.real_set.step(in.real_source_row[i]));
+  return most + 1;
+}
+
+std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options) {
+  const int signature = options.candidates.executions_per_placement;
+  const int real = RealExecutionsPerPlacement(a.inputs);
+  if (!options.every_execution_on_step_drift || signature == 0 || real <= signature) return "";
+  for (const VerdictDrifting& d : a.verdict.drifting) {
+    if (d.along != "execution index") continue;
+    return d.knob + "'s fitted size varied with the execution index, and the signatures had recorded " +
+           std::to_string(signature) + " of the real set's " + std::to_string(real) + " executions per placement";
+  }
+  return "";
+}
+
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
                  const AnalysisOptions& options, const std::string& no_simulator_reason) {
   std::string error;
@@ -118,26 +163,18 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
     return a;
   }
   a.knobs_analysed = true;
-  auto t = Clock::now();
-  stage("candidates (knob signatures)");
-  a.candidates = BuildCandidates(*simulator, a.inputs, a.baseline, options.candidates);
-  a.seconds.candidates = Since(t), t = Clock::now();
-  stage("selection and refinement");
-  a.refinement = SelectAndRefine(*simulator, a.inputs, a.baseline, options.candidates, options.refine, &a.candidates);
-  a.seconds.refine = Since(t), t = Clock::now();
-  stage("confidence (bootstrap)");
-  std::mt19937_64 rng(options.seed + 1);
-  a.confidence = AssessConfidence(a.candidates, a.refinement, rng);
-  a.seconds.confidence = Since(t), t = Clock::now();
-  stage("adequacy");
-  a.adequacy = AssessAdequacy(a.inputs, a.baseline, a.candidates, a.refinement, options.adequacy);
-  a.naming = DecideNamed(a.candidates, a.refinement, a.confidence, a.adequacy, options.verdict);
-  a.seconds.adequacy = Since(t), t = Clock::now();
-  stage("ties and experiment checks");
-  a.ties = FindTies(simulator, a.inputs, a.baseline, a.candidates, a.refinement, a.naming.named, options.ties);
-  a.seconds.ties = Since(t);
-  a.verdict = ComposeVerdict(a.baseline, a.candidates, a.refinement, a.confidence, a.adequacy, a.naming, a.ties,
-                             options.verdict);
+  KnobStages(*simulator, options, stage, &a);
+  a.every_execution_because = EveryExecutionBecause(a, options);
+  if (!a.every_execution_because.empty()) {
+    AnalysisOptions every = options;
+    every.candidates.executions_per_placement = RealExecutionsPerPlacement(a.inputs);
+    // The recordings of both runs are counted.
+    const int recorded = a.candidates.recorded, from_cache = a.candidates.from_cache, requests = a.candidates.requests;
+    const int refined = a.refinement.recorded, refined_from_cache = a.refinement.from_cache;
+    KnobStages(*simulator, every, stage, &a);
+    a.candidates.recorded += recorded, a.candidates.from_cache += from_cache, a.candidates.requests += requests;
+    a.refinement.recorded += refined, a.refinement.from_cache += refined_from_cache;
+  }
   SearchByOwnModels(*simulator, options, stage, &a);
   if (const LegSearch* own = NamedByOwnModels(a)) {
     a.correction = LegSearchCorrection(*own);

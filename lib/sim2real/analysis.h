@@ -9,7 +9,9 @@
 //   6. adequacy    (adequacy.h)      locate again on the correction, the fit against the ceiling,
 //                                    values pinned or impossible, residual structure and drift;
 //   7. ties        (ties.h)          what the data cannot tell apart, and the experiment that would;
-//   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence;
+//   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence; 3-8 once more
+//                                    with every execution's signatures when an effect's size
+//                                    varied with the execution index;
 //      runoff      (runoff.h)        on uneven ground with a mismatch left: the first step's contenders
 //                                    recorded again, each recording scored by its own model;
 //      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
@@ -38,6 +40,10 @@ struct AnalysisOptions {
   VerdictOptions verdict;
   LegSearchOptions legs;   // its model options are the baseline's (locate.model)
   RunoffOptions runoff;    // likewise
+  // When an effect fits on average but its size varies with the execution index and the
+  // signatures recorded fewer executions per placement than the real set has, stages 3-8 run
+  // again with signatures of every execution (Analysis::every_execution_because).
+  bool every_execution_on_step_drift = true;
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };
@@ -51,6 +57,9 @@ struct Analysis {
   Baseline baseline;
   bool knobs_analysed = false;     // false: locate only (no simulator)
   std::string locate_only_because;
+  // Why stages 3-8 ran again with signatures of every execution per placement (empty: they did
+  // not); the stages' results are the second run's.
+  std::string every_execution_because;
   CandidateSet candidates;
   Refinement refinement;
   Confidence confidence;
@@ -70,6 +79,16 @@ struct Analysis {
 // The search that named the verdict's knob by recordings scored with their own models (the runoff,
 // else the leg search), or nullptr when the knob path's correction stands.
 const LegSearch* NamedByOwnModels(const Analysis& a);
+
+// Why stages 3-8 run again with signatures of every execution of a placement (empty: they do
+// not): an effect fits on average but its size varies with the execution index, and the
+// signatures were recorded with fewer executions per placement than the real set has. A knob can
+// act differently in a placement's first executions than in its later ones (the hexapod's
+// payload most in the first, docs/sim2real.md); a signature that never saw the later ones reads
+// that profile as a drift. The run again records as many executions as the real set has.
+std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options);
+// The largest execution index of a placement in the real set, plus one (0 without sequence data).
+int RealExecutionsPerPlacement(const AnalysisInputs& in);
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
                  const AnalysisOptions& options, const std::string& no_simulator_reason = "");

@@ -277,6 +277,11 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
     o << "</table>\n<p>Recordings: " << a.candidates.recorded << " for the signatures (" << a.candidates.from_cache
       << " from the cache), " << a.refinement.recorded << " for the refinement; " << a.ties.experiment_checks
       << " experiment checks.</p>\n";
+    if (!a.every_execution_because.empty()) {
+      o << "<p>The signatures were recorded again with every execution of a placement, and the analysis from them "
+           "is the one reported: "
+        << Escape(a.every_execution_because) << ".</p>\n";
+    }
   }
   if (a.runoff.ran) {
     o << LegSearchTable(a.runoff.search, "Runoff of the first step's contenders on uneven ground (each recording scored "
@@ -338,6 +343,9 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
       << ")";
   }
   o << "\n";
+  if (!a.every_execution_because.empty()) {
+    o << "signatures recorded again with every execution of a placement: " << a.every_execution_because << "\n";
+  }
   for (const auto& n : ctx.notes) o << "note: " << n << "\n";
   if (!ctx.recalibrated_config_file.empty()) o << "config at the named values: " << ctx.recalibrated_config_file << "\n";
   o << "report: " << report_path << "\n";

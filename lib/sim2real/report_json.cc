@@ -105,7 +105,8 @@ json KnobsJson(const Analysis& a) {
                           {"signature_requests", set.requests}, {"refinement", r.recorded},
                           {"refinement_from_cache", r.from_cache}}},
           {"placements_per_recording", set.recording.placements},
-          {"executions_per_placement", set.recording.executions_per_placement}};
+          {"executions_per_placement", set.recording.executions_per_placement},
+          {"every_execution_because", a.every_execution_because.empty() ? json(nullptr) : json(a.every_execution_because)}};
   if (set.spread_signatures) {  // --spread-signatures (experimental): the fitted per-axis log variance ratio
     out["spread_signatures"] = {{"on", true}, {"fitted_log_variance_ratio", Vec(r.selection.fit.log_var)}};
   }

@@ -188,3 +188,38 @@ TEST(Analysis, WithoutASimulatorItOnlyLocates) {
 
 }  // namespace
 }  // namespace dgmm::sim2real
+
+namespace dgmm::sim2real {
+namespace {
+
+// Stages 3-8 run again with every execution's signatures only when an effect's size varied with
+// the execution index and the signatures had recorded fewer executions than the real set has.
+TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
+  const auto pair = test::MakeFakePair(Fake(), {});
+  Analysis a;
+  a.inputs = PrepareInputs(pair.sim, pair.real, 1);
+  const int real = RealExecutionsPerPlacement(a.inputs);
+  ASSERT_GE(real, 2) << "the fake's protocol records several executions per placement";
+  AnalysisOptions options = test::FastOptions();
+  options.candidates.executions_per_placement = real - 1;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "nothing drifts";
+  VerdictDrifting drift;
+  drift.knob = "payload.mass_kg", drift.along = "session order";
+  a.verdict.drifting = {drift};
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "a drift over the session is not the execution index's";
+  a.verdict.drifting[0].along = "execution index";
+  const std::string why = EveryExecutionBecause(a, options);
+  EXPECT_NE(why.find("payload.mass_kg"), std::string::npos) << why;
+  EXPECT_NE(why.find(std::to_string(real - 1) + " of the real set's " + std::to_string(real)), std::string::npos)
+      << why;
+  options.candidates.executions_per_placement = real;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "the signatures saw every execution";
+  options.candidates.executions_per_placement = 0;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "0: the protocol's own number";
+  options.candidates.executions_per_placement = 1;
+  options.every_execution_on_step_drift = false;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "turned off";
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real
