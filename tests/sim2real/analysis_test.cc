@@ -223,3 +223,37 @@ TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
 
 }  // namespace
 }  // namespace dgmm::sim2real
+
+namespace dgmm::sim2real {
+namespace {
+
+// End to end on the fake: its latency acts in the first execution after a command change only.
+// Signatures of one execution per placement see nothing else, so the fitted latency's size varies
+// with the execution index of the real set's five; the step-drift recheck records them again with
+// five and names the latency, which the single-execution analysis alone does not.
+TEST(Analysis, TheStepDriftRecheckNamesWhatFewSignatureExecutionsReadAsADrift) {
+  FakeSimulator fake;
+  fake.honour_executions = true;
+  const auto pair = test::MakeFakePair(fake, {{test::kLatency, 0.04}});
+  AnalysisOptions options = test::FastOptions();
+  options.candidates.executions_per_placement = 1;
+  options.every_execution_on_step_drift = false;
+  const Analysis once = Analyse(pair.sim, pair.real, &fake, options);
+  options.every_execution_on_step_drift = true;
+  const Analysis again = Analyse(pair.sim, pair.real, &fake, options);
+  auto latency = [](const Analysis& a) {
+    for (const auto& n : a.verdict.named) {
+      if (n.knob == "actuators.latency_s") return n.value;
+    }
+    return -1.0;
+  };
+  EXPECT_LT(latency(once), 0) << once.verdict.sentence;
+  EXPECT_EQ(once.every_execution_because, "");
+  EXPECT_NE(again.every_execution_because.find("actuators.latency_s"), std::string::npos)
+      << again.every_execution_because;
+  EXPECT_NEAR(latency(again), 0.04, 0.25 * 0.04) << again.verdict.sentence;
+  EXPECT_EQ(again.candidates.recording.executions_per_placement, 5);
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real

@@ -137,7 +137,8 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
     std::snprintf(label, sizeof label, "%+.1f,%+.1f,%+.1f", s.commands(c, 0), s.commands(c, 1), s.commands(c, 2));
     s.command_labels.push_back(label);
   }
-  const int n = 5 * placements;
+  const int executions = honour_executions && recording.executions_per_placement > 0 ? recording.executions_per_placement : 5;
+  const int n = executions * placements;
   s.command.resize(n), s.episode.resize(n), s.step.resize(n);
   s.x.resize(n, 3), s.z.resize(n, 2);
   std::mt19937_64 rng;
@@ -152,8 +153,8 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
       std::normal_distribution<double> place(0, ground_sd);
       for (int j = 0; j < 3; ++j) stands(j) = kNoiseSd(j) * place(ground);
     }
-    for (int e = 0; e < 5; ++e) {
-      const int i = 5 * p + e;
+    for (int e = 0; e < executions; ++e) {
+      const int i = executions * p + e;
       const double pitch = kSlopeRad * std::cos(heading) + 0.02 * unit(rng);
       const double roll = kSlopeRad * std::sin(heading) + 0.02 * unit(rng);
       Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));

@@ -53,7 +53,7 @@ class FakeSimulator : public KnobSimulator {
   std::string Fingerprint() const override {
     return (friction_threshold_ > 0 ? "fake-simulator-v1-threshold-" + std::to_string(friction_threshold_)
                                     : "fake-simulator-v1") +
-           (ground_sd > 0 ? "-ground-" + std::to_string(ground_sd) : "");
+           (ground_sd > 0 ? "-ground-" + std::to_string(ground_sd) : "") + (honour_executions ? "-executions" : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -75,6 +75,9 @@ class FakeSimulator : public KnobSimulator {
   // Rough ground: every execution at a placement shares an offset of this many noise sds, drawn
   // per (recording seed, placement): where the robot stands, which z does not tell.
   double ground_sd = 0;
+  // Record as many executions per placement as the recording asks for (else always 5, the
+  // protocol's own number, whatever it asks for).
+  bool honour_executions = false;
   int cells() const { return cells_; }
 
  private:
