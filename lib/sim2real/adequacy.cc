@@ -79,10 +79,7 @@ void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refineme
     resid -= shift;
     if (!fp.library[fit.effects[k]].is_noise) shifts.push_back(shift), total += shift;
   }
-  std::vector<int> step(n, -1);
-  if (in.real.has_sequence && in.real_set.has_sequence()) {
-    for (int i = 0; i < n; ++i) step[i] = in.real_set.step(in.real_source_row[i]);
-  }
+  const std::vector<int> step = RealSteps(in);
   std::vector<EffectDrift> drifts, step_drifts;
   for (size_t q = 0, k = 0; k < fit.effects.size(); ++k) {
     if (fp.library[fit.effects[k]].is_noise) continue;

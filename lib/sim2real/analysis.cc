@@ -125,10 +125,8 @@ const LegSearch* NamedByOwnModels(const Analysis& a) {
 
 // The largest execution index of a placement in the real set, plus one (0 without sequence data).
 int RealExecutionsPerPlacement(const AnalysisInputs& in) {
-  if (!in.real.has_sequence || !in.real_set.has_sequence()) return 0;
-  int most = -1;
-  for (int i = 0; i < in.real.size(); ++i) most = std::max(most, in.real_set.step(in.real_source_row[i]));
-  return most + 1;
+  const std::vector<int> step = RealSteps(in);
+  return step.empty() ? 0 : *std::max_element(step.begin(), step.end()) + 1;
 }
 
 std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options) {

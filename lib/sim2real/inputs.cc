@@ -144,4 +144,12 @@ std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_pat
          "placements (e.g. dgmm simulate --protocol paper --placements 166)";
 }
 
+std::vector<int> RealSteps(const AnalysisInputs& in) {
+  std::vector<int> step(in.real.size(), -1);
+  if (in.real.has_sequence && in.real_set.has_sequence()) {
+    for (int i = 0; i < in.real.size(); ++i) step[i] = in.real_set.step(in.real_source_row[i]);
+  }
+  return step;
+}
+
 }  // namespace dgmm::sim2real

@@ -32,6 +32,10 @@ struct AnalysisInputs {
 // than 10 real samples share a command with the sim set.
 AnalysisInputs PrepareInputs(const SampleSet& sim, const SampleSet& real, std::uint64_t fallback_seed);
 
+// Per real sample (in.real's order) its execution index within its placement; all -1 without
+// sequence data.
+std::vector<int> RealSteps(const AnalysisInputs& in);
+
 // How closely the sim set's placements cover the settings (terrain z) of each command: per
 // placement its mean z; medians over the real set's commands of
 //   sim_to_sim  = |z_p - nearest other sim placement of its command|  (infinite when it has none),

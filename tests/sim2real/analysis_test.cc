@@ -186,12 +186,6 @@ TEST(Analysis, WithoutASimulatorItOnlyLocates) {
   EXPECT_NE(a.verdict.sentence.find("no simulator config"), std::string::npos) << a.verdict.sentence;
 }
 
-}  // namespace
-}  // namespace dgmm::sim2real
-
-namespace dgmm::sim2real {
-namespace {
-
 // Stages 3-8 run again with every execution's signatures only when an effect's size varied with
 // the execution index and the signatures had recorded fewer executions than the real set has.
 TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
@@ -220,12 +214,6 @@ TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
   options.every_execution_on_step_drift = false;
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "turned off";
 }
-
-}  // namespace
-}  // namespace dgmm::sim2real
-
-namespace dgmm::sim2real {
-namespace {
 
 // End to end on the fake: its latency acts in the first execution after a command change only.
 // Signatures of one execution per placement see nothing else, so the fitted latency's size varies
