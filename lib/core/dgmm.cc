@@ -1,5 +1,7 @@
 #include "core/dgmm.h"
 
+#include "core/log_sum_exp.h"
+
 #include <algorithm>
 #include <array>
 #include <cassert>
@@ -138,16 +140,10 @@ double Dgmm::MaxLogDensity() const {
 double Dgmm::PeakLogDensityBound() const {
   // p(x) <= sum_i w_i/W max N_i = sum_i w_i/W (2 pi)^(-d/2) det(S_i)^(-1/2).
   constexpr double kLog2Pi = 1.8378770664093454835606594728112;
-  double m = kNegInf;
   const int k = mixture_.size();
-  for (int i = 0; i < k; ++i) {
-    m = std::max(m, std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det());
-  }
-  double s = 0.0;
-  for (int i = 0; i < k; ++i) {
-    s += std::exp(std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det() - m);
-  }
-  return m + std::log(s) - std::log(mixture_.total_weight()) - 0.5 * dim_ * kLog2Pi;
+  Eigen::VectorXd peak(k);
+  for (int i = 0; i < k; ++i) peak[i] = std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det();
+  return LogSumExp(peak) - std::log(mixture_.total_weight()) - 0.5 * dim_ * kLog2Pi;
 }
 
 AddSampleResult Dgmm::AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng) {

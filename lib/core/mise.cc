@@ -1,5 +1,7 @@
 #include "core/mise.h"
 
+#include "core/log_sum_exp.h"
+
 #include <Eigen/Cholesky>
 #include <cassert>
 #include <cmath>
@@ -22,15 +24,6 @@ double LogGaussianAt(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const E
   return -0.5 * (static_cast<double>(a.size()) * kLog2Pi + log_det + r.squaredNorm());
 }
 
-double LogSumExp(const std::vector<double>& v) {
-  double m = -std::numeric_limits<double>::infinity();
-  for (double x : v) m = std::max(m, x);
-  if (!std::isfinite(m)) return m;
-  double s = 0;
-  for (double x : v) s += std::exp(x - m);
-  return m + std::log(s);
-}
-
 }  // namespace
 
 double LogOverlapIntegral(const Mixture& p, const Mixture& q) {
@@ -48,7 +41,7 @@ double LogOverlapIntegral(const Mixture& p, const Mixture& q) {
                       LogGaussianAt(gi.mean(), gj.mean(), gi.covariance() + gj.covariance()));
     }
   }
-  return LogSumExp(terms);
+  return LogSumExp(terms.data(), static_cast<int>(terms.size()));
 }
 
 IseTerms IntegratedSquaredErrorTerms(const Mixture& p, const Mixture& q) {

@@ -1,5 +1,7 @@
 #include "core/mixture.h"
 
+#include "core/log_sum_exp.h"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -10,14 +12,6 @@ namespace dgmm {
 namespace {
 
 constexpr double kNegInf = -std::numeric_limits<double>::infinity();
-
-// log sum_i exp(v_i), -inf for an empty or all -inf vector.
-double LogSumExp(const Eigen::Ref<const Eigen::VectorXd>& v) {
-  if (v.size() == 0) return kNegInf;
-  const double m = v.maxCoeff();
-  if (!std::isfinite(m)) return m;
-  return m + std::log((v.array() - m).exp().sum());
-}
 
 }  // namespace
 
@@ -46,15 +40,8 @@ double Mixture::LogDensity(const Eigen::Ref<const Eigen::VectorXd>& x) const {
     heap.resize(k);
     v = heap.data();
   }
-  double m = kNegInf;
-  for (int i = 0; i < k; ++i) {
-    v[i] = std::log(weights_[i]) + components_[i].LogDensity(x);
-    m = std::max(m, v[i]);
-  }
-  if (!std::isfinite(m)) return m;
-  double s = 0.0;
-  for (int i = 0; i < k; ++i) s += std::exp(v[i] - m);
-  return m + std::log(s) - log_total;
+  for (int i = 0; i < k; ++i) v[i] = std::log(weights_[i]) + components_[i].LogDensity(x);
+  return LogSumExp(v, k) - log_total;
 }
 
 Eigen::VectorXd Mixture::LogDensity(const Eigen::Ref<const Eigen::MatrixXd>& X) const {
