@@ -33,6 +33,8 @@ struct Sim2RealArgs {
   int signature_placements = sim2real::CandidateOptions{}.placements;  // the library's defaults
   int signature_executions = sim2real::CandidateOptions{}.executions_per_placement;
   bool step_drift_recheck = sim2real::AnalysisOptions{}.every_execution_on_step_drift;
+  bool confirm_every_execution = sim2real::AnalysisOptions{}.every_execution_to_confirm;
+  double confirm_from_z = sim2real::AnalysisOptions{}.every_execution_from_z;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
@@ -139,6 +141,8 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.placements = args.signature_placements;
   o.candidates.executions_per_placement = args.signature_executions;
   o.every_execution_on_step_drift = args.step_drift_recheck;
+  o.every_execution_to_confirm = args.confirm_every_execution;
+  o.every_execution_from_z = args.confirm_from_z;
   o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
@@ -290,6 +294,14 @@ void Setup(CLI::App& root) {
                 "when an effect fits on average but its size varies with the execution index and the signatures "
                 "recorded fewer executions per placement than the real set has, record them again with every "
                 "execution and analyse once more (on by default; docs/sim2real.md)");
+  cmd->add_flag("--confirm-every-execution,!--no-confirm-every-execution", args->confirm_every_execution,
+                "when a knob is named from signatures of fewer executions per placement than the real set has, "
+                "record them again with every execution and analyse once more before naming it (on by default; "
+                "--no-confirm-every-execution keeps the first look; docs/sim2real.md)");
+  cmd->add_option("--confirm-from-z", args->confirm_from_z,
+                  "... and when nothing is named but the first look's best candidate reached this held-out z "
+                  "(a near miss; significance starts near 2.8)")
+      ->capture_default_str()->check(CLI::Range(0.0, 1e9));
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
   cmd->add_flag("--leg-search,!--no-leg-search", args->leg_search,

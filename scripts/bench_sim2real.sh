@@ -37,7 +37,7 @@ t=$(run cached "$cores" "$tmp/cache-$cores")
 n=$(field cached "j['knobs']['recordings']['signatures'] + j['knobs']['recordings']['refinement']")
 rows+="| cached | $cores | $(printf '%.1f' "$t") | - | $n |"$'\n'
 echo "sim2real $pair cached, $cores thread(s): ${t}s ($n recordings)"
-design=$(field cached "'%d placements of %d executions' % (j['knobs']['placements_per_recording'], j['knobs']['executions_per_placement'])")
+design=$(field cached "'%d placements of %d executions' % (j['knobs']['placements_per_recording'], j['knobs']['executions_per_placement']) + (' (stages 3-8 ran twice: ' + j['knobs']['every_execution_because'] + ')' if j['knobs']['every_execution_because'] else '')")
 verdict=$(field cached "j['verdict']['status'] + ': ' + '; '.join('%s %.3g' % (n['knob'], n['value']) for n in j['verdict']['named'])")
 cat > "$tmp/section.md" <<MD
 ### sim2real (\`scripts/bench_sim2real.sh\`)

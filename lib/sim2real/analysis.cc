@@ -2,8 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <random>
 
+#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -114,6 +116,10 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
+  if (std::isnan(every_execution_from_z)) {
+    *error = "every_execution_from_z: a number expected (infinity: near misses are not confirmed)";
+    return false;
+  }
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
          runoff.IsValid(error);
@@ -132,13 +138,27 @@ int RealExecutionsPerPlacement(const AnalysisInputs& in) {
 std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options) {
   const int signature = options.candidates.executions_per_placement;
   const int real = RealExecutionsPerPlacement(a.inputs);
-  if (!options.every_execution_on_step_drift || signature == 0 || real <= signature) return "";
+  if (signature == 0 || real <= signature) return "";
+  const std::string of_real = std::to_string(signature) + " of the real set's " + std::to_string(real) +
+                              " executions per placement";
   for (const VerdictDrifting& d : a.verdict.drifting) {
-    if (d.along != "execution index") continue;
-    return d.knob + "'s fitted size varied with the execution index, and the signatures had recorded " +
-           std::to_string(signature) + " of the real set's " + std::to_string(real) + " executions per placement";
+    if (options.every_execution_on_step_drift && d.along == "execution index") {
+      return d.knob + "'s fitted size varied with the execution index, and the signatures had recorded " + of_real;
+    }
   }
-  return "";
+  if (!options.every_execution_to_confirm) return "";
+  std::string named;
+  for (const VerdictNamed& n : a.verdict.named) named += (named.empty() ? "" : ", ") + n.knob;
+  if (!named.empty()) {
+    return "a first look named " + named + " from signatures of " + of_real + "; a name is confirmed with every execution";
+  }
+  const std::vector<SelectionStep>& steps = a.refinement.selection.steps;
+  if (steps.empty() || steps[0].candidates.empty()) return "";
+  const auto best = std::max_element(steps[0].candidates.begin(), steps[0].candidates.end(),
+                                     [](const CandidateScore& x, const CandidateScore& y) { return x.z < y.z; });
+  if (!(best->z >= options.every_execution_from_z)) return "";
+  return "a first look from signatures of " + of_real + " came near: " + a.candidates.candidates.at(best->effect).key +
+         " reached held-out z " + Fmt("%.2f", best->z) + " (significant from " + Fmt("%.2f", steps[0].threshold_z) + ")";
 }
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,

@@ -44,6 +44,14 @@ struct AnalysisOptions {
   // signatures recorded fewer executions per placement than the real set has, stages 3-8 run
   // again with signatures of every execution (Analysis::every_execution_because).
   bool every_execution_on_step_drift = true;
+  // When a knob is named from signatures of fewer executions per placement than the real set has,
+  // stages 3-8 run again with every execution before the name stands: two executions decide
+  // near-ties worse (on the octopod a stiffer servo was named as a lighter robot, docs/sim2real.md).
+  bool every_execution_to_confirm = true;
+  // ... and when the first look names nothing but its best candidate at the first selection step
+  // reached this held-out z (significance starts at the step's threshold, about 2.8): a near miss
+  // that less noisy signatures may settle (the hexapod's payloads, z 2.4-2.7 from 2 executions).
+  double every_execution_from_z = 2.0;
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };
@@ -81,11 +89,14 @@ struct Analysis {
 const LegSearch* NamedByOwnModels(const Analysis& a);
 
 // Why stages 3-8 run again with signatures of every execution of a placement (empty: they do
-// not): an effect fits on average but its size varies with the execution index, and the
-// signatures were recorded with fewer executions per placement than the real set has. A knob can
-// act differently in a placement's first executions than in its later ones (the hexapod's
-// payload most in the first, docs/sim2real.md); a signature that never saw the later ones reads
-// that profile as a drift. The run again records as many executions as the real set has.
+// not). Only when the signatures were recorded with fewer executions per placement than the real
+// set has, and then (1) an effect fits on average but its size varies with the execution index: a
+// knob can act differently in a placement's first executions than in its later ones (the
+// hexapod's payload most in the first, docs/sim2real.md), and a signature that never saw the later
+// ones reads that profile as a drift; (2) a knob is named: a name from fewer executions is
+// confirmed with every one; or (3) the best candidate of the first selection step reached
+// every_execution_from_z without being significant. The run again records as many executions as
+// the real set has.
 std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options);
 // The largest execution index of a placement in the real set, plus one (0 without sequence data).
 int RealExecutionsPerPlacement(const AnalysisInputs& in);

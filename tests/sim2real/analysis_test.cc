@@ -215,6 +215,58 @@ TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "turned off";
 }
 
+TEST(Analysis, ANameFromFewerSignatureExecutionsIsConfirmedWithEveryExecution) {
+  const auto pair = test::MakeFakePair(Fake(), {});
+  Analysis a;
+  a.inputs = PrepareInputs(pair.sim, pair.real, 1);
+  const int real = RealExecutionsPerPlacement(a.inputs);
+  ASSERT_GE(real, 3);
+  AnalysisOptions options = test::FastOptions();
+  options.candidates.executions_per_placement = 2;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "nothing named: a null stays a quick look";
+  VerdictNamed mass;
+  mass.knob = "bodies.mass_scale";
+  a.verdict.named = {mass};
+  const std::string why = EveryExecutionBecause(a, options);
+  EXPECT_NE(why.find("bodies.mass_scale"), std::string::npos) << why;
+  EXPECT_NE(why.find("2 of the real set's " + std::to_string(real)), std::string::npos) << why;
+  VerdictDrifting drift;
+  drift.knob = "payload.mass_kg", drift.along = "execution index";
+  a.verdict.drifting = {drift};
+  EXPECT_NE(EveryExecutionBecause(a, options).find("payload.mass_kg's fitted size varied"), std::string::npos)
+      << "a drift is the more specific reason";
+  a.verdict.drifting.clear();
+  options.candidates.executions_per_placement = real;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "the signatures saw every execution";
+  options.candidates.executions_per_placement = 2;
+  options.every_execution_to_confirm = false;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "turned off";
+}
+
+TEST(Analysis, ANearMissFromFewerSignatureExecutionsIsLookedAtAgain) {
+  const auto pair = test::MakeFakePair(Fake(), {});
+  Analysis a;
+  a.inputs = PrepareInputs(pair.sim, pair.real, 1);
+  a.candidates.candidates.resize(2);
+  a.candidates.candidates[0].key = "tracker_noise", a.candidates.candidates[1].key = "payload";
+  SelectionStep first;
+  first.threshold_z = 2.81;
+  first.candidates = {{0, 0.1, 0.1, 1.2}, {1, 0.05, 0.02, 2.5}};  // sorted by gain, not by z
+  a.refinement.selection.steps = {first};
+  AnalysisOptions options = test::FastOptions();
+  options.candidates.executions_per_placement = 2;
+  const std::string why = EveryExecutionBecause(a, options);
+  EXPECT_NE(why.find("payload reached held-out z 2.50 (significant from 2.81)"), std::string::npos) << why;
+  options.every_execution_from_z = 2.6;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "below the screen";
+  a.refinement.selection.steps[0].candidates[1].z = 1.9;
+  options.every_execution_from_z = 2.0;
+  EXPECT_EQ(EveryExecutionBecause(a, options), "") << "a null's best stays a quick look";
+  std::string error;
+  options.every_execution_from_z = std::nan("");
+  EXPECT_FALSE(options.IsValid(&error));
+}
+
 // End to end on the fake: its latency acts in the first execution after a command change only.
 // Signatures of one execution per placement see nothing else, so the fitted latency's size varies
 // with the execution index of the real set's five; the step-drift recheck records them again with
@@ -226,6 +278,7 @@ TEST(Analysis, TheStepDriftRecheckNamesWhatFewSignatureExecutionsReadAsADrift) {
   AnalysisOptions options = test::FastOptions();
   options.candidates.executions_per_placement = 1;
   options.every_execution_on_step_drift = false;
+  options.every_execution_to_confirm = false;
   const Analysis once = Analyse(pair.sim, pair.real, &fake, options);
   options.every_execution_on_step_drift = true;
   const Analysis again = Analyse(pair.sim, pair.real, &fake, options);
