@@ -140,10 +140,11 @@ double Dgmm::MaxLogDensity() const {
 double Dgmm::PeakLogDensityBound() const {
   // p(x) <= sum_i w_i/W max N_i = sum_i w_i/W (2 pi)^(-d/2) det(S_i)^(-1/2).
   constexpr double kLog2Pi = 1.8378770664093454835606594728112;
-  const int k = mixture_.size();
-  Eigen::VectorXd peak(k);
-  for (int i = 0; i < k; ++i) peak[i] = std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det();
-  return LogSumExp(peak) - std::log(mixture_.total_weight()) - 0.5 * dim_ * kLog2Pi;
+  // Each term is cheap (cached log-determinant): recomputed per pass, no buffer on AddSample's path.
+  const double lse = LogSumExpOf(mixture_.size(), [this](int i) {
+    return std::log(mixture_.weight(i)) - 0.5 * mixture_.component(i).log_det();
+  });
+  return lse - std::log(mixture_.total_weight()) - 0.5 * dim_ * kLog2Pi;
 }
 
 AddSampleResult Dgmm::AddSample(const Eigen::Ref<const Eigen::VectorXd>& x, std::mt19937_64& rng) {

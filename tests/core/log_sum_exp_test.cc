@@ -40,5 +40,16 @@ TEST(LogSumExp, PropagatesInfinityAndNan) {
   EXPECT_TRUE(std::isnan(LogSumExp(nan.data(), 2)));
 }
 
+TEST(LogSumExp, TermFormAgreesWithTheBufferFormAndCallsEachTermTwice) {
+  const std::vector<double> v = {-1.5, 0.25, 2.0, -3.0, 700.0};
+  std::vector<int> calls(v.size(), 0);
+  const double streamed = LogSumExpOf(static_cast<int>(v.size()), [&](int i) {
+    ++calls[i];
+    return v[i];
+  });
+  EXPECT_EQ(streamed, LogSumExp(v.data(), static_cast<int>(v.size())));
+  for (int c : calls) EXPECT_EQ(c, 2);
+}
+
 }  // namespace
 }  // namespace dgmm
