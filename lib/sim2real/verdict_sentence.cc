@@ -45,6 +45,10 @@ std::string Headline(const Verdict& v) {
                             : "No mismatch located: clean.";
   }
   if (v.status == "located") return "Mismatch located; no physics named.";
+  if (v.named.empty() && !v.weak.empty()) {
+    return "Unexplained mismatch: a simulator knob improves the held-out fit, but the resamples do not agree on "
+           "which one.";
+  }
   if (v.named.empty()) return "Unexplained mismatch: no simulator knob or measurement effect fits.";
   std::string s = "Simulator knobs and measurement effects, in order of evidence:";
   for (size_t k = 0; k < v.named.size(); ++k) s += NamedPart(v, k) + (k + 1 < v.named.size() ? ";" : "");
@@ -111,7 +115,8 @@ std::string VerdictSentence(const Verdict& v, const Adequacy* adequacy, const Na
   }
   if (v.status == "located") s += " Where the sim model fails:" + FirstFew(v.structured_in, "; ") + ".";
   for (const auto& w : v.weak) {
-    s += " " + w.family + " (" + w.knob + Fmt(" = %.4g) also fitted but is not named: inclusion %.0f%%", w.value, 100 * w.inclusion) +
+    s += " " + w.family + " (" + w.knob + Fmt(" = %.4g)", w.value) + (v.named.empty() ? "" : " also") +
+         Fmt(" fitted but is not named: inclusion %.0f%%", 100 * w.inclusion) +
          Fmt(" is below %.0f%%.", 100 * v.min_inclusion);
   }
   for (const auto& d : v.drifting) s += DriftPart(d);

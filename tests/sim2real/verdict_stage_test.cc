@@ -41,6 +41,27 @@ TEST(VerdictStage, UnderTheInclusionThresholdNothingIsNamed) {
   EXPECT_EQ(j["not_named_low_inclusion"][0]["family"], "friction");
 }
 
+// A knob forward selection took improved the held-out fit: with nothing located and no doubt the
+// verdict is still a mismatch, never "clean" beside a fitted knob (hexapod payload 39005).
+TEST(VerdictStage, AFittedKnobUnderTheInclusionThresholdIsNeverClean) {
+  test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 6);
+  s.confidence.family_inclusion["friction"] = 0.2;
+  Naming naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
+  ASSERT_EQ(naming.weak.size(), 1u);
+  // Every other sign of a mismatch off: only the fitted knob says there is one.
+  s.base.significant_mismatch = s.adequacy.below_ceiling = naming.structured = naming.noise_withheld = false;
+  s.adequacy.total_drift.drifting = s.adequacy.total_step_variation.drifting = false;
+  s.adequacy.remaining.clear();
+  s.adequacy.doubts.clear();
+  const Verdict v = Compose(s, naming);
+  EXPECT_EQ(v.status, "unexplained") << v.sentence;
+  EXPECT_EQ(v.sentence.find("clean"), std::string::npos) << v.sentence;
+  EXPECT_EQ(v.sentence.find("no simulator knob"), std::string::npos) << v.sentence;
+  EXPECT_NE(v.sentence.find("friction (floor.friction = "), std::string::npos) << v.sentence;
+  EXPECT_EQ(v.sentence.find("also fitted"), std::string::npos) << "nothing else is named: " << v.sentence;
+  ASSERT_FALSE(v.structured_in.empty());
+}
+
 TEST(VerdictStage, DoubtsMakeItPartlyExplainedAndAreInTheSentence) {
   const test::Stages s = test::RunStages({{test::kFriction, 0.02}}, 6);
   const Verdict v = Compose(s, s.naming);
