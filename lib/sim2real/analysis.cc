@@ -157,8 +157,12 @@ std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& opti
   const auto best = std::max_element(steps[0].candidates.begin(), steps[0].candidates.end(),
                                      [](const CandidateScore& x, const CandidateScore& y) { return x.z < y.z; });
   if (!(best->z >= options.every_execution_from_z)) return "";
-  return "a first look from signatures of " + of_real + " came near: " + a.candidates.candidates.at(best->effect).key +
-         " reached held-out z " + Fmt("%.2f", best->z) + " (significant from " + Fmt("%.2f", steps[0].threshold_z) + ")";
+  const std::string& key = a.candidates.candidates.at(best->effect).key;
+  const std::string z = Fmt("held-out z %.2f", best->z) + Fmt(", significant from %.2f", steps[0].threshold_z);
+  if (best->z >= steps[0].threshold_z) {
+    return "a first look from signatures of " + of_real + " selected " + key + " (" + z + ") but did not name it";
+  }
+  return "a first look from signatures of " + of_real + " came near: " + key + " reached " + z;
 }
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,

@@ -256,7 +256,13 @@ TEST(Analysis, ANearMissFromFewerSignatureExecutionsIsLookedAtAgain) {
   AnalysisOptions options = test::FastOptions();
   options.candidates.executions_per_placement = 2;
   const std::string why = EveryExecutionBecause(a, options);
-  EXPECT_NE(why.find("payload reached held-out z 2.50 (significant from 2.81)"), std::string::npos) << why;
+  EXPECT_NE(why.find("came near: payload reached held-out z 2.50, significant from 2.81"), std::string::npos) << why;
+  a.refinement.selection.steps[0].candidates[1].z = 3.2;  // selected, but not named (weak or drifting)
+  const std::string selected = EveryExecutionBecause(a, options);
+  EXPECT_NE(selected.find("selected payload (held-out z 3.20, significant from 2.81) but did not name it"),
+            std::string::npos) << selected;
+  EXPECT_EQ(selected.find("came near"), std::string::npos) << selected;
+  a.refinement.selection.steps[0].candidates[1].z = 2.5;
   options.every_execution_from_z = 2.6;
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "below the screen";
   a.refinement.selection.steps[0].candidates[1].z = 1.9;
