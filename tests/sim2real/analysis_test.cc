@@ -186,15 +186,24 @@ TEST(Analysis, WithoutASimulatorItOnlyLocates) {
   EXPECT_NE(a.verdict.sentence.find("no simulator config"), std::string::npos) << a.verdict.sentence;
 }
 
+// When stages 3-8 run again with every execution (EveryExecutionBecause): an analysis of a
+// fake null pair whose verdict, selection steps and options each test sets.
+class EveryExecution : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto pair = test::MakeFakePair(Fake(), {});
+    a.inputs = PrepareInputs(pair.sim, pair.real, 1);
+    real = RealExecutionsPerPlacement(a.inputs);
+    ASSERT_GE(real, 3) << "the fake's protocol records several executions per placement";
+  }
+  Analysis a;
+  AnalysisOptions options = test::FastOptions();
+  int real = 0;
+};
+
 // Stages 3-8 run again with every execution's signatures only when an effect's size varied with
 // the execution index and the signatures had recorded fewer executions than the real set has.
-TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
-  const auto pair = test::MakeFakePair(Fake(), {});
-  Analysis a;
-  a.inputs = PrepareInputs(pair.sim, pair.real, 1);
-  const int real = RealExecutionsPerPlacement(a.inputs);
-  ASSERT_GE(real, 2) << "the fake's protocol records several executions per placement";
-  AnalysisOptions options = test::FastOptions();
+TEST_F(EveryExecution, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
   options.candidates.executions_per_placement = real - 1;
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "nothing drifts";
   VerdictDrifting drift;
@@ -215,13 +224,7 @@ TEST(Analysis, AStepDriftWithFewerSignatureExecutionsAsksForEveryExecution) {
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "turned off";
 }
 
-TEST(Analysis, ANameFromFewerSignatureExecutionsIsConfirmedWithEveryExecution) {
-  const auto pair = test::MakeFakePair(Fake(), {});
-  Analysis a;
-  a.inputs = PrepareInputs(pair.sim, pair.real, 1);
-  const int real = RealExecutionsPerPlacement(a.inputs);
-  ASSERT_GE(real, 3);
-  AnalysisOptions options = test::FastOptions();
+TEST_F(EveryExecution, ANameFromFewerSignatureExecutionsIsConfirmed) {
   options.candidates.executions_per_placement = 2;
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "nothing named: a null stays a quick look";
   VerdictNamed mass;
@@ -243,17 +246,13 @@ TEST(Analysis, ANameFromFewerSignatureExecutionsIsConfirmedWithEveryExecution) {
   EXPECT_EQ(EveryExecutionBecause(a, options), "") << "turned off";
 }
 
-TEST(Analysis, ANearMissFromFewerSignatureExecutionsIsLookedAtAgain) {
-  const auto pair = test::MakeFakePair(Fake(), {});
-  Analysis a;
-  a.inputs = PrepareInputs(pair.sim, pair.real, 1);
+TEST_F(EveryExecution, ANearMissFromFewerSignatureExecutionsIsLookedAtAgain) {
   a.candidates.candidates.resize(2);
   a.candidates.candidates[0].key = "tracker_noise", a.candidates.candidates[1].key = "payload";
   SelectionStep first;
   first.threshold_z = 2.81;
   first.candidates = {{0, 0.1, 0.1, 1.2}, {1, 0.05, 0.02, 2.5}};  // sorted by gain, not by z
   a.refinement.selection.steps = {first};
-  AnalysisOptions options = test::FastOptions();
   options.candidates.executions_per_placement = 2;
   const std::string why = EveryExecutionBecause(a, options);
   EXPECT_NE(why.find("came near: payload reached held-out z 2.50, significant from 2.81"), std::string::npos) << why;
