@@ -51,15 +51,16 @@ def foot_body_block(xml, foot_geom):
     return start, end
 
 
-def edit_leg(xml, foot_geom, kind, value):
-    """The MJCF with one leg's lowest body edited: 'leg_mass' adds `value` kg on a child body,
-    'short_tibia' scales every geom position (pos, fromto) of that body by `value`."""
+def edit_leg(xml, foot_geom, kind, value, reach_m):
+    """The MJCF with one leg's lowest body edited: 'leg_mass' adds `value` kg on a child body (a
+    sphere of radius 0.035 leg reaches, 0.07 reaches below the body's origin: 1 and 2 cm on the
+    hexapod), 'short_tibia' scales every geom position (pos, fromto) of that body by `value`."""
     start, end = foot_body_block(xml, foot_geom)
     block = xml[start:end]
     head = block.index(">") + 1  # after the body's opening tag
     if kind == "leg_mass":
-        block = (block[:head] + f'<body name="dgmm_added_mass" pos="0 0 -0.02"><geom type="sphere" size="0.01" '
-                 f'mass="{value:.6g}" contype="0" conaffinity="0"/></body>' + block[head:])
+        block = (block[:head] + f'<body name="dgmm_added_mass" pos="0 0 {-0.07 * reach_m:.6g}"><geom type="sphere" '
+                 f'size="{0.035 * reach_m:.6g}" mass="{value:.6g}" contype="0" conaffinity="0"/></body>' + block[head:])
     else:
         def scale(m):
             return f'{m.group(1)}="' + " ".join(f"{float(v) * value:.6g}" for v in m.group(2).split()) + '"'
@@ -81,7 +82,7 @@ def planted(seed, cfg, mass_kg, reach_m, kinds, pair_dir):
         foot = leg["foot"].get("geom")
         if foot is None:
             raise ValueError(f"{kind}: leg {leg['name']} needs a foot geom")
-        xml = edit_leg(open(cfg["mjcf_path"]).read(), foot, kind, value)
+        xml = edit_leg(open(cfg["mjcf_path"]).read(), foot, kind, value, reach_m)
         cfg["mjcf_path"] = os.path.join(pair_dir, "real.xml")
         open(cfg["mjcf_path"], "w").write(xml)
         return f"{kind}:{leg['name']}", value

@@ -25,29 +25,33 @@ class EditLeg(unittest.TestCase):
         self.xml = open(HEXAPOD).read()
 
     def test_short_tibia_scales_the_foot_bodys_geoms_only(self):
-        out = robots.edit_leg(self.xml, "middle_left_foot", "short_tibia", 0.5)
+        out = robots.edit_leg(self.xml, "middle_left_foot", "short_tibia", 0.5, 0.3)
         diff = changed_lines(self.xml, out)
         self.assertEqual(len(diff), 2, diff)  # the tibia capsule and the foot box
         self.assertIn('pos="0.015 0 -0.08"', out)  # the box foot at (0.03, 0, -0.16) halved
         self.assertIn('<body name="middle_left_tibia" pos="0.08 0 0.05">', out)  # the joint stays
 
     def test_leg_mass_adds_one_body_under_the_foot_body(self):
-        out = robots.edit_leg(self.xml, "rear_right_foot", "leg_mass", 0.123)
+        out = robots.edit_leg(self.xml, "rear_right_foot", "leg_mass", 0.123, 0.3)
         self.assertEqual(out.count("dgmm_added_mass"), 1)
         at = out.index("dgmm_added_mass")
         self.assertEqual(out.rfind("<body name=", 0, at - 20), out.index('<body name="rear_right_tibia"'))
         self.assertIn('mass="0.123"', out)
+        # Placed and sized in leg reaches: a robot twice as large gets a sphere twice as large.
+        self.assertIn('pos="0 0 -0.021"><geom type="sphere" size="0.0105"', out)
+        big = robots.edit_leg(self.xml, "rear_right_foot", "leg_mass", 0.123, 0.6)
+        self.assertIn('pos="0 0 -0.042"><geom type="sphere" size="0.021"', big)
 
     def test_a_foot_in_a_body_with_child_bodies_is_refused(self):
         child = '<body name="child"><geom name="x" type="sphere" size="0.01"/></body>'
         foot = '<geom name="foot" type="sphere" size="0.01"/>'
         for inner in (child + foot, foot + child):  # either order: the span would not be the whole body
             with self.assertRaises(ValueError):
-                robots.edit_leg(f'<body name="tibia">{inner}</body>', "foot", "short_tibia", 0.6)
+                robots.edit_leg(f'<body name="tibia">{inner}</body>', "foot", "short_tibia", 0.6, 0.3)
 
     def test_a_missing_foot_is_refused(self):
         with self.assertRaises(ValueError):
-            robots.edit_leg(self.xml, "no_such_foot", "leg_mass", 0.1)
+            robots.edit_leg(self.xml, "no_such_foot", "leg_mass", 0.1, 0.3)
 
 
 class Planted(unittest.TestCase):
