@@ -182,10 +182,23 @@ json LegSearchJson(const LegSearch& l) {
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 
+// The runoff's rows are knobs: a point's `leg` is null unless its knob is a leg's, the knobs whose
+// points fit as well as the best are `knobs_as_well`, and the leg search's challenge fields go.
 json RunoffJson(const Runoff& r) {
   if (!r.ran && r.why_not.empty()) return nullptr;
   if (!r.ran) return {{"ran", false}, {"why_not", r.why_not}};
-  json out = LegSearchJson(r.search);
+  const LegSearch& s = r.search;
+  json out = LegSearchJson(s);
+  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named"}) out.erase(leg_only);
+  const auto leg_of = [](const LegSearchPoint& p) { return p.leg == p.knob ? json(nullptr) : json(p.leg); };
+  json knobs_as_well = json::array();
+  for (size_t j = 0; j < s.points.size(); ++j) {
+    const LegSearchPoint& p = s.points[j];
+    out["points"][j]["leg"] = leg_of(p);
+    if (p.fits_as_well && p.knob != s.knob && !knobs_as_well.contains(p.knob)) knobs_as_well.push_back(p.knob);
+  }
+  if (s.best >= 0) out["leg"] = leg_of(s.points[s.best]);
+  out["knobs_as_well"] = knobs_as_well;
   out["ran"] = true;
   out["contenders"] = r.contenders;
   out["named_before"] = r.named_before.empty() ? json(nullptr) : json(r.named_before);

@@ -123,5 +123,29 @@ TEST(Report, ALegNamedByTheLegSearchIsOneStoryInEveryOutput) {
   EXPECT_NE(html_all.find("removes all of the nominal's misfit"), std::string::npos);
 }
 
+// The runoff's JSON speaks of knobs: no leg for a knob that is not a leg's, the knobs that fit as
+// well by knob name, none of the leg search's challenge fields.
+TEST(Report, TheRunoffsJsonNamesKnobsNotLegs) {
+  const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
+  a.runoff.ran = true;
+  a.runoff.contenders = {"floor.friction@0.6", "actuators.leg1.gain@0.5"};
+  LegSearch& s = a.runoff.search;
+  s.ran = true, s.by = "runoff";
+  s.points = {{"floor.friction", "floor.friction", 0, 0.6, -1.0, true},
+              {"leg1", "actuators.leg1.gain", 1, 0.5, -1.1, true},
+              {"floor.friction", "floor.friction", 0, 0.8, -1.5, false}};
+  s.best = 0, s.leg = "floor.friction", s.knob = "floor.friction", s.value = 0.6;
+  s.legs_as_well = {"leg1"};
+  const auto j = nlohmann::json::parse(ReportJson(a, ReportContext{}))["runoff"];
+  EXPECT_TRUE(j["leg"].is_null()) << j.dump();
+  EXPECT_EQ(j["knob"], "floor.friction");
+  EXPECT_TRUE(j["points"][0]["leg"].is_null());
+  EXPECT_EQ(j["points"][1]["leg"], "leg1");
+  EXPECT_EQ(j["knobs_as_well"], nlohmann::json::array({"actuators.leg1.gain"}));
+  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named"}) EXPECT_FALSE(j.contains(leg_only)) << leg_only;
+  EXPECT_EQ(j["contenders"].size(), 2u);
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real
