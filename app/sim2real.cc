@@ -35,6 +35,9 @@ struct Sim2RealArgs {
   bool step_drift_recheck = sim2real::AnalysisOptions{}.every_execution_on_step_drift;
   bool confirm_every_execution = sim2real::AnalysisOptions{}.every_execution_to_confirm;
   double confirm_from_z = sim2real::AnalysisOptions{}.every_execution_from_z;
+  bool confirm_screened_only = sim2real::AnalysisOptions{}.confirm_screened_only;
+  double confirm_screen_z = sim2real::AnalysisOptions{}.confirm_screen_z;
+  double confirm_screen_share = sim2real::AnalysisOptions{}.confirm_screen_share;
   std::uint64_t seed = 1;
   int bootstrap = 20;
   int permutations = 1000;
@@ -143,6 +146,9 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.every_execution_on_step_drift = args.step_drift_recheck;
   o.every_execution_to_confirm = args.confirm_every_execution;
   o.every_execution_from_z = args.confirm_from_z;
+  o.confirm_screened_only = args.confirm_screened_only;
+  o.confirm_screen_z = args.confirm_screen_z;
+  o.confirm_screen_share = args.confirm_screen_share;
   o.candidates.spread_signatures = args.spread_signatures;
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
@@ -302,6 +308,18 @@ void Setup(CLI::App& root) {
                   "... and when nothing is named but the first look's best candidate reached this held-out z "
                   "(a near miss; significance starts near 2.8)")
       ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+  cmd->add_flag("--confirm-screened-only,!--confirm-all-knobs", args->confirm_screened_only,
+                "the run again with every execution records only the knobs the first look screened in (held-out z "
+                "of at least --confirm-screen-z and --confirm-screen-share of the step's best at some selection "
+                "step, selected or confusable; the others keep "
+                "their first-look signatures; on by default); --confirm-all-knobs records every knob again");
+  cmd->add_option("--confirm-screen-z", args->confirm_screen_z,
+                  "... the held-out z a knob needs at some step of the first look to be recorded again (two "
+                  "executions can underrate an effect about threefold)")
+      ->capture_default_str()->check(CLI::Range(-1e9, 1e9));
+  cmd->add_option("--confirm-screen-share", args->confirm_screen_share,
+                  "... and the share of the step's best held-out z it needs")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
   cmd->add_flag("--leg-search,!--no-leg-search", args->leg_search,

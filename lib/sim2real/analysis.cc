@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <iterator>
+#include <limits>
 #include <random>
 
 #include "sim2real/sentence_format.h"
@@ -54,11 +56,18 @@ bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
 }
 
 // Stages 3 to 8 (candidates to verdict) on the inputs and baseline in `a`.
+// A run again on only some knobs keeps the other candidates of `first_look` (their signatures as
+// recorded then) as competitors, and returns how many it kept.
 template <typename Stage>
-void KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
+int KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a,
+               const CandidateSet* first_look = nullptr) {
   auto t = Clock::now();
   stage("candidates (knob signatures)");
   a->candidates = BuildCandidates(simulator, a->inputs, a->baseline, options.candidates);
+  int kept = 0;
+  if (first_look && !options.candidates.only_knobs.empty()) {
+    kept = KeepFirstLookCandidates(*first_look, options.candidates.only_knobs, &a->candidates);
+  }
   a->seconds.candidates += Since(t), t = Clock::now();
   stage("selection and refinement");
   a->refinement = SelectAndRefine(simulator, a->inputs, a->baseline, options.candidates, options.refine, &a->candidates);
@@ -76,6 +85,7 @@ void KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, 
   a->seconds.ties += Since(t);
   a->verdict = ComposeVerdict(a->baseline, a->candidates, a->refinement, a->confidence, a->adequacy, a->naming,
                               a->ties, options.verdict);
+  return kept;
 }
 
 // The runoff runs on uneven ground when the stages before left a mismatch: something named but
@@ -113,11 +123,29 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   }
 }
 
+// "; recorded again: the 4 of 23 knobs the first look screened in (z >= 2 at some step, selected or
+// confusable): a, b, c, d; 9 other candidates kept their first-look signatures".
+std::string ScreenedPart(const KnobSimulator& simulator, const std::vector<int>& knobs, const AnalysisOptions& options,
+                         int kept) {
+  std::string names;
+  for (int k : knobs) names += (names.empty() ? "" : ", ") + simulator.knobs()[k].name;
+  return Fmt("; recorded again: the %.0f", static_cast<double>(knobs.size())) +
+         Fmt(" of %.0f knobs the first look screened in", static_cast<double>(simulator.knobs().size())) +
+         Fmt(" (held-out z >= %.3g", options.confirm_screen_z) +
+         Fmt(" and >= %.3g of the step's best at some step, selected or confusable): ", options.confirm_screen_share) +
+         names +
+         Fmt("; %.0f other candidates kept their first-look signatures", kept);
+}
+
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
   if (std::isnan(every_execution_from_z)) {
     *error = "every_execution_from_z: a number expected (infinity: near misses are not confirmed)";
+    return false;
+  }
+  if (std::isnan(confirm_screen_z) || !(confirm_screen_share >= 0 && confirm_screen_share <= 1)) {
+    *error = "confirm_screen_z a number (-infinity: every knob the first look scored), confirm_screen_share in [0, 1]";
     return false;
   }
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
@@ -127,6 +155,30 @@ bool AnalysisOptions::IsValid(std::string* error) const {
 
 const LegSearch* NamedByOwnModels(const Analysis& a) {
   return a.runoff.search.named ? &a.runoff.search : a.leg_search.named ? &a.leg_search : nullptr;
+}
+
+std::vector<int> ScreenedKnobs(const CandidateSet& set, const SelectionResult& selection, double from_z,
+                               double share) {
+  std::vector<int> effects = selection.selected;
+  for (const SelectionStep& step : selection.steps) {
+    double best = -std::numeric_limits<double>::infinity();
+    for (const CandidateScore& c : step.candidates) best = std::max(best, c.z);
+    const double z = std::max(from_z, share * best);
+    for (const CandidateScore& c : step.candidates) {
+      if (c.z >= z) effects.push_back(c.effect);
+    }
+    effects.insert(effects.end(), step.confusable.begin(), step.confusable.end());
+  }
+  std::vector<int> knobs;
+  if (set.tracker_knob >= 0) knobs.push_back(set.tracker_knob);
+  for (int e : effects) {
+    const KnobCandidate& c = set.candidates.at(e);
+    if (c.knob_index >= 0) knobs.push_back(c.knob_index);
+    if (c.key == "payload") knobs.insert(knobs.end(), std::begin(set.payload_knob), std::end(set.payload_knob));
+  }
+  std::sort(knobs.begin(), knobs.end());
+  knobs.erase(std::unique(knobs.begin(), knobs.end()), knobs.end());
+  return knobs;
 }
 
 // The largest execution index of a placement in the real set, plus one (0 without sequence data).
@@ -190,10 +242,18 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   if (!a.every_execution_because.empty()) {
     AnalysisOptions every = options;
     every.candidates.executions_per_placement = RealExecutionsPerPlacement(a.inputs);
+    if (options.confirm_screened_only) {
+      every.candidates.only_knobs =
+          ScreenedKnobs(a.candidates, a.refinement.selection, options.confirm_screen_z, options.confirm_screen_share);
+    }
     // The recordings of both runs are counted.
     const int recorded = a.candidates.recorded, from_cache = a.candidates.from_cache, requests = a.candidates.requests;
     const int refined = a.refinement.recorded, refined_from_cache = a.refinement.from_cache;
-    KnobStages(*simulator, every, stage, &a);
+    const CandidateSet first_look = std::move(a.candidates);
+    const int kept = KnobStages(*simulator, every, stage, &a, &first_look);
+    if (!every.candidates.only_knobs.empty()) {
+      a.every_execution_because += ScreenedPart(*simulator, every.candidates.only_knobs, options, kept);
+    }
     a.candidates.recorded += recorded, a.candidates.from_cache += from_cache, a.candidates.requests += requests;
     a.refinement.recorded += refined, a.refinement.from_cache += refined_from_cache;
   }

@@ -52,6 +52,17 @@ struct AnalysisOptions {
   // reached this held-out z (significance starts at the step's threshold, about 2.8): a near miss
   // that less noisy signatures may settle (the hexapod's payloads, z 2.4-2.7 from 2 executions).
   double every_execution_from_z = 2.0;
+  // The run again records only the knobs the first look screened in (ScreenedKnobs: at some step a
+  // held-out z of at least confirm_screen_z and confirm_screen_share of the step's best); the other
+  // candidates stay as competitors with their first-look signatures (KeepFirstLookCandidates).
+  // false: every knob recorded again.
+  bool confirm_screened_only = true;
+  // Two executions can underrate an effect that acts differently in a placement's later executions
+  // by a factor of about 3 (octopod 38007: servo kp z 2.9 from 2 executions, 9.7 from 5, beside a
+  // lighter robot's 8.9 and 9.0): a knob significant (about 2.8) from every execution may score 0.8
+  // from two, and one that may overtake the best scores at least a quarter of the best's z.
+  double confirm_screen_z = 0.8;
+  double confirm_screen_share = 0.25;
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };
@@ -98,6 +109,12 @@ const LegSearch* NamedByOwnModels(const Analysis& a);
 // every_execution_from_z without being significant. The run again records as many executions as
 // the real set has.
 std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options);
+// The simulator knobs (indices, sorted) a first look screened in for the run again with every
+// execution: those of every candidate that at some selection step reached held-out z `from_z` and
+// `share` of the step's best z, was selected or was confusable with a chosen one (a payload brings
+// its mass and position knobs), and the tracker's spread probe. Measurement effects need no recording.
+std::vector<int> ScreenedKnobs(const CandidateSet& set, const SelectionResult& selection, double from_z,
+                               double share = 0);
 // The largest execution index of a placement in the real set, plus one (0 without sequence data).
 int RealExecutionsPerPlacement(const AnalysisInputs& in);
 

@@ -189,6 +189,25 @@ std::string SideProbeToppled(const CandidateSet& set, const std::vector<Knob>& k
   return "";
 }
 
+// The candidates of CandidateOptions::only_knobs' probes alone (sorted, once each).
+CandidateSet OnlyTheseKnobs(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& options,
+                            CandidateSet set) {
+  const auto& knobs = simulator.knobs();
+  std::vector<int> only = options.only_knobs;
+  std::sort(only.begin(), only.end());
+  only.erase(std::unique(only.begin(), only.end()), only.end());
+  if (only.back() >= static_cast<int>(knobs.size())) {
+    throw MakeInputError("", "candidate options", Fmt("only_knobs: knob index %.0f", only.back()) +
+                                                      Fmt(" is not below the simulator's %.0f knobs",
+                                                          static_cast<double>(knobs.size())));
+  }
+  BuildLibrary(simulator, in, RecordProbes(simulator, in, only, options, &set), options.slope_ridge, &set);
+  set.legs_probed = std::any_of(only.begin(), only.end(), [&](int k) { return !knobs[k].leg.empty(); });
+  set.legs_note = set.legs_probed ? "per-leg probes recorded: the legs a first look screened in"
+                                  : "per-leg probes not recorded: a first look screened in no leg";
+  return set;
+}
+
 }  // namespace
 
 std::vector<int> ImplicatedSides(const CandidateSet& set, const SelectionResult& sel, const CandidateOptions& options,
@@ -220,6 +239,10 @@ bool CandidateOptions::IsValid(std::string* error) const {
     if (error) *error = "placements >= 0, executions_per_placement >= 0, slope_ridge >= 0 and side_top >= 1";
     return false;
   }
+  if (std::any_of(only_knobs.begin(), only_knobs.end(), [](int k) { return k < 0; })) {
+    if (error) *error = "only_knobs: knob indices >= 0";
+    return false;
+  }
   return recording.IsValid(error) && first_pass.IsValid(error);
 }
 
@@ -238,6 +261,56 @@ void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const C
               ExternalDesign(set.externals[k], set.shifts, base.sim_model, in.layout, real.pose_dim(), real.command[i],
                              real.z.row(i).transpose(), real.first_execution[i]));
   }
+}
+
+namespace {
+
+// Appends first_look's candidate k with the shifts `shifts` (first_look's indices) copied into set.
+void KeepCandidate(const CandidateSet& first_look, int k, const std::vector<int>& shifts, CandidateSet* set) {
+  ExternalCandidate e = first_look.externals[k];
+  e.shifts.clear();
+  for (int s : shifts) {
+    set->shifts.push_back(first_look.shifts.at(s));
+    e.shifts.push_back(static_cast<int>(set->shifts.size()) - 1);
+  }
+  set->candidates.push_back(first_look.candidates[k]);
+  set->library.push_back(first_look.library[k]);
+  set->externals.push_back(std::move(e));
+}
+
+void AddUnique(const std::vector<std::string>& from, std::vector<std::string>* to) {
+  for (const std::string& x : from) {
+    if (std::find(to->begin(), to->end(), x) == to->end()) to->push_back(x);
+  }
+}
+
+}  // namespace
+
+int KeepFirstLookCandidates(const CandidateSet& first_look, const std::vector<int>& recorded_knobs, CandidateSet* set) {
+  auto recorded = [&](int knob) {
+    return std::find(recorded_knobs.begin(), recorded_knobs.end(), knob) != recorded_knobs.end();
+  };
+  int kept = 0;
+  for (size_t k = 0; k < first_look.candidates.size(); ++k) {
+    const KnobCandidate& c = first_look.candidates[k];
+    const ExternalCandidate& e = first_look.externals[k];
+    const bool knob = c.simulated && c.knob_index >= 0 && !recorded(c.knob_index) && e.shifts.size() == 1;
+    const bool payload = e.kind == ExternalCandidate::kPayload && e.shifts.size() == 3 &&
+                         !recorded(first_look.payload_knob[0]) && set->payload_shift[0] < 0;
+    if (!knob && !payload) continue;
+    KeepCandidate(first_look, static_cast<int>(k), e.shifts, set);
+    if (payload) {
+      for (int j = 0; j < 3; ++j) {
+        set->payload_knob[j] = first_look.payload_knob[j];
+        set->payload_shift[j] = set->externals.back().shifts[j];
+      }
+    }
+    ++kept;
+  }
+  AddUnique(first_look.inert_knobs, &set->inert_knobs);
+  AddUnique(first_look.unwalkable_probes, &set->unwalkable_probes);
+  if (first_look.legs_probed && !set->legs_probed) set->legs_probed = true, set->legs_note = first_look.legs_note;
+  return kept;
 }
 
 FitProblem MakeCandidateProblem(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set) {
@@ -277,10 +350,11 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
     (knobs[k].leg.empty() ? first : legs).push_back(k);
     any_side |= !knobs[k].side.empty();
   }
-  const bool gate = options.legs_only_when_implicated && any_side && !legs.empty();
   CandidateSet set;
   set.recording = OwnRecording(in, options);
   set.spread_signatures = options.spread_signatures;
+  if (!options.only_knobs.empty()) return OnlyTheseKnobs(simulator, in, options, std::move(set));
+  const bool gate = options.legs_only_when_implicated && any_side && !legs.empty();
   std::vector<Probe> probes = RecordProbes(simulator, in, gate ? first : [&] {
     std::vector<int> all = first;
     all.insert(all.end(), legs.begin(), legs.end());

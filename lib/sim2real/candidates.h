@@ -41,6 +41,10 @@ struct CandidateOptions {
   // log-variance ratio per axis (effect_fit.h), so a knob whose effect is mostly a wider spread (a
   // weak leg the robot sags onto now and then) can be selected and refined. Off by default.
   bool spread_signatures = false;
+  // Non-empty: record these knobs' probes only (simulator knob indices), no side gate: the
+  // confirmation with every execution records again what the first look screened in
+  // (AnalysisOptions::confirm_screened_only).
+  std::vector<int> only_knobs;
   bool IsValid(std::string* error) const;
 };
 
@@ -80,6 +84,12 @@ struct CandidateSet {
 
 CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                              const CandidateOptions& options);
+
+// Appends to `set` (built from only some knobs, CandidateOptions::only_knobs) the simulated
+// candidates of `first_look` whose knobs it did not record, with their first-look signatures: the
+// run again keeps every competitor, the screened ones measured with every execution. Returns how
+// many candidates were kept. A payload refined in the first look is not kept (its signature changed).
+int KeepFirstLookCandidates(const CandidateSet& first_look, const std::vector<int>& recorded_knobs, CandidateSet* set);
 
 // The side knobs (knob indices) the first pass `sel` implicates: a side knob's candidate
 // selected, or among the `side_top` best simulator knobs' candidates of a forward step

@@ -270,6 +270,12 @@ TEST_F(EveryExecution, ANearMissFromFewerSignatureExecutionsIsLookedAtAgain) {
   std::string error;
   options.every_execution_from_z = std::nan("");
   EXPECT_FALSE(options.IsValid(&error));
+  options.every_execution_from_z = 2.0;
+  options.confirm_screen_z = std::nan("");
+  EXPECT_FALSE(options.IsValid(&error));
+  options.confirm_screen_z = 0.8;
+  options.confirm_screen_share = 1.5;
+  EXPECT_FALSE(options.IsValid(&error));
 }
 
 // End to end on the fake: its latency acts in the first execution after a command change only.
@@ -299,6 +305,49 @@ TEST(Analysis, TheStepDriftRecheckNamesWhatFewSignatureExecutionsReadAsADrift) {
       << again.every_execution_because;
   EXPECT_NEAR(latency(again), 0.04, 0.25 * 0.04) << again.verdict.sentence;
   EXPECT_EQ(again.candidates.recording.executions_per_placement, 5);
+  // The run again recorded only what the first look screened in, and names the same latency as a
+  // run again with every knob.
+  EXPECT_NE(again.every_execution_because.find("recorded again: the "), std::string::npos)
+      << again.every_execution_because;
+  options.confirm_screened_only = false;
+  const Analysis every_knob = Analyse(pair.sim, pair.real, &fake, options);
+  EXPECT_EQ(again.candidates.candidates.size(), every_knob.candidates.candidates.size()) << "every competitor kept";
+  EXPECT_LT(again.candidates.requests, every_knob.candidates.requests) << "fewer recorded again";
+  EXPECT_NE(again.every_execution_because.find("other candidates kept their first-look signatures"), std::string::npos);
+  EXPECT_NEAR(latency(again), latency(every_knob), 0.05 * 0.04);
+  EXPECT_EQ(again.verdict.status, every_knob.verdict.status);
+}
+
+// What a first look screens in for the run again: a candidate's knob when it reached the z at some
+// step, was selected or confusable; a payload's three knobs; the tracker's spread probe always;
+// nothing for a measurement effect.
+TEST(Analysis, TheFirstLookScreensInWhatCameNearOrWasSelected) {
+  CandidateSet set;
+  set.tracker_knob = test::kTrackerNoise;
+  set.payload_knob[0] = test::kPayloadMass, set.payload_knob[1] = test::kPayloadX, set.payload_knob[2] = test::kPayloadY;
+  set.candidates.resize(5);
+  set.candidates[0].key = "tracker_bias";  // a measurement effect: knob_index -1
+  set.candidates[1].key = "friction@0.6", set.candidates[1].knob_index = test::kFriction;
+  set.candidates[2].key = "latency@0.05", set.candidates[2].knob_index = test::kLatency;
+  set.candidates[3].key = "payload";
+  set.candidates[4].key = "leg1@0.5", set.candidates[4].knob_index = test::kLeg1Gain;
+  SelectionResult sel;
+  SelectionStep first;
+  first.chosen = 0;
+  first.candidates = {{0, 0.3, 0.05, 6.0}, {1, 0.1, 0.05, 2.0}, {2, 0.05, 0.05, 1.0}, {4, 0.01, 0.05, 0.2}};
+  sel.steps = {first};
+  sel.selected = {0};
+  EXPECT_EQ(ScreenedKnobs(set, sel, 2.0), (std::vector<int>{test::kFriction, test::kTrackerNoise}));
+  sel.steps[0].confusable = {4};
+  sel.selected = {0, 3};
+  const std::vector<int> more = ScreenedKnobs(set, sel, 2.0);
+  EXPECT_EQ(more, (std::vector<int>{test::kFriction, test::kLeg1Gain, test::kPayloadMass, test::kPayloadX,
+                                    test::kPayloadY, test::kTrackerNoise}));
+  EXPECT_EQ(ScreenedKnobs(set, sel, 0.5).size(), more.size() + 1) << "latency at z 1.0 comes in";
+  EXPECT_EQ(ScreenedKnobs(set, sel, 0.5, 0.25).size(), more.size()) << "1.0 is under a quarter of the best's 6.0";
+  EXPECT_EQ(ScreenedKnobs(set, sel, 0.5, 0.5), (std::vector<int>{test::kLeg1Gain, test::kPayloadMass, test::kPayloadX,
+                                                                   test::kPayloadY, test::kTrackerNoise}))
+      << "friction's 2.0 is under half the best's 6.0; the selected and the confusable stay";
 }
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/sim2real/stage_fixture.h"
+#include "util/error.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -46,6 +47,52 @@ TEST(Candidates, EveryLegIsProbedWhenAsked) {
   EXPECT_TRUE(set.legs_probed);
   EXPECT_NE(set.legs_note.find("(always)"), std::string::npos) << set.legs_note;
   for (int leg = 0; leg < 4; ++leg) EXPECT_GE(test::CandidateOf(set, "actuators.leg" + std::to_string(leg) + ".gain@0.5"), 0);
+}
+
+// CandidateOptions::only_knobs (the run again with every execution): those knobs' probes alone,
+// a leg among them recorded without a side's first pass, the measurement effects as always; an
+// index past the simulator's knobs is refused.
+TEST(Candidates, OnlyTheScreenedKnobsAreRecorded) {
+  test::Stages s = test::RunStages({}, 2);
+  CandidateOptions options = s.options.candidates;
+  options.only_knobs = {test::kPayloadY, test::kFriction, test::kPayloadMass, test::kPayloadX, test::kLeg1Gain,
+                        test::kFriction};
+  const CandidateSet set = BuildCandidates(test::SharedFake(), s.in, s.base, options);
+  EXPECT_EQ(set.requests, 1 + 5) << "the nominal and five knobs' probes, each once";
+  for (const std::string key : {"tracker_bias", "tracker_noise", "floor.friction@0.6", "payload",
+                                "actuators.leg1.gain@0.5"}) {
+    EXPECT_GE(test::CandidateOf(set, key), 0) << key;
+  }
+  EXPECT_LT(test::CandidateOf(set, "actuators.side.left.gain@0.5"), 0);
+  EXPECT_TRUE(set.legs_probed) << set.legs_note;
+  options.only_knobs = {test::kNumFakeKnobs};
+  EXPECT_THROW(BuildCandidates(test::SharedFake(), s.in, s.base, options), InputError);
+  options.only_knobs = {-1};
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+}
+
+// The run again keeps the first look's other candidates with their signatures: every key once,
+// the kept ones' shifts those of the first look.
+TEST(Candidates, TheFirstLooksOtherCandidatesAreKept) {
+  const test::Stages s = test::RunStages({{test::kFriction, 0.7}}, 3);
+  CandidateOptions options = s.options.candidates;
+  options.only_knobs = {test::kFriction};
+  CandidateSet again = BuildCandidates(test::SharedFake(), s.in, s.base, options);
+  const int own = static_cast<int>(again.candidates.size());
+  const int kept = KeepFirstLookCandidates(s.set, options.only_knobs, &again);
+  EXPECT_EQ(own + kept, static_cast<int>(s.set.candidates.size()));
+  for (const KnobCandidate& c : s.set.candidates) EXPECT_GE(test::CandidateOf(again, c.key), 0) << c.key;
+  const int payload = test::CandidateOf(again, "payload");
+  ASSERT_GE(payload, own) << "kept, not recorded";
+  EXPECT_EQ(again.payload_knob[0], test::kPayloadMass);
+  const PairedShift& kept_shift = again.shifts[again.externals[payload].shifts[0]];
+  const PairedShift& first_shift = s.set.shifts[s.set.externals[test::CandidateOf(s.set, "payload")].shifts[0]];
+  const Eigen::VectorXd z = Eigen::VectorXd::Zero(s.in.real.terrain_dim());
+  EXPECT_EQ(kept_shift.Shift(0, z, 1.0), first_shift.Shift(0, z, 1.0));
+  EXPECT_EQ(kept_shift.pairs(), first_shift.pairs());
+  EXPECT_EQ(again.candidates.size(), again.library.size());
+  EXPECT_EQ(again.candidates.size(), again.externals.size());
 }
 
 TEST(Candidates, MeasurementEffectsRankedAboveASideDoNotHideIt) {
