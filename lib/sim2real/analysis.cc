@@ -123,8 +123,9 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   }
 }
 
-// "; recorded again: the 4 of 23 knobs the first look screened in (z >= 2 at some step, selected or
-// confusable): a, b, c, d; 9 other candidates kept their first-look signatures".
+// "; recorded again: the 4 of 23 knobs the first look screened in (held-out z >= 0.8 and >= 0.25 of
+// the step's best at some step, selected or confusable): a, b, c, d; 9 other candidates kept their
+// first-look signatures".
 std::string ScreenedPart(const KnobSimulator& simulator, const std::vector<int>& knobs, const AnalysisOptions& options,
                          int kept) {
   std::string names;

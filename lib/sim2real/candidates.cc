@@ -93,9 +93,7 @@ void AddKnobCandidates(const KnobSimulator& sim, const AnalysisInputs& in, const
     const bool payload = k.role == Knob::Role::kPayloadMass || k.role == Knob::Role::kPayloadX ||
                          k.role == Knob::Role::kPayloadY;
     if (!payload && SameRecording(p.set, set->nominal)) {
-      if (std::find(set->inert_knobs.begin(), set->inert_knobs.end(), k.name) == set->inert_knobs.end()) {
-        set->inert_knobs.push_back(k.name);
-      }
+      AddUnique(&set->inert_knobs, k.name);
       continue;
     }
     try {
@@ -278,12 +276,6 @@ void KeepCandidate(const CandidateSet& first_look, int k, const std::vector<int>
   set->externals.push_back(std::move(e));
 }
 
-void AddUnique(const std::vector<std::string>& from, std::vector<std::string>* to) {
-  for (const std::string& x : from) {
-    if (std::find(to->begin(), to->end(), x) == to->end()) to->push_back(x);
-  }
-}
-
 }  // namespace
 
 int KeepFirstLookCandidates(const CandidateSet& first_look, const std::vector<int>& recorded_knobs, CandidateSet* set) {
@@ -307,8 +299,8 @@ int KeepFirstLookCandidates(const CandidateSet& first_look, const std::vector<in
     }
     ++kept;
   }
-  AddUnique(first_look.inert_knobs, &set->inert_knobs);
-  AddUnique(first_look.unwalkable_probes, &set->unwalkable_probes);
+  for (const std::string& k : first_look.inert_knobs) AddUnique(&set->inert_knobs, k);
+  for (const std::string& p : first_look.unwalkable_probes) AddUnique(&set->unwalkable_probes, p);
   if (first_look.legs_probed && !set->legs_probed) set->legs_probed = true, set->legs_note = first_look.legs_note;
   return kept;
 }
@@ -343,6 +335,10 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
   if (!in.sim_set.has_sequence()) {
     throw MakeInputError("--sim", "episode", "signatures need the sim set's episodes and steps");
   }
+  CandidateSet set;
+  set.recording = OwnRecording(in, options);
+  set.spread_signatures = options.spread_signatures;
+  if (!options.only_knobs.empty()) return OnlyTheseKnobs(simulator, in, options, std::move(set));
   const auto& knobs = simulator.knobs();
   std::vector<int> first, legs;
   bool any_side = false;
@@ -350,10 +346,6 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
     (knobs[k].leg.empty() ? first : legs).push_back(k);
     any_side |= !knobs[k].side.empty();
   }
-  CandidateSet set;
-  set.recording = OwnRecording(in, options);
-  set.spread_signatures = options.spread_signatures;
-  if (!options.only_knobs.empty()) return OnlyTheseKnobs(simulator, in, options, std::move(set));
   const bool gate = options.legs_only_when_implicated && any_side && !legs.empty();
   std::vector<Probe> probes = RecordProbes(simulator, in, gate ? first : [&] {
     std::vector<int> all = first;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 
+#include "sim2real/sentence_format.h"
 #include "util/error.h"
 
 namespace dgmm::sim2real {
@@ -78,10 +79,6 @@ VerdictDrifting Drifting(const CandidateSet& set, const Refinement& r, const Con
     w.first_step = e.low_step, w.last_step = e.high_step;
   }
   return w;
-}
-
-void AddUnique(std::vector<std::string>* v, const std::string& s) {
-  if (std::find(v->begin(), v->end(), s) == v->end()) v->push_back(s);
 }
 
 }  // namespace
