@@ -3,7 +3,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <random>
+#include <vector>
 
 namespace dgmm::sim2real {
 namespace {
@@ -47,6 +50,63 @@ TEST(MmdTest, ShiftedDistributionIsRejected) {
 TEST(MmdTest, TooFewSamplesGiveNoEvidence) {
   std::mt19937_64 rng(2);
   EXPECT_EQ(MmdTest(Normal(1, 2, 5, rng), Normal(10, 2, 0, rng), MmdOptions{}, rng).p_value, 1.0);
+}
+
+// The unbiased MMD^2 written out pair by pair (Gretton et al. 2012, eq. 3) with the median-heuristic
+// bandwidth over the pooled rows.
+double Mmd2ByPairs(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  Eigen::MatrixXd pooled(a.rows() + b.rows(), a.cols());
+  pooled << a, b;
+  std::vector<double> d2;
+  for (int i = 0; i < pooled.rows(); ++i)
+    for (int j = i + 1; j < pooled.rows(); ++j) d2.push_back((pooled.row(i) - pooled.row(j)).squaredNorm());
+  std::nth_element(d2.begin(), d2.begin() + d2.size() / 2, d2.end());
+  const double h2 = d2[d2.size() / 2];
+  auto k = [&](const Eigen::MatrixXd& x, int i, const Eigen::MatrixXd& y, int j) {
+    return std::exp(-(x.row(i) - y.row(j)).squaredNorm() / (2 * h2));
+  };
+  const double na = a.rows(), nb = b.rows();
+  double saa = 0, sbb = 0, sab = 0;
+  for (int i = 0; i < na; ++i)
+    for (int j = 0; j < na; ++j) saa += i == j ? 0.0 : k(a, i, a, j);
+  for (int i = 0; i < nb; ++i)
+    for (int j = 0; j < nb; ++j) sbb += i == j ? 0.0 : k(b, i, b, j);
+  for (int i = 0; i < na; ++i)
+    for (int j = 0; j < nb; ++j) sab += k(a, i, b, j);
+  return saa / (na * (na - 1)) + sbb / (nb * (nb - 1)) - 2 * sab / (na * nb);
+}
+
+TEST(MmdTest, TheStatisticIsTheUnbiasedEstimate) {
+  std::mt19937_64 rng(7);
+  for (const double shift : {0.0, 0.7}) {
+    const Eigen::MatrixXd a = Normal(23, 3, shift, rng), b = Normal(31, 3, 0, rng);
+    EXPECT_NEAR(MmdTest(a, b, MmdOptions{10}, rng).mmd2, Mmd2ByPairs(a, b), 1e-12);
+  }
+}
+
+// The p-value counts, over every permutation drawn (more than one block of them, and counts that are
+// not a multiple of a block), the splits whose statistic written out pair by pair reaches the
+// observed one; the draws: the clusters shuffled again each time, the first n_a rows to a.
+TEST(MmdTest, ThePValueCountsEveryPermutation) {
+  std::mt19937_64 data(8);
+  const Eigen::MatrixXd a = Normal(9, 2, 0.4, data), b = Normal(11, 2, 0, data);
+  Eigen::MatrixXd pooled(20, 2);
+  pooled << a, b;
+  const double observed = Mmd2ByPairs(a, b);
+  for (const int permutations : {1, 63, 64, 65, 150}) {
+    std::mt19937_64 rng(permutations), replay(permutations);
+    const MmdResult r = MmdTest(a, b, MmdOptions{permutations}, rng);
+    std::vector<std::vector<int>> clusters;  // shuffled again from the last draw's order
+    for (int i = 0; i < 20; ++i) clusters.push_back({i});
+    int exceed = 0;
+    for (int p = 0; p < permutations; ++p) {
+      std::shuffle(clusters.begin(), clusters.end(), replay);
+      Eigen::MatrixXd pa(9, 2), pb(11, 2);
+      for (int i = 0; i < 20; ++i) (i < 9 ? pa.row(i) : pb.row(i - 9)) = pooled.row(clusters[i][0]);
+      exceed += Mmd2ByPairs(pa, pb) >= observed;
+    }
+    EXPECT_DOUBLE_EQ(r.p_value, (1.0 + exceed) / (1.0 + permutations)) << permutations;
+  }
 }
 
 // `clusters` clusters of `size` rows; each cluster shares an offset of sd `between` in every
