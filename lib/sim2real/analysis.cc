@@ -65,8 +65,8 @@ int KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, c
   stage("candidates (knob signatures)");
   a->candidates = BuildCandidates(simulator, a->inputs, a->baseline, options.candidates);
   int kept = 0;
-  if (first_look && !options.candidates.only_knobs.empty()) {
-    kept = KeepFirstLookCandidates(*first_look, options.candidates.only_knobs, &a->candidates);
+  if (first_look && options.candidates.only_knobs) {
+    kept = KeepFirstLookCandidates(*first_look, *options.candidates.only_knobs, &a->candidates);
   }
   a->seconds.candidates += Since(t), t = Clock::now();
   stage("selection and refinement");
@@ -252,8 +252,8 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
     const int refined = a.refinement.recorded, refined_from_cache = a.refinement.from_cache;
     const CandidateSet first_look = std::move(a.candidates);
     const int kept = KnobStages(*simulator, every, stage, &a, &first_look);
-    if (!every.candidates.only_knobs.empty()) {
-      a.every_execution_because += ScreenedPart(*simulator, every.candidates.only_knobs, options, kept);
+    if (every.candidates.only_knobs) {
+      a.every_execution_because += ScreenedPart(*simulator, *every.candidates.only_knobs, options, kept);
     }
     a.candidates.recorded += recorded, a.candidates.from_cache += from_cache, a.candidates.requests += requests;
     a.refinement.recorded += refined, a.refinement.from_cache += refined_from_cache;

@@ -191,10 +191,10 @@ std::string SideProbeToppled(const CandidateSet& set, const std::vector<Knob>& k
 CandidateSet OnlyTheseKnobs(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& options,
                             CandidateSet set) {
   const auto& knobs = simulator.knobs();
-  std::vector<int> only = options.only_knobs;
+  std::vector<int> only = *options.only_knobs;
   std::sort(only.begin(), only.end());
   only.erase(std::unique(only.begin(), only.end()), only.end());
-  if (only.back() >= static_cast<int>(knobs.size())) {
+  if (!only.empty() && only.back() >= static_cast<int>(knobs.size())) {
     throw MakeInputError("", "candidate options", Fmt("only_knobs: knob index %.0f", only.back()) +
                                                       Fmt(" is not below the simulator's %.0f knobs",
                                                           static_cast<double>(knobs.size())));
@@ -237,7 +237,7 @@ bool CandidateOptions::IsValid(std::string* error) const {
     if (error) *error = "placements >= 0, executions_per_placement >= 0, slope_ridge >= 0 and side_top >= 1";
     return false;
   }
-  if (std::any_of(only_knobs.begin(), only_knobs.end(), [](int k) { return k < 0; })) {
+  if (only_knobs && std::any_of(only_knobs->begin(), only_knobs->end(), [](int k) { return k < 0; })) {
     if (error) *error = "only_knobs: knob indices >= 0";
     return false;
   }
@@ -338,7 +338,7 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
   CandidateSet set;
   set.recording = OwnRecording(in, options);
   set.spread_signatures = options.spread_signatures;
-  if (!options.only_knobs.empty()) return OnlyTheseKnobs(simulator, in, options, std::move(set));
+  if (options.only_knobs) return OnlyTheseKnobs(simulator, in, options, std::move(set));
   const auto& knobs = simulator.knobs();
   std::vector<int> first, legs;
   bool any_side = false;

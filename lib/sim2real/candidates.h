@@ -10,6 +10,7 @@
 // ranks among the best `side_top` simulator knobs' candidates of a forward step (measurement
 // effects not counted) with held-out z >= side_min_z (both sides' legs when both are), or for
 // every leg when the robot has no side knobs at all or a side probe toppled it.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,10 +42,10 @@ struct CandidateOptions {
   // log-variance ratio per axis (effect_fit.h), so a knob whose effect is mostly a wider spread (a
   // weak leg the robot sags onto now and then) can be selected and refined. Off by default.
   bool spread_signatures = false;
-  // Non-empty: record these knobs' probes only (simulator knob indices), no side gate: the
-  // confirmation with every execution records again what the first look screened in
-  // (AnalysisOptions::confirm_screened_only).
-  std::vector<int> only_knobs;
+  // Set: record these knobs' probes only (simulator knob indices; none: the nominal alone), no side
+  // gate: the confirmation with every execution records again what the first look screened in
+  // (AnalysisOptions::confirm_screened_only). Unset: every knob.
+  std::optional<std::vector<int>> only_knobs;
   bool IsValid(std::string* error) const;
 };
 

@@ -55,8 +55,8 @@ TEST(Candidates, EveryLegIsProbedWhenAsked) {
 TEST(Candidates, OnlyTheScreenedKnobsAreRecorded) {
   test::Stages s = test::RunStages({}, 2);
   CandidateOptions options = s.options.candidates;
-  options.only_knobs = {test::kPayloadY, test::kFriction, test::kPayloadMass, test::kPayloadX, test::kLeg1Gain,
-                        test::kFriction};
+  options.only_knobs = std::vector<int>{test::kPayloadY, test::kFriction, test::kPayloadMass, test::kPayloadX,
+                                        test::kLeg1Gain, test::kFriction};
   const CandidateSet set = BuildCandidates(test::SharedFake(), s.in, s.base, options);
   EXPECT_EQ(set.requests, 1 + 5) << "the nominal and five knobs' probes, each once";
   for (const std::string key : {"tracker_bias", "tracker_noise", "floor.friction@0.6", "payload",
@@ -65,9 +65,9 @@ TEST(Candidates, OnlyTheScreenedKnobsAreRecorded) {
   }
   EXPECT_LT(test::CandidateOf(set, "actuators.side.left.gain@0.5"), 0);
   EXPECT_TRUE(set.legs_probed) << set.legs_note;
-  options.only_knobs = {test::kNumFakeKnobs};
+  options.only_knobs = std::vector<int>{test::kNumFakeKnobs};
   EXPECT_THROW(BuildCandidates(test::SharedFake(), s.in, s.base, options), InputError);
-  options.only_knobs = {-1};
+  options.only_knobs = std::vector<int>{-1};
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
 }
@@ -77,10 +77,10 @@ TEST(Candidates, OnlyTheScreenedKnobsAreRecorded) {
 TEST(Candidates, TheFirstLooksOtherCandidatesAreKept) {
   const test::Stages s = test::RunStages({{test::kFriction, 0.7}}, 3);
   CandidateOptions options = s.options.candidates;
-  options.only_knobs = {test::kFriction};
+  options.only_knobs = std::vector<int>{test::kFriction};
   CandidateSet again = BuildCandidates(test::SharedFake(), s.in, s.base, options);
   const int own = static_cast<int>(again.candidates.size());
-  const int kept = KeepFirstLookCandidates(s.set, options.only_knobs, &again);
+  const int kept = KeepFirstLookCandidates(s.set, *options.only_knobs, &again);
   EXPECT_EQ(own + kept, static_cast<int>(s.set.candidates.size()));
   for (const KnobCandidate& c : s.set.candidates) EXPECT_GE(test::CandidateOf(again, c.key), 0) << c.key;
   const int payload = test::CandidateOf(again, "payload");
@@ -93,6 +93,24 @@ TEST(Candidates, TheFirstLooksOtherCandidatesAreKept) {
   EXPECT_EQ(kept_shift.pairs(), first_shift.pairs());
   EXPECT_EQ(again.candidates.size(), again.library.size());
   EXPECT_EQ(again.candidates.size(), again.externals.size());
+}
+
+// A screen of no knob (a first look whose finding was a measurement effect, on a robot without a
+// tracker noise knob) records the nominal alone, not every knob; the run again keeps every
+// simulated candidate of the first look.
+TEST(Candidates, AnEmptyScreenRecordsTheNominalAlone) {
+  const test::Stages s = test::RunStages({}, 3);
+  CandidateOptions options = s.options.candidates;
+  options.only_knobs = std::vector<int>{};
+  CandidateSet again = BuildCandidates(test::SharedFake(), s.in, s.base, options);
+  EXPECT_EQ(again.requests, 1) << "the nominal";
+  for (const KnobCandidate& c : again.candidates) EXPECT_FALSE(c.simulated) << c.key;
+  EXPECT_GE(test::CandidateOf(again, "tracker_bias"), 0);
+  EXPECT_FALSE(again.legs_probed);
+  const int own = static_cast<int>(again.candidates.size());
+  const int kept = KeepFirstLookCandidates(s.set, {}, &again);
+  EXPECT_GT(kept, 0);
+  EXPECT_EQ(own + kept, static_cast<int>(s.set.candidates.size()));
 }
 
 TEST(Candidates, MeasurementEffectsRankedAboveASideDoNotHideIt) {
