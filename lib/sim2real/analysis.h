@@ -114,7 +114,7 @@ std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& opti
 // `share` of the step's best z, was selected or was confusable with a chosen one (a payload brings
 // its mass and position knobs), and the tracker's spread probe. Measurement effects need no recording.
 std::vector<int> ScreenedKnobs(const CandidateSet& set, const SelectionResult& selection, double from_z,
-                               double share = 0);
+                               double share);
 // The largest execution index of a placement in the real set, plus one (0 without sequence data).
 int RealExecutionsPerPlacement(const AnalysisInputs& in);
 

@@ -337,13 +337,13 @@ TEST(Analysis, TheFirstLookScreensInWhatCameNearOrWasSelected) {
   first.candidates = {{0, 0.3, 0.05, 6.0}, {1, 0.1, 0.05, 2.0}, {2, 0.05, 0.05, 1.0}, {4, 0.01, 0.05, 0.2}};
   sel.steps = {first};
   sel.selected = {0};
-  EXPECT_EQ(ScreenedKnobs(set, sel, 2.0), (std::vector<int>{test::kFriction, test::kTrackerNoise}));
+  EXPECT_EQ(ScreenedKnobs(set, sel, 2.0, 0.0), (std::vector<int>{test::kFriction, test::kTrackerNoise}));
   sel.steps[0].confusable = {4};
   sel.selected = {0, 3};
-  const std::vector<int> more = ScreenedKnobs(set, sel, 2.0);
+  const std::vector<int> more = ScreenedKnobs(set, sel, 2.0, 0.0);
   EXPECT_EQ(more, (std::vector<int>{test::kFriction, test::kLeg1Gain, test::kPayloadMass, test::kPayloadX,
                                     test::kPayloadY, test::kTrackerNoise}));
-  EXPECT_EQ(ScreenedKnobs(set, sel, 0.5).size(), more.size() + 1) << "latency at z 1.0 comes in";
+  EXPECT_EQ(ScreenedKnobs(set, sel, 0.5, 0.0).size(), more.size() + 1) << "latency at z 1.0 comes in";
   EXPECT_EQ(ScreenedKnobs(set, sel, 0.5, 0.25).size(), more.size()) << "1.0 is under a quarter of the best's 6.0";
   EXPECT_EQ(ScreenedKnobs(set, sel, 0.5, 0.5), (std::vector<int>{test::kLeg1Gain, test::kPayloadMass, test::kPayloadX,
                                                                    test::kPayloadY, test::kTrackerNoise}))
