@@ -134,7 +134,7 @@ std::string ScreenedPart(const KnobSimulator& simulator, const std::vector<int>&
          Fmt(" of %.0f knobs the first look screened in", static_cast<double>(simulator.knobs().size())) +
          Fmt(" (held-out z >= %.3g", options.confirm_screen_z) +
          Fmt(" and >= %.3g of the step's best at some step, selected or confusable): ", options.confirm_screen_share) +
-         names +
+         (names.empty() ? "none" : names) +
          Fmt("; %.0f other candidates kept their first-look signatures", kept);
 }
 

@@ -103,7 +103,7 @@ MmdResult MmdTest(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const std:
   r.mmd2 = Mmd2(sums, observed, observed.dot(k * observed));
   // Permutations in blocks, so a'Ka of a block is one matrix product (the draws are made in order).
   constexpr int kBlock = 64;
-  Eigen::MatrixXd split(k.rows(), kBlock);
+  Eigen::MatrixXd split(k.rows(), kBlock), k_split(k.rows(), kBlock);
   // A split equal to the observed one (small regions draw it again) ties, whatever the rounding of
   // its matrix product: kernel entries are at most 1, so MMD^2 is at most 4.
   const double reached = r.mmd2 - 1e-12;
@@ -114,7 +114,7 @@ MmdResult MmdTest(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const std:
       std::shuffle(clusters.begin(), clusters.end(), rng);
       indicator(split.col(j));
     }
-    const Eigen::MatrixXd k_split = k * split.leftCols(m);
+    k_split.leftCols(m).noalias() = k * split.leftCols(m);
     for (int j = 0; j < m; ++j) {
       const double n_a = split.col(j).sum(), n_b = static_cast<double>(k.rows()) - n_a;
       // A draw that leaves a side under 2 rows has no statistic: it counts against the observed one.
