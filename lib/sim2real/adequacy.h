@@ -6,7 +6,9 @@
 //     region still significant is mismatch the knobs leave;
 //   - the held-out fit: shortfall = ceiling - corrected per real sample, with its standard error
 //     clustered by episode; gap closed = (corrected - sim) / (ceiling - sim) with a delta-method SE;
-//     a shortfall above `shortfall_z` SE and `min_shortfall_nats` is a doubt;
+//     less the null shortfall (ceiling.h: the sim model's own estimation error), an excess above
+//     `shortfall_z` SE (the larger of the real SE and the null's spread) and `min_shortfall_nats`
+//     is a doubt;
 //   - each selected knob: its value (the fit's own reading) inside the knob's range, not pinned at
 //     a limit, physically possible (>= physical_min; a gain or friction at 0 is not), and its
 //     refinement converged;
@@ -52,6 +54,7 @@ struct Adequacy {
   std::vector<Region> remaining;      // its significant regions where it is below the ceiling
   double ll_corrected = 0;
   double shortfall = 0, shortfall_se = 0;  // ceiling - corrected, nats per real sample
+  double excess_shortfall = 0, excess_shortfall_se = 0;  // less the baseline's null shortfall
   double gap_closed = NAN, gap_closed_se = NAN;
   bool below_ceiling = false;
   std::vector<KnobCheck> checks;      // per entry of the final selection

@@ -4,6 +4,7 @@
 #include <map>
 #include <set>
 
+#include "sim2real/ceiling.h"
 #include "sim2real/selection.h"
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
@@ -28,37 +29,13 @@ Eigen::MatrixXd CrossFittedResiduals(const Samples& sim, const LinearGaussianOpt
   return r;
 }
 
-// Held-out log-likelihood of each real sample under a real-trained model (same folds), with the
-// sim model as a prior of strength `prior_count` (0: real data only).
-Eigen::VectorXd RealTrainedHeldout(const Samples& real, const LinearGaussianOptions& options,
-                                   const std::vector<int>& fold, const LinearGaussianModel& sim_model,
-                                   double prior_count) {
-  std::vector<int> rows(real.size());
-  for (int i = 0; i < real.size(); ++i) rows[i] = i;
-  Eigen::VectorXd ll(real.size());
-  const int folds = *std::max_element(fold.begin(), fold.end()) + 1;
-  for (int f = 0; f < folds; ++f) {
-    const FoldSplit split = SplitFold(rows, fold, f);
-    if (split.test.empty()) continue;
-    const LinearGaussianModel m = LinearGaussianModel::FitWithPrior(real, options, split.train, sim_model, prior_count);
-    const Eigen::VectorXd t = m.LogLikelihood(SubsetSamples(real, split.test));
-    for (size_t k = 0; k < split.test.size(); ++k) ll(split.test[k]) = t(k);
-  }
-  return ll;
-}
-
-// The ceiling: the best held-out real-trained model, from real data alone (prior 0) to real data
-// with the sim model as a prior of growing strength.
+// The ceiling (ceiling.h) on the real samples with the baseline's folds and sim model.
 void Ceiling(const AnalysisInputs& in, const BaselineOptions& options, Baseline* b) {
-  for (double prior_count : {0.0, 3.0, 10.0, 30.0, 100.0}) {
-    const Eigen::VectorXd ll = RealTrainedHeldout(in.real, options.model, b->fold, b->sim_model, prior_count);
-    if (prior_count == 0) b->ll_real_only = ll.mean();
-    if (b->heldout_ceiling.size() == 0 || ll.mean() > b->heldout_ceiling.mean()) {
-      b->heldout_ceiling = ll;
-      b->ceiling_prior_count = prior_count;
-    }
-  }
-  b->ll_ceiling = b->heldout_ceiling.mean();
+  const CeilingFit c = FitCeiling(in.real, options.model, b->fold, b->sim_model);
+  b->heldout_ceiling = c.heldout;
+  b->ceiling_prior_count = c.prior_count;
+  b->ll_real_only = c.ll_real_only;
+  b->ll_ceiling = c.heldout.mean();
 }
 
 // Held-out log-likelihood of the sim model itself (nothing fitted on the real samples).
@@ -97,7 +74,7 @@ bool BaselineOptions::IsValid(std::string* error) const {
     if (error) *error = "folds >= 2, terrain_regions >= 1 and sim_residual_folds >= 2";
     return false;
   }
-  return model.IsValid(error) && locate.IsValid(error) && placement.IsValid(error);
+  return model.IsValid(error) && locate.IsValid(error) && placement.IsValid(error) && null_shortfall.IsValid(error);
 }
 
 LocateSummary LocateModel(const AnalysisInputs& in, const Baseline& base, const Eigen::MatrixXd& real_residuals,
@@ -143,6 +120,9 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
   b.heldout_sim = SimHeldout(in.real, b.sim_model);
   b.ll_sim = b.heldout_sim.mean();
   Ceiling(in, options, &b);
+  NullShortfallOptions null_options = options.null_shortfall;
+  null_options.seed = options.seed + 11;
+  b.null_shortfall = SimNullShortfall(b.sim_model, in.sim, in.real, b.fold, options.model, null_options);
   TerrainRegions(in, options, rng, &b);
   b.sim_residuals = CrossFittedResiduals(in.sim, options.model, options.sim_residual_folds, rng);
   b.real_residuals = b.sim_model.WhitenedResiduals(in.real);
