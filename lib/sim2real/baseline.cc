@@ -120,9 +120,6 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
   b.heldout_sim = SimHeldout(in.real, b.sim_model);
   b.ll_sim = b.heldout_sim.mean();
   Ceiling(in, options, &b);
-  NullShortfallOptions null_options = options.null_shortfall;
-  null_options.seed = options.seed + 11;
-  b.null_shortfall = SimNullShortfall(b.sim_model, in.sim, in.real, b.fold, options.model, null_options);
   TerrainRegions(in, options, rng, &b);
   b.sim_residuals = CrossFittedResiduals(in.sim, options.model, options.sim_residual_folds, rng);
   b.real_residuals = b.sim_model.WhitenedResiduals(in.real);
@@ -138,6 +135,12 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
     b.permute_why = Fmt("the executions at one placement are not independent: placement test p = %.3g",
                         b.placement.p_value);
   }
+  NullShortfallOptions null_options = options.null_shortfall;
+  null_options.seed = options.seed + 11;
+  if (b.permute_placements) {
+    null_options.placement_correlation = WithinPlacementCorrelation(b.sim_own_residuals, in.sim.episode);
+  }
+  b.null_shortfall = SimNullShortfall(b.sim_model, in.sim, in.real, b.fold, options.model, null_options);
   b.before = LocateModel(in, b, b.real_residuals, b.heldout_sim, true, options.locate, rng);
   b.significant_mismatch = b.before.conditional_flagged > 0;
   return b;

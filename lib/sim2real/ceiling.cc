@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
 #include <string>
 
@@ -29,15 +30,31 @@ Eigen::VectorXd RealTrainedHeldout(const Samples& real, const LinearGaussianOpti
   return ll;
 }
 
-// Samples with the commands, terrain and sequence of `design`, x drawn from `truth`.
-Samples DrawFrom(const LinearGaussianModel& truth, const Samples& design, std::mt19937_64& rng) {
+// Samples with the commands, terrain and sequence of `design`, x drawn from `truth`: whitened
+// noise sqrt(1 - rho) e + sqrt(rho) u, u shared by the executions of a placement.
+Samples DrawFrom(const LinearGaussianModel& truth, const Samples& design, const Eigen::VectorXd& rho,
+                 std::mt19937_64& rng) {
   Samples s = design;
+  const int dx = design.pose_dim();
   std::normal_distribution<double> normal;
-  Eigen::VectorXd e(design.pose_dim());
+  auto standard = [&] {
+    Eigen::VectorXd v(dx);
+    for (int d = 0; d < dx; ++d) v(d) = normal(rng);
+    return v;
+  };
+  const bool shares = rho.size() == dx;  // without a share no placement draw (the same stream as before)
+  const Eigen::ArrayXd shared = shares ? rho.array().sqrt().eval() : Eigen::ArrayXd::Zero(dx);
+  const Eigen::ArrayXd own = (1.0 - shared.square()).sqrt();
+  std::map<int, Eigen::VectorXd> placement;
   for (int i = 0; i < s.size(); ++i) {
+    Eigen::VectorXd w = standard();
+    if (shares) {
+      auto it = placement.find(s.episode[i]);
+      if (it == placement.end()) it = placement.emplace(s.episode[i], standard()).first;
+      w = (own * w.array() + shared * it->second.array()).matrix();
+    }
     const Prediction p = truth.Predict(s.command[i], s.z.row(i).transpose(), s.first_execution[i]);
-    for (int d = 0; d < e.size(); ++d) e(d) = normal(rng);
-    s.x.row(i) = (p.mean + p.chol * e).transpose();
+    s.x.row(i) = (p.mean + p.chol * w).transpose();
   }
   return s;
 }
@@ -72,7 +89,8 @@ NullShortfall SimNullShortfall(const LinearGaussianModel& sim_model, const Sampl
   std::mt19937_64 rng(options.seed);
   std::vector<double> s;
   for (int d = 0; d < options.draws; ++d) {
-    const Samples sim_d = DrawFrom(sim_model, sim, rng), real_d = DrawFrom(sim_model, real, rng);
+    const Samples sim_d = DrawFrom(sim_model, sim, options.placement_correlation, rng);
+    const Samples real_d = DrawFrom(sim_model, real, options.placement_correlation, rng);
     const LinearGaussianModel m = LinearGaussianModel::Fit(sim_d, model);
     s.push_back(FitCeiling(real_d, model, fold, m).heldout.mean() - m.LogLikelihood(real_d).mean());
   }

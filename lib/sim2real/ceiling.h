@@ -5,7 +5,10 @@
 //             with the sim model as a prior of k samples (k = 0: real data alone);
 //   null shortfall = the same gap where the sim model is the truth: sim and real sets with the
 //             sets' own commands, terrain and sequence, x drawn from the fitted sim model, the sim
-//             model refitted on the drawn sim set (a parametric bootstrap of the whole comparison).
+//             model refitted on the drawn sim set (a parametric bootstrap of the whole
+//             comparison); where the executions of a placement are dependent, each placement's
+//             draws share a part of their noise (the sim set's intraclass correlation,
+//             placement_dependence.h).
 // Where real and sim physics agree, the real-trained ceiling still beats the sim model by the sim
 // model's own estimation error (it sees more data); the adequacy test (adequacy.h) counts only
 // what lies beyond this null.
@@ -31,6 +34,8 @@ CeilingFit FitCeiling(const Samples& real, const LinearGaussianOptions& options,
 struct NullShortfallOptions {
   int draws = 20;   // parametric bootstrap draws (0: not measured)
   std::uint64_t seed = 1;
+  // Per whitened pose entry, the share of the noise a placement's executions share (empty: none).
+  Eigen::VectorXd placement_correlation;
   bool IsValid(std::string* error) const;
 };
 

@@ -88,4 +88,32 @@ PlacementDependence TestPlacementDependence(const Samples& sim, const Eigen::Mat
   return d;
 }
 
+Eigen::VectorXd WithinPlacementCorrelation(const Eigen::MatrixXd& residuals, const std::vector<int>& episode) {
+  const int dx = static_cast<int>(residuals.cols());
+  const double n = static_cast<double>(residuals.rows());
+  std::map<int, std::vector<int>> rows_of;
+  for (int i = 0; i < residuals.rows(); ++i) rows_of[episode[i]].push_back(i);
+  const double p = static_cast<double>(rows_of.size());
+  Eigen::VectorXd rho = Eigen::VectorXd::Zero(dx);
+  if (p < 2 || n <= p) return rho;
+  const Eigen::RowVectorXd grand = residuals.colwise().mean();
+  Eigen::VectorXd between = Eigen::VectorXd::Zero(dx), within = Eigen::VectorXd::Zero(dx);
+  double sum_n2 = 0;
+  for (const auto& [e, rows] : rows_of) {
+    Eigen::RowVectorXd m = Eigen::RowVectorXd::Zero(dx);
+    for (int i : rows) m += residuals.row(i);
+    m /= static_cast<double>(rows.size());
+    between += rows.size() * (m - grand).array().square().matrix().transpose();
+    for (int i : rows) within += (residuals.row(i) - m).array().square().matrix().transpose();
+    sum_n2 += static_cast<double>(rows.size()) * rows.size();
+  }
+  const double n0 = (n - sum_n2 / n) / (p - 1);
+  for (int d = 0; d < dx; ++d) {
+    const double msb = between(d) / (p - 1), msw = within(d) / (n - p);
+    const double denominator = msb + (n0 - 1) * msw;
+    rho(d) = denominator > 0 ? std::clamp((msb - msw) / denominator, 0.0, 0.95) : 0.0;
+  }
+  return rho;
+}
+
 }  // namespace dgmm::sim2real

@@ -37,4 +37,10 @@ PlacementDependence TestPlacementDependence(const Samples& sim, const Eigen::Mat
                                             const Samples& real, const Eigen::MatrixXd& real_residuals,
                                             const PlacementDependenceOptions& options, std::uint64_t seed);
 
+// Per column of `residuals` (one row per sample), the share of its variance the executions of one
+// placement (`episode`) share: the one-way intraclass correlation
+//   rho = (MSB - MSW) / (MSB + (n0 - 1) MSW),  n0 = (N - sum n_p^2 / N) / (P - 1),
+// clamped to [0, 0.95]; zeros when there are fewer than two placements or none repeats.
+Eigen::VectorXd WithinPlacementCorrelation(const Eigen::MatrixXd& residuals, const std::vector<int>& episode);
+
 }  // namespace dgmm::sim2real

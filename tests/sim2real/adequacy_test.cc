@@ -44,6 +44,26 @@ TEST(Adequacy, PhysicsNoKnobDescribesLeavesLocatedMismatch) {
   EXPECT_FALSE(s.adequacy.doubts.empty());
 }
 
+TEST(Adequacy, OnlyTheShortfallBeyondTheSimSetsOwnSizeIsADoubt) {
+  test::FakeExtras extras;
+  extras.geometry = 0.03;
+  test::Stages s = test::RunStages({}, 5, extras);
+  s.base.null_shortfall = {};  // no null: the whole shortfall counts
+  const Adequacy whole = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  ASSERT_TRUE(whole.below_ceiling) << whole.shortfall << " SE " << whole.shortfall_se;
+  EXPECT_DOUBLE_EQ(whole.excess_shortfall, whole.shortfall);
+  // A null that accounts for all but a sliver of it leaves no doubt about the fit ...
+  s.base.null_shortfall.mean = whole.shortfall - 0.01;
+  s.base.null_shortfall.draws = 20;
+  const Adequacy within = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  EXPECT_FALSE(within.below_ceiling);
+  EXPECT_NEAR(within.excess_shortfall, 0.01, 1e-12);
+  // ... and a null as large but spread wider than the excess is no doubt either.
+  s.base.null_shortfall.mean = 0;
+  s.base.null_shortfall.sd = whole.shortfall;
+  EXPECT_FALSE(AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy).below_ceiling);
+}
+
 TEST(Adequacy, GapClosedAndItsStandardError) {
   // corrected - sim = 1 and ceiling - sim = 2 in every episode: half the gap, no spread.
   const Eigen::VectorXd sim = Eigen::VectorXd::Zero(6), corrected = Eigen::VectorXd::Ones(6);

@@ -65,6 +65,20 @@ TEST(NullShortfall, MissingPhysicsStandsAboveTheNull) {
   EXPECT_GT(shortfall - null.mean, 3 * null.sd + 0.05) << "null " << null.mean << " shortfall " << shortfall;
 }
 
+TEST(NullShortfall, PlacementsSharingTheirNoiseRaiseTheNull) {
+  // Executions of a placement that share half their noise carry less information than as many
+  // independent ones: the sim model's estimation error, and so the null, grow.
+  const Samples sim = Make(SyntheticWorld{}, "paper-830", 25), real = Make(SyntheticWorld{}, "paper", 25);
+  const std::vector<int> fold = Folds(real, 1);
+  const LinearGaussianModel m = LinearGaussianModel::Fit(sim, LinearGaussianOptions{});
+  NullShortfallOptions o;
+  const NullShortfall independent = SimNullShortfall(m, sim, real, fold, LinearGaussianOptions{}, o);
+  o.placement_correlation = Eigen::VectorXd::Constant(6, 0.5);
+  const NullShortfall shared = SimNullShortfall(m, sim, real, fold, LinearGaussianOptions{}, o);
+  EXPECT_GT(shared.mean, independent.mean + 2 * independent.sd / std::sqrt(20.0))
+      << "shared " << shared.mean << " independent " << independent.mean;
+}
+
 TEST(NullShortfall, NoDrawsNoNull) {
   const Samples sim = Make(SyntheticWorld{}, "paper-830", 23), real = Make(SyntheticWorld{}, "paper", 23);
   const NullShortfall null = Null(sim, real, Folds(real, 1), 0);

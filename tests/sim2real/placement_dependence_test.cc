@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include <map>
 #include <random>
 
 namespace dgmm::sim2real {
@@ -69,6 +70,34 @@ TEST(PlacementDependence, SetsWithoutPlacementsGiveNoEvidence) {
       TestPlacementDependence(s, Residuals(s, 4), s, Residuals(s, 4), PlacementDependenceOptions{}, 1);
   EXPECT_EQ(d.p_value, 1.0);
   EXPECT_FALSE(d.dependent);
+}
+
+// x less its command's mean: what the command leaves.
+Eigen::MatrixXd CommandResiduals(const Samples& s) {
+  Eigen::MatrixXd r = s.x;
+  std::map<int, std::pair<Eigen::RowVectorXd, int>> sum;
+  for (int i = 0; i < s.size(); ++i) {
+    auto& [m, n] = sum.try_emplace(s.command[i], Eigen::RowVectorXd::Zero(s.pose_dim()), 0).first->second;
+    m += s.x.row(i), ++n;
+  }
+  for (int i = 0; i < s.size(); ++i) r.row(i) -= sum[s.command[i]].first / sum[s.command[i]].second;
+  return r;
+}
+
+TEST(PlacementDependence, TheIntraclassCorrelationIsTheSharedShareOfTheVariance) {
+  std::mt19937_64 rng(5);
+  // An offset of sd 1 shared by a placement's executions, noise of sd 1 of their own: half the
+  // variance is shared.
+  const Samples dependent = Set(300, 5, 3, 1.0, rng), independent = Set(300, 5, 3, 0.0, rng);
+  const Eigen::VectorXd rho = WithinPlacementCorrelation(CommandResiduals(dependent), dependent.episode);
+  ASSERT_EQ(rho.size(), 2);
+  EXPECT_NEAR(rho(0), 0.5, 0.08);
+  EXPECT_NEAR(rho(1), 0.5, 0.08);
+  EXPECT_LT(WithinPlacementCorrelation(CommandResiduals(independent), independent.episode).maxCoeff(), 0.06);
+  // Every sample its own placement: nothing shared to measure.
+  std::vector<int> own(dependent.size());
+  for (int i = 0; i < dependent.size(); ++i) own[i] = i;
+  EXPECT_EQ(WithinPlacementCorrelation(CommandResiduals(dependent), own).maxCoeff(), 0.0);
 }
 
 TEST(PlacementDependence, OptionsAreChecked) {
