@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <map>
 
+#include "sim2real/ceiling.h"
+#include "sim2real/placement_dependence.h"
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
 
@@ -111,17 +113,17 @@ void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refineme
 }
 
 // The held-out fit against the ceiling; the located regions that remain.
-void TestFit(const AnalysisInputs& in, const Baseline& base, const Refinement& r, const AdequacyOptions& options,
-             Adequacy* out) {
+void TestFit(const AnalysisInputs& in, const Baseline& base, const NullShortfall& null, const Refinement& r,
+             const AdequacyOptions& options, Adequacy* out) {
   const Eigen::VectorXd& corrected = r.selection.heldout_corrected;
   out->ll_corrected = corrected.mean();
   ClusteredMean(base.heldout_ceiling - corrected, in.real.episode, &out->shortfall, &out->shortfall_se);
   GapClosed(base.heldout_sim, corrected, base.heldout_ceiling, in.real.episode, &out->gap_closed, &out->gap_closed_se);
   // Only what lies beyond the sim set's own estimation error (ceiling.h) is the correction's doubt.
-  out->excess_shortfall = out->shortfall - base.null_shortfall.mean;
+  out->excess_shortfall = out->shortfall - null.mean;
   // Two estimates of the shortfall's spread, the larger counts: the null's draws (sim model's
   // estimation and real sampling, executions independent) and the real samples' clustered SE.
-  out->excess_shortfall_se = std::max(out->shortfall_se, base.null_shortfall.sd);
+  out->excess_shortfall_se = std::max(out->shortfall_se, null.sd);
   out->below_ceiling = out->excess_shortfall > options.min_shortfall_nats &&
                        out->excess_shortfall > options.shortfall_z * out->excess_shortfall_se;
   if (out->below_ceiling) {
@@ -155,7 +157,7 @@ bool AdequacyOptions::IsValid(std::string* error) const {
     if (error) *error = "shortfall_z > 0, min_shortfall_nats >= 0, 0 <= pinned_within < 0.5";
     return false;
   }
-  return locate.IsValid(error) && residual.IsValid(error) && drift.IsValid(error);
+  return locate.IsValid(error) && residual.IsValid(error) && drift.IsValid(error) && null_shortfall.IsValid(error);
 }
 
 void GapClosed(const Eigen::VectorXd& sim, const Eigen::VectorXd& corrected, const Eigen::VectorXd& ceiling,
@@ -175,13 +177,23 @@ void GapClosed(const Eigen::VectorXd& sim, const Eigen::VectorXd& corrected, con
   *se = std::sqrt(c / (c - 1) * v) / (n * gm);
 }
 
-Adequacy AssessAdequacy(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, const Refinement& r,
-                        const AdequacyOptions& options) {
+NullShortfall MeasureNullShortfall(const AnalysisInputs& in, const Baseline& base, const LinearGaussianOptions& model,
+                                   const AdequacyOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "adequacy options", error);
+  NullShortfallOptions null = options.null_shortfall;
+  null.seed = options.seed + 11;
+  if (base.permute_placements) null.placement_correlation = WithinPlacementCorrelation(base.sim_own_residuals, in.sim.episode);
+  return SimNullShortfall(base.sim_model, in.sim, in.real, base.fold, model, null);
+}
+
+Adequacy AssessAdequacy(const AnalysisInputs& in, const Baseline& base, const NullShortfall& null,
+                        const CandidateSet& set, const Refinement& r, const AdequacyOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "adequacy options", error);
   Adequacy out;
   TestResidual(in, base, r, options, &out);
-  TestFit(in, base, r, options, &out);
+  TestFit(in, base, null, r, options, &out);
   for (size_t pos = 0; pos < r.selection.selected.size(); ++pos) {
     out.checks.push_back(CheckKnob(set, r, static_cast<int>(pos), options));
   }

@@ -31,6 +31,7 @@ struct AdequacyOptions {
   double shortfall_z = 3.0;           // SEs below the ceiling that make a doubt ...
   double min_shortfall_nats = 0.05;   // ... when also this far below (nats per real sample)
   double pinned_within = 1e-3;        // share of the knob's range counted as "at the limit"
+  NullShortfallOptions null_shortfall;  // seeded from seed + 11 (0 draws: the null is 0)
   bool IsValid(std::string* error) const;
 };
 
@@ -54,7 +55,7 @@ struct Adequacy {
   std::vector<Region> remaining;      // its significant regions where it is below the ceiling
   double ll_corrected = 0;
   double shortfall = 0, shortfall_se = 0;  // ceiling - corrected, nats per real sample
-  double excess_shortfall = 0, excess_shortfall_se = 0;  // less the baseline's null shortfall
+  double excess_shortfall = 0, excess_shortfall_se = 0;  // less the null shortfall
   double gap_closed = NAN, gap_closed_se = NAN;
   bool below_ceiling = false;
   std::vector<KnobCheck> checks;      // per entry of the final selection
@@ -64,8 +65,15 @@ struct Adequacy {
   std::vector<std::string> doubts;    // about the correction as a whole, in words
 };
 
-Adequacy AssessAdequacy(const AnalysisInputs& in, const Baseline& base, const CandidateSet& set, const Refinement& r,
-                        const AdequacyOptions& options);
+// The null shortfall of this comparison (ceiling.h), measured once per analysis: where locate
+// permutes whole placements, each placement's draws share the sim set's within-placement share of
+// the noise (placement_dependence.h). `model` is the baseline's (BaselineOptions::model).
+NullShortfall MeasureNullShortfall(const AnalysisInputs& in, const Baseline& base, const LinearGaussianOptions& model,
+                                   const AdequacyOptions& options);
+
+// `null` is MeasureNullShortfall's (a default NullShortfall: the whole shortfall counts).
+Adequacy AssessAdequacy(const AnalysisInputs& in, const Baseline& base, const NullShortfall& null,
+                        const CandidateSet& set, const Refinement& r, const AdequacyOptions& options);
 
 // (corrected - sim) / (ceiling - sim) of per-sample held-out values, with its SE clustered by
 // `cluster` (delta method). NaN when the ceiling is not above the sim model.

@@ -77,7 +77,7 @@ int KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, c
   a->confidence = AssessConfidence(a->candidates, a->refinement, rng);
   a->seconds.confidence += Since(t), t = Clock::now();
   stage("adequacy");
-  a->adequacy = AssessAdequacy(a->inputs, a->baseline, a->candidates, a->refinement, options.adequacy);
+  a->adequacy = AssessAdequacy(a->inputs, a->baseline, a->null_shortfall, a->candidates, a->refinement, options.adequacy);
   a->naming = DecideNamed(a->candidates, a->refinement, a->confidence, a->adequacy, options.verdict);
   a->seconds.adequacy += Since(t), t = Clock::now();
   stage("ties and experiment checks");
@@ -238,6 +238,9 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
     return a;
   }
   a.knobs_analysed = true;
+  const auto null_start = Clock::now();
+  a.null_shortfall = MeasureNullShortfall(a.inputs, a.baseline, options.locate.model, options.adequacy);
+  a.seconds.adequacy += Since(null_start);
   KnobStages(*simulator, options, stage, &a);
   a.every_execution_because = EveryExecutionBecause(a, options);
   if (!a.every_execution_because.empty()) {

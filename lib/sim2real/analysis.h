@@ -79,6 +79,7 @@ struct Analysis {
   // Why stages 3-8 ran again with signatures of every execution per placement (empty: they did
   // not); the stages' results are the second run's.
   std::string every_execution_because;
+  NullShortfall null_shortfall;    // the adequacy's null, measured once (MeasureNullShortfall)
   CandidateSet candidates;
   Refinement refinement;
   Confidence confidence;

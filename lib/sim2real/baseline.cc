@@ -74,7 +74,7 @@ bool BaselineOptions::IsValid(std::string* error) const {
     if (error) *error = "folds >= 2, terrain_regions >= 1 and sim_residual_folds >= 2";
     return false;
   }
-  return model.IsValid(error) && locate.IsValid(error) && placement.IsValid(error) && null_shortfall.IsValid(error);
+  return model.IsValid(error) && locate.IsValid(error) && placement.IsValid(error);
 }
 
 LocateSummary LocateModel(const AnalysisInputs& in, const Baseline& base, const Eigen::MatrixXd& real_residuals,
@@ -135,12 +135,6 @@ Baseline LocateMismatch(const AnalysisInputs& in, const BaselineOptions& options
     b.permute_why = Fmt("the executions at one placement are not independent: placement test p = %.3g",
                         b.placement.p_value);
   }
-  NullShortfallOptions null_options = options.null_shortfall;
-  null_options.seed = options.seed + 11;
-  if (b.permute_placements) {
-    null_options.placement_correlation = WithinPlacementCorrelation(b.sim_own_residuals, in.sim.episode);
-  }
-  b.null_shortfall = SimNullShortfall(b.sim_model, in.sim, in.real, b.fold, options.model, null_options);
   b.before = LocateModel(in, b, b.real_residuals, b.heldout_sim, true, options.locate, rng);
   b.significant_mismatch = b.before.conditional_flagged > 0;
   return b;

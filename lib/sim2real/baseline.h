@@ -25,7 +25,6 @@ struct BaselineOptions {
   LinearGaussianOptions model;
   LocateOptions locate;
   PlacementDependenceOptions placement;  // seeded with `seed`
-  NullShortfallOptions null_shortfall;   // seeded from `seed` (0 draws: the ceiling's null is 0)
   // The simulator's ground is a height field: where a placement stands shapes all its executions
   // and z does not say where, so locate permutes whole placements whatever the test says.
   bool uneven_ground = false;
@@ -47,7 +46,6 @@ struct Baseline {
   Eigen::VectorXd heldout_sim;        // per real sample: the sim model (no fitting involved)
   Eigen::VectorXd heldout_ceiling;    // per real sample: the best real-trained model, same folds
   double ll_sim = 0, ll_ceiling = 0, ll_real_only = 0, ceiling_prior_count = 0;
-  NullShortfall null_shortfall;       // how far below the ceiling the sim set's own size puts the sim model
   Eigen::MatrixXd terrain_centres;    // k x dz
   std::vector<std::string> terrain_labels;
   std::vector<int> real_terrain, sim_terrain;  // region per sample

@@ -91,15 +91,14 @@ PlacementDependence TestPlacementDependence(const Samples& sim, const Eigen::Mat
 Eigen::VectorXd WithinPlacementCorrelation(const Eigen::MatrixXd& residuals, const std::vector<int>& episode) {
   const int dx = static_cast<int>(residuals.cols());
   const double n = static_cast<double>(residuals.rows());
-  std::map<int, std::vector<int>> rows_of;
-  for (int i = 0; i < residuals.rows(); ++i) rows_of[episode[i]].push_back(i);
+  const std::vector<std::vector<int>> rows_of = RowsOfUnits(NumberUnitsAscending(episode));
   const double p = static_cast<double>(rows_of.size());
   Eigen::VectorXd rho = Eigen::VectorXd::Zero(dx);
   if (p < 2 || n <= p) return rho;
   const Eigen::RowVectorXd grand = residuals.colwise().mean();
   Eigen::VectorXd between = Eigen::VectorXd::Zero(dx), within = Eigen::VectorXd::Zero(dx);
   double sum_n2 = 0;
-  for (const auto& [e, rows] : rows_of) {
+  for (const std::vector<int>& rows : rows_of) {
     Eigen::RowVectorXd m = Eigen::RowVectorXd::Zero(dx);
     for (int i : rows) m += residuals.row(i);
     m /= static_cast<double>(rows.size());

@@ -230,7 +230,7 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
                                     : std::string("no gap (the sim model is at or above the ceiling)"))
     << "; the corrected model is " << F("%.3f", q.shortfall) << " nats per sample (SE " << F("%.3f", q.shortfall_se)
     << ") below the ceiling; where the physics agree, the sim set's own size puts the sim model "
-    << F("%.3f", a.baseline.null_shortfall.mean) << " below it (SD " << F("%.3f", a.baseline.null_shortfall.sd)
+    << F("%.3f", a.null_shortfall.mean) << " below it (SD " << F("%.3f", a.null_shortfall.sd)
     << ", sets drawn from the sim model). The corrected model is written as <code>" << Escape(ctx.corrected_model_file)
     << "</code> (readable by <code>dgmm score</code> and <code>dgmm render</code>).</p>\n"
     << "<h3>Locate again, on the corrected model</h3>"

@@ -48,20 +48,20 @@ TEST(Adequacy, OnlyTheShortfallBeyondTheSimSetsOwnSizeIsADoubt) {
   test::FakeExtras extras;
   extras.geometry = 0.03;
   test::Stages s = test::RunStages({}, 5, extras);
-  s.base.null_shortfall = {};  // no null: the whole shortfall counts
-  const Adequacy whole = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  s.null = {};  // no null: the whole shortfall counts
+  const Adequacy whole = AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, s.options.adequacy);
   ASSERT_TRUE(whole.below_ceiling) << whole.shortfall << " SE " << whole.shortfall_se;
   EXPECT_DOUBLE_EQ(whole.excess_shortfall, whole.shortfall);
   // A null that accounts for all but a sliver of it leaves no doubt about the fit ...
-  s.base.null_shortfall.mean = whole.shortfall - 0.01;
-  s.base.null_shortfall.draws = 20;
-  const Adequacy within = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  s.null.mean = whole.shortfall - 0.01;
+  s.null.draws = 20;
+  const Adequacy within = AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, s.options.adequacy);
   EXPECT_FALSE(within.below_ceiling);
   EXPECT_NEAR(within.excess_shortfall, 0.01, 1e-12);
   // ... and a null as large but spread wider than the excess is no doubt either.
-  s.base.null_shortfall.mean = 0;
-  s.base.null_shortfall.sd = whole.shortfall;
-  EXPECT_FALSE(AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy).below_ceiling);
+  s.null.mean = 0;
+  s.null.sd = whole.shortfall;
+  EXPECT_FALSE(AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, s.options.adequacy).below_ceiling);
 }
 
 TEST(Adequacy, GapClosedAndItsStandardError) {

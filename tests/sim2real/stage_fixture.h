@@ -19,6 +19,7 @@ struct Stages {
   CandidateSet set;
   Refinement refinement;
   Confidence confidence;
+  NullShortfall null;
   Adequacy adequacy;
   Naming naming;
 };
@@ -39,7 +40,8 @@ inline Stages RunStages(const FakeSimulator& fake, const std::vector<KnobValue>&
   std::mt19937_64 rng(2);
   s.confidence = AssessConfidence(s.set, s.refinement, rng);
   if (last < 6) return s;
-  s.adequacy = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  s.null = MeasureNullShortfall(s.in, s.base, s.options.locate.model, s.options.adequacy);
+  s.adequacy = AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, s.options.adequacy);
   s.naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
   return s;
 }

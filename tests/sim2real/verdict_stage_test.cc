@@ -94,7 +94,7 @@ TEST(VerdictStage, BootstrapOffWritesNullInclusionAndNotComputed) {
   s.refinement.selection_options.bootstrap_selection = 0;
   std::mt19937_64 rng(1);
   s.confidence = AssessConfidence(s.set, s.refinement, rng);
-  s.adequacy = AssessAdequacy(s.in, s.base, s.set, s.refinement, s.options.adequacy);
+  s.adequacy = AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, s.options.adequacy);
   s.naming = DecideNamed(s.set, s.refinement, s.confidence, s.adequacy, s.options.verdict);
   const Verdict v = Compose(s, s.naming);
   ASSERT_FALSE(v.named.empty());
