@@ -59,6 +59,71 @@ Eigen::Matrix3d YToZ() {
   return m;
 }
 
+void AddCapsuleOrCylinder(vtkRenderer* renderer, const ScenePrimitive& p) {
+  auto cylinder = Ptr<vtkCylinderSource>::New();
+  cylinder->SetRadius(p.size[0]);
+  cylinder->SetHeight(2 * p.size[1]);
+  cylinder->SetResolution(20);
+  AddActor(renderer, cylinder, p.rotation * YToZ(), p.position, p.rgba);
+  if (p.type != ScenePrimitive::Type::kCapsule) return;
+  for (double end : {-1.0, 1.0}) {
+    auto cap = Ptr<vtkSphereSource>::New();
+    cap->SetRadius(p.size[0]);
+    cap->SetThetaResolution(16);
+    cap->SetPhiResolution(10);
+    AddActor(renderer, cap, p.rotation, p.position + p.rotation * Eigen::Vector3d(0, 0, end * p.size[1]), p.rgba);
+  }
+}
+
+// The grid as a plane source of that resolution, its points lifted to the heights.
+void AddHeightField(vtkRenderer* renderer, const ScenePrimitive& p) {
+  auto plane = Ptr<vtkPlaneSource>::New();
+  const double h = 0.5 * (p.grid - 1) * p.spacing;
+  plane->SetOrigin(-h, -h, 0);
+  plane->SetPoint1(h, -h, 0);
+  plane->SetPoint2(-h, h, 0);
+  plane->SetResolution(p.grid - 1, p.grid - 1);
+  plane->Update();
+  auto surface = Ptr<vtkPolyData>::New();
+  surface->DeepCopy(plane->GetOutput());
+  vtkPoints* points = surface->GetPoints();
+  for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
+    double xyz[3];
+    points->GetPoint(i, xyz);
+    xyz[2] = p.heights[static_cast<std::size_t>(i)];
+    points->SetPoint(i, xyz);
+  }
+  auto normals = Ptr<vtkPolyDataNormals>::New();
+  normals->SetInputData(surface);
+  AddActor(renderer, normals, p.rotation, p.position, p.rgba);
+}
+
+// A tile with a grid of lines on it, so motion and tilt read in a still picture.
+void AddPlane(vtkRenderer* renderer, const ScenePrimitive& p) {
+  auto plane = Ptr<vtkPlaneSource>::New();
+  const double hx = p.size[0] > 0 ? p.size[0] : 2, hy = p.size[1] > 0 ? p.size[1] : 2;
+  plane->SetOrigin(-hx, -hy, 0);
+  plane->SetPoint1(hx, -hy, 0);
+  plane->SetPoint2(-hx, hy, 0);
+  plane->SetResolution(static_cast<int>(2 * hx / 0.25), static_cast<int>(2 * hy / 0.25));
+  AddActor(renderer, plane, p.rotation, p.position, p.rgba);
+  auto mapper = Ptr<vtkPolyDataMapper>::New();
+  mapper->SetInputConnection(plane->GetOutputPort());
+  auto grid = Ptr<vtkActor>::New();
+  grid->SetMapper(mapper);
+  auto m = Ptr<vtkMatrix4x4>::New();
+  const Eigen::Vector3d lifted = p.position + p.rotation * Eigen::Vector3d(0, 0, 1e-3);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) m->SetElement(i, j, p.rotation(i, j));
+    m->SetElement(i, 3, lifted[i]);
+  }
+  grid->SetUserMatrix(m);
+  grid->GetProperty()->SetRepresentationToWireframe();
+  grid->GetProperty()->SetColor(0.3, 0.35, 0.3);
+  grid->GetProperty()->LightingOff();
+  renderer->AddActor(grid);
+}
+
 void AddPrimitive(vtkRenderer* renderer, const ScenePrimitive& p) {
   using Type = ScenePrimitive::Type;
   switch (p.type) {
@@ -79,73 +144,15 @@ void AddPrimitive(vtkRenderer* renderer, const ScenePrimitive& p) {
       break;
     }
     case Type::kCapsule:
-    case Type::kCylinder: {
-      auto cylinder = Ptr<vtkCylinderSource>::New();
-      cylinder->SetRadius(p.size[0]);
-      cylinder->SetHeight(2 * p.size[1]);
-      cylinder->SetResolution(20);
-      AddActor(renderer, cylinder, p.rotation * YToZ(), p.position, p.rgba);
-      if (p.type == Type::kCapsule) {
-        for (double end : {-1.0, 1.0}) {
-          auto cap = Ptr<vtkSphereSource>::New();
-          cap->SetRadius(p.size[0]);
-          cap->SetThetaResolution(16);
-          cap->SetPhiResolution(10);
-          AddActor(renderer, cap, p.rotation,
-                   p.position + p.rotation * Eigen::Vector3d(0, 0, end * p.size[1]), p.rgba);
-        }
-      }
+    case Type::kCylinder:
+      AddCapsuleOrCylinder(renderer, p);
       break;
-    }
-    case Type::kHeightField: {
-      // The grid as a plane source of that resolution, its points lifted to the heights.
-      auto plane = Ptr<vtkPlaneSource>::New();
-      const double h = 0.5 * (p.grid - 1) * p.spacing;
-      plane->SetOrigin(-h, -h, 0);
-      plane->SetPoint1(h, -h, 0);
-      plane->SetPoint2(-h, h, 0);
-      plane->SetResolution(p.grid - 1, p.grid - 1);
-      plane->Update();
-      auto surface = Ptr<vtkPolyData>::New();
-      surface->DeepCopy(plane->GetOutput());
-      vtkPoints* points = surface->GetPoints();
-      for (vtkIdType i = 0; i < points->GetNumberOfPoints(); ++i) {
-        double xyz[3];
-        points->GetPoint(i, xyz);
-        xyz[2] = p.heights[static_cast<std::size_t>(i)];
-        points->SetPoint(i, xyz);
-      }
-      auto normals = Ptr<vtkPolyDataNormals>::New();
-      normals->SetInputData(surface);
-      AddActor(renderer, normals, p.rotation, p.position, p.rgba);
+    case Type::kHeightField:
+      AddHeightField(renderer, p);
       break;
-    }
-    case Type::kPlane: {
-      auto plane = Ptr<vtkPlaneSource>::New();
-      const double hx = p.size[0] > 0 ? p.size[0] : 2, hy = p.size[1] > 0 ? p.size[1] : 2;
-      plane->SetOrigin(-hx, -hy, 0);
-      plane->SetPoint1(hx, -hy, 0);
-      plane->SetPoint2(-hx, hy, 0);
-      plane->SetResolution(static_cast<int>(2 * hx / 0.25), static_cast<int>(2 * hy / 0.25));
-      AddActor(renderer, plane, p.rotation, p.position, p.rgba);
-      // A grid of lines on the tile so motion and tilt read in a still picture.
-      auto mapper = Ptr<vtkPolyDataMapper>::New();
-      mapper->SetInputConnection(plane->GetOutputPort());
-      auto grid = Ptr<vtkActor>::New();
-      grid->SetMapper(mapper);
-      auto m = Ptr<vtkMatrix4x4>::New();
-      const Eigen::Vector3d lifted = p.position + p.rotation * Eigen::Vector3d(0, 0, 1e-3);
-      for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j) m->SetElement(i, j, p.rotation(i, j));
-        m->SetElement(i, 3, lifted[i]);
-      }
-      grid->SetUserMatrix(m);
-      grid->GetProperty()->SetRepresentationToWireframe();
-      grid->GetProperty()->SetColor(0.3, 0.35, 0.3);
-      grid->GetProperty()->LightingOff();
-      renderer->AddActor(grid);
+    case Type::kPlane:
+      AddPlane(renderer, p);
       break;
-    }
   }
 }
 

@@ -74,6 +74,14 @@ SliceExplorer::SliceExplorer(ExplorerInputs inputs, const ExplorerOptions& optio
                          "the viewer shows two pose dimensions; the model has " +
                              std::to_string(a.pose_dim));
   }
+  ListCommands();
+  PickCommandAndAxes(options);
+  MakeSliders(options);
+  Update();
+}
+
+void SliceExplorer::ListCommands() {
+  const MotionModel& a = in_.model;
   names_ = DimensionNames(a);
   if (in_.compare && DimensionNames(*in_.compare) != names_) {
     throw MakeInputError(in_.compare_file, "dimensions",
@@ -100,6 +108,10 @@ SliceExplorer::SliceExplorer(ExplorerInputs inputs, const ExplorerOptions& optio
                          "expected " + std::to_string(a.pose_dim) + " pose + " +
                              std::to_string(a.terrain_dim) + " terrain dimensions like the model");
   }
+}
+
+void SliceExplorer::PickCommandAndAxes(const ExplorerOptions& options) {
+  const MotionModel& a = in_.model;
   if (!options.command.empty()) {
     const int id = ResolveCommand(a, options.command, in_.model_file);
     auto it = std::find(command_ids_.begin(), command_ids_.end(), id);
@@ -120,6 +132,10 @@ SliceExplorer::SliceExplorer(ExplorerInputs inputs, const ExplorerOptions& optio
   y_index_ = pose_index(options.y_dim, x_index_ == 0 ? 1 : 0);
   if (x_index_ == y_index_) throw MakeInputError("", "dimension", "x and y must differ");
 
+}
+
+void SliceExplorer::MakeSliders(const ExplorerOptions& options) {
+  const MotionModel& a = in_.model;
   // Slider spans: the data's terrain when given, else the model's 3-sigma extent.
   const Mixture first = RawMixture(a, command_ids_[command_index_]);
   std::vector<Mixture> raws;
@@ -162,7 +178,6 @@ SliceExplorer::SliceExplorer(ExplorerInputs inputs, const ExplorerOptions& optio
     it->max = std::max(it->max, value);
     it->value = value;
   }
-  Update();
 }
 
 void SliceExplorer::StepCommand(int step) {

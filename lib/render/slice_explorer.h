@@ -102,6 +102,12 @@ class SliceExplorer {
   std::vector<std::string> RenderArguments(const std::string& png) const;
 
  private:
+  // The constructor's parts: the commands shown (both models' when comparing), the data checked
+  // against the model; the command shown first and the x and y pose dimensions; one slider per terrain dimension, spanning
+  // the data's terrain (else the model's 3-sigma extent) and set to the options' conditions.
+  void ListCommands();
+  void PickCommandAndAxes(const ExplorerOptions& options);
+  void MakeSliders(const ExplorerOptions& options);
   // Recomputes slices and points after a change of picks; a window held by a terrain move is
   // released unless keep_window.
   void Update(bool keep_window = false);

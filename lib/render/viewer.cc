@@ -109,6 +109,11 @@ struct Viewer::Impl {
   }
 
   void Build();
+  void AddPanels(double top);  // one chart renderer per panel, below `top` (viewport units)
+  void AddStrip(double top);   // the control strip above `top`: help, hover and status lines
+  void AddSlider(int t, int width, int height);  // terrain slider t, in a window width x height
+  void StyleSlider(vtkSliderRepresentation2D* rep, int width, int height);
+  void Listen();               // keys, mouse and sliders to OnKey/OnMouseMove/OnWheel; the recorder
   void UpdateTexts();
   std::vector<std::string> SaveTo(const std::string& png_path);
   void OnKey(const std::string& key);
@@ -141,6 +146,14 @@ void Viewer::Impl::Build() {
   // pixel (0, 0) like the offscreen view of `dgmm render`, so its pixels are the same (an offset
   // viewport can round a line end that lies on a pixel boundary to the other side).
   const double top = static_cast<double>(panel_h) / height;
+  AddPanels(top);
+  AddStrip(top);
+  interactor->Initialize();
+  for (int t = 0; t < terrain; ++t) AddSlider(t, width, height);
+  Listen();
+}
+
+void Viewer::Impl::AddPanels(double top) {
   for (int i = 0; i < panels; ++i) {
     auto renderer = vtkSmartPointer<vtkRenderer>::New();
     renderer->SetBackground(1.0, 1.0, 1.0);
@@ -154,6 +167,9 @@ void Viewer::Impl::Build() {
     panel_actors.push_back(actor);
     charts.push_back(nullptr);
   }
+}
+
+void Viewer::Impl::AddStrip(double top) {
   // The strip's grey background, then the controls on a transparent layer over the whole window:
   // VTK's 2-D slider picks in the frame of a renderer at the window's origin.
   auto strip = vtkSmartPointer<vtkRenderer>::New();
@@ -177,56 +193,62 @@ void Viewer::Impl::Build() {
   help->GetTextProperty()->SetFontSize(12);
   help->SetInput("keys: n/p command  / label  x/X y/Y axes  Tab , . slider  c condition  "
                  "g ellipses  [ ] band  wheel +/- zoom  arrows pan  r reset  s save  q quit");
+}
 
-  interactor->Initialize();
-  for (int t = 0; t < terrain; ++t) {
-    const TerrainSlider& s = explorer.terrain()[t];
-    auto rep = vtkSmartPointer<vtkSliderRepresentation2D>::New();
-    rep->SetMinimumValue(s.min);
-    rep->SetMaximumValue(s.max);
-    rep->SetValue(s.value);
-    rep->SetTitleText("");  // the name goes left of the slider (below, it would meet the next)
-    rep->SetLabelFormat("%.4g");
-    const double y = panel_h + 3 * kLine + 12 + t * kSliderRow + kSliderRow / 2.0 - 6;
-    rep->GetPoint1Coordinate()->SetCoordinateSystemToDisplay();
-    rep->GetPoint1Coordinate()->SetValue(120, y);
-    rep->GetPoint2Coordinate()->SetCoordinateSystemToDisplay();
-    rep->GetPoint2Coordinate()->SetValue(std::max(320, width - 40), y);
-    auto name = vtkSmartPointer<vtkTextActor>::New();
-    name->SetInput(s.name.c_str());
-    name->GetTextProperty()->SetFontSize(15);
-    name->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
-    name->GetTextProperty()->SetVerticalJustificationToCentered();
-    name->SetDisplayPosition(8, static_cast<int>(y));
-    controls->AddActor2D(name);
-    // Sizes are fractions of the renderer (the window): lengths of its width, widths and
-    // text heights of its height; these give pixels.
-    const double w = width, h = height;
-    rep->SetSliderLength(12 / w);
-    rep->SetSliderWidth(18 / h);
-    rep->SetTubeWidth(5 / h);
-    rep->SetEndCapLength(4 / w);
-    rep->SetEndCapWidth(18 / h);
-    rep->SetTitleHeight(14 / h);
-    rep->SetLabelHeight(13 / h);
-    for (vtkTextProperty* p : {rep->GetTitleProperty(), rep->GetLabelProperty()}) {
-      p->SetColor(0.1, 0.1, 0.1);
-      p->ShadowOff();
-      p->BoldOff();
-    }
-    rep->GetTubeProperty()->SetColor(0.55, 0.55, 0.55);
-    rep->GetSliderProperty()->SetColor(0.2, 0.35, 0.8);
-    rep->GetCapProperty()->SetColor(0.4, 0.4, 0.4);
-    auto widget = vtkSmartPointer<vtkSliderWidget>::New();
-    widget->SetInteractor(interactor);
-    widget->SetCurrentRenderer(controls);
-    widget->SetDefaultRenderer(controls);
-    widget->SetRepresentation(rep);
-    widget->SetAnimationModeToJump();
-    widget->AddObserver(vtkCommand::InteractionEvent, on_event);
-    widget->EnabledOn();
-    sliders.push_back(widget);
+void Viewer::Impl::AddSlider(int t, int width, int height) {
+  const TerrainSlider& s = explorer.terrain()[t];
+  auto rep = vtkSmartPointer<vtkSliderRepresentation2D>::New();
+  rep->SetMinimumValue(s.min);
+  rep->SetMaximumValue(s.max);
+  rep->SetValue(s.value);
+  rep->SetTitleText("");  // the name goes left of the slider (below, it would meet the next)
+  rep->SetLabelFormat("%.4g");
+  const double y = panel_h + 3 * kLine + 12 + t * kSliderRow + kSliderRow / 2.0 - 6;
+  rep->GetPoint1Coordinate()->SetCoordinateSystemToDisplay();
+  rep->GetPoint1Coordinate()->SetValue(120, y);
+  rep->GetPoint2Coordinate()->SetCoordinateSystemToDisplay();
+  rep->GetPoint2Coordinate()->SetValue(std::max(320, width - 40), y);
+  auto name = vtkSmartPointer<vtkTextActor>::New();
+  name->SetInput(s.name.c_str());
+  name->GetTextProperty()->SetFontSize(15);
+  name->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
+  name->GetTextProperty()->SetVerticalJustificationToCentered();
+  name->SetDisplayPosition(8, static_cast<int>(y));
+  controls->AddActor2D(name);
+  StyleSlider(rep, width, height);
+  auto widget = vtkSmartPointer<vtkSliderWidget>::New();
+  widget->SetInteractor(interactor);
+  widget->SetCurrentRenderer(controls);
+  widget->SetDefaultRenderer(controls);
+  widget->SetRepresentation(rep);
+  widget->SetAnimationModeToJump();
+  widget->AddObserver(vtkCommand::InteractionEvent, on_event);
+  widget->EnabledOn();
+  sliders.push_back(widget);
+}
+
+void Viewer::Impl::StyleSlider(vtkSliderRepresentation2D* rep, int width, int height) {
+  // Sizes are fractions of the renderer (the window): lengths of its width, widths and
+  // text heights of its height; these give pixels.
+  const double w = width, h = height;
+  rep->SetSliderLength(12 / w);
+  rep->SetSliderWidth(18 / h);
+  rep->SetTubeWidth(5 / h);
+  rep->SetEndCapLength(4 / w);
+  rep->SetEndCapWidth(18 / h);
+  rep->SetTitleHeight(14 / h);
+  rep->SetLabelHeight(13 / h);
+  for (vtkTextProperty* p : {rep->GetTitleProperty(), rep->GetLabelProperty()}) {
+    p->SetColor(0.1, 0.1, 0.1);
+    p->ShadowOff();
+    p->BoldOff();
   }
+  rep->GetTubeProperty()->SetColor(0.55, 0.55, 0.55);
+  rep->GetSliderProperty()->SetColor(0.2, 0.35, 0.8);
+  rep->GetCapProperty()->SetColor(0.4, 0.4, 0.4);
+}
+
+void Viewer::Impl::Listen() {
   on_event->SetCallback(&Impl::Dispatch);
   on_event->SetClientData(this);
   for (unsigned long e : {vtkCommand::KeyPressEvent, vtkCommand::MouseMoveEvent,
