@@ -184,6 +184,17 @@ TEST(Analysis, WithoutASimulatorItOnlyLocates) {
   EXPECT_EQ(a.verdict.status, "located") << a.verdict.sentence;
   EXPECT_TRUE(a.verdict.named.empty());
   EXPECT_NE(a.verdict.sentence.find("no simulator config"), std::string::npos) << a.verdict.sentence;
+  EXPECT_EQ(a.null_shortfall.draws, 0) << "the adequacy's null is not drawn where nothing is assessed";
+}
+
+TEST(Analysis, TheNullShortfallIsDrawnOnceForTheAdequacy) {
+  const auto pair = test::MakeFakePair(Fake(), {{test::kFriction, 0.6}});
+  const AnalysisOptions options = test::FastOptions();
+  const Analysis a = Analyse(pair.sim, pair.real, &Fake(), options);
+  ASSERT_TRUE(a.knobs_analysed);
+  EXPECT_EQ(a.null_shortfall.draws, options.adequacy.null_shortfall.draws);
+  EXPECT_GT(a.null_shortfall.mean, 0) << "a sim set of finite size puts the sim model below the ceiling";
+  EXPECT_NEAR(a.adequacy.excess_shortfall, a.adequacy.shortfall - a.null_shortfall.mean, 1e-12);
 }
 
 // When stages 3-8 run again with every execution (EveryExecutionBecause): an analysis of a
