@@ -131,7 +131,6 @@ void SliceExplorer::PickCommandAndAxes(const ExplorerOptions& options) {
   x_index_ = pose_index(options.x_dim, 0);
   y_index_ = pose_index(options.y_dim, x_index_ == 0 ? 1 : 0);
   if (x_index_ == y_index_) throw MakeInputError("", "dimension", "x and y must differ");
-
 }
 
 void SliceExplorer::MakeSliders(const ExplorerOptions& options) {

@@ -103,8 +103,9 @@ class SliceExplorer {
 
  private:
   // The constructor's parts: the commands shown (both models' when comparing), the data checked
-  // against the model; the command shown first and the x and y pose dimensions; one slider per terrain dimension, spanning
-  // the data's terrain (else the model's 3-sigma extent) and set to the options' conditions.
+  // against the model; the command shown first and the x and y pose dimensions; one slider per
+  // terrain dimension, spanning the data's terrain (else the model's 3-sigma extent) and set to
+  // the options' conditions.
   void ListCommands();
   void PickCommandAndAxes(const ExplorerOptions& options);
   void MakeSliders(const ExplorerOptions& options);

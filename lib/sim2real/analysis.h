@@ -6,7 +6,8 @@
 //   3. candidates  (candidates.h)    the simulator's knobs' signatures and the measurement effects;
 //   4. refine      (refine.h)        selection by held-out likelihood, refined by re-recording;
 //   5. confidence  (confidence.h)    bootstrap inclusion per family, the values' intervals;
-//   6. adequacy    (adequacy.h)      locate again on the correction, the fit against the ceiling,
+//   6. adequacy    (adequacy.h)      locate again on the correction, the fit against the ceiling
+//                                    less its null (drawn once per analysis),
 //                                    values pinned or impossible, residual structure and drift;
 //   7. ties        (ties.h)          what the data cannot tell apart, and the experiment that would;
 //   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence; 3-8 once more
