@@ -50,6 +50,8 @@ struct Sim2RealArgs {
   bool runoff = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
+  std::string null_source = "auto";
+  int null_recordings = sim2real::RecordedNullOptions{}.draws;
   bool locate_only = false;
   bool no_experiment_check = false;
 };
@@ -161,6 +163,10 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.refine.seed = args.seed;
   o.refine.selection.bootstrap_selection = args.bootstrap;
   o.adequacy.seed = args.seed;
+  o.null_source = args.null_source == "drawn"      ? sim2real::NullSource::kDrawn
+                  : args.null_source == "recorded" ? sim2real::NullSource::kRecorded
+                                                   : sim2real::NullSource::kAuto;
+  o.recorded_null.draws = args.null_recordings;
   o.adequacy.locate.mmd.permutations = args.permutations;
   o.ties.experiment.enabled = !args.no_experiment_check;
   o.ties.experiment.seed = args.seed;
@@ -320,6 +326,13 @@ void Setup(CLI::App& root) {
   cmd->add_option("--confirm-screen-share", args->confirm_screen_share,
                   "... and the share of the step's best held-out z it needs")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--null", args->null_source,
+                  "where the null shortfall (how far below the real-trained ceiling the sim model stands when the "
+                  "physics agree) comes from: drawn from the sim model, recorded (the nominal re-recorded with the "
+                  "real set's design, --null-recordings times), or auto: recorded on uneven ground, drawn elsewhere")
+      ->capture_default_str()->check(CLI::IsMember({"auto", "drawn", "recorded"}));
+  cmd->add_option("--null-recordings", args->null_recordings, "re-recordings of the nominal for a recorded null")
+      ->capture_default_str()->check(CLI::Range(2, 100));
   cmd->add_flag("--every-leg", args->every_leg,
                 "probe every leg's gain (default: only the legs of a side the first pass implicates)");
   cmd->add_flag("--leg-search,!--no-leg-search", args->leg_search,

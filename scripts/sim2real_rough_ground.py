@@ -15,12 +15,16 @@ null,stones,payload,leg: s mod 4), the values from random.Random(s):
 The real set is the planted config, protocol paper, the same placements count, seed s. Then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
 what was named, the value, which stage named it (`knobs`: the mean shifts; `runoff`; `leg_search`)
-and whether it lies within 25% of the truth, the status, whether the
+and whether it lies within 25% of the truth, the status, the excess shortfall (shortfall − null, nats
+per real sample) with its SE and the null's source and value, whether the
 located tests permuted whole placements, and the wall time.
 
 Usage: scripts/sim2real_rough_ground.py [--build build] [--config datasets/robots/rough_ground.json]
           [--seeds 301-308] [--kinds null,stones,payload,leg] [--sim-seed 100]
-          [--sim-placements 166] [--threads 2] [--out DIR]
+          [--sim-placements 166] [--threads 2] [--null auto|drawn|recorded] [--out DIR]
+
+A second run with the same --out and another --null reuses the sim set, the real sets (when their
+config is the same) and the cache, and writes its reports beside the first (report-drawn/...).
 """
 import argparse, copy, json, os, random, subprocess, sys, tempfile, time
 
@@ -68,8 +72,12 @@ def row(seed, knob, truth, report, wall):
         ok = hit is not None and named[0]["knob"] == knob and abs(value - truth) <= 0.25 * abs(truth)
     names = ", ".join(n["knob"] for n in named) or "-"
     by = (j["fit"]["corrected_by"] or "-") if named else "-"
+    ad = j["adequacy"] or {}
+    excess = (f"{ad['excess_shortfall_nats_per_sample']:.2f} ± {ad['excess_shortfall_se']:.2f} "
+              f"({ad['null_shortfall_source']} {ad['null_shortfall_nats_per_sample']:.2f})"
+              if ad.get("excess_shortfall_nats_per_sample") is not None else "-")
     return (f"| {seed} | {knob or 'null'} | {truth:.3g} | {names} | {value:.3g} | {by} | {'yes' if ok else 'no'} | "
-            f"{v['status']} | {permuted} | {wall:.0f} |")
+            f"{v['status']} | {excess} | {permuted} | {wall:.0f} |")
 
 
 def main():
@@ -81,6 +89,8 @@ def main():
     ap.add_argument("--sim-seed", type=int, default=100)
     ap.add_argument("--sim-placements", type=int, default=166)
     ap.add_argument("--threads", default="2")
+    ap.add_argument("--null", default="auto", choices=["auto", "drawn", "recorded"],
+                    help="the shortfall's null (dgmm sim2real --null); auto: recorded on uneven ground")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     lo, hi = (int(v) for v in a.seeds.split("-"))
@@ -98,22 +108,25 @@ def main():
              "--seed", str(a.sim_seed), "-o", sim)
     print(f"Rough ground {a.config}, sim set seed {a.sim_seed} ({a.sim_placements} placements), real seeds "
           f"{lo}-{hi} (kinds {a.kinds}), sim2real with --threads {a.threads}\n")
-    print("| seed | planted | truth | named | value | named by | right | status | tests permute | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| seed | planted | truth | named | value | named by | right | status | excess ± SE (null) | tests permute "
+          "| wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)
         cfg = copy.deepcopy(base)
         knob, truth = planted(seed, cfg, kinds)
         real_cfg = os.path.join(d, "real.json")
-        json.dump(cfg, open(real_cfg, "w"), indent=1)
         real = os.path.join(d, "real.h5")
-        dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--placements",
-             str(a.sim_placements), "--seed", str(seed), "-o", real)
+        if not (os.path.exists(real) and os.path.exists(real_cfg) and json.load(open(real_cfg)) == cfg):
+            json.dump(cfg, open(real_cfg, "w"), indent=1)  # a real set is reused only with its own config
+            dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--placements",
+                 str(a.sim_placements), "--seed", str(seed), "-o", real)
+        report = os.path.join(d, "report" if a.null == "auto" else f"report-{a.null}")
         start = time.time()
-        dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", os.path.join(d, "report"), "--no-figures",
-             "--threads", a.threads, "--cache", os.path.join(out, "cache"))
-        print(row(seed, knob, truth, os.path.join(d, "report", "report.json"), time.time() - start), flush=True)
+        dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", report, "--no-figures",
+             "--threads", a.threads, "--cache", os.path.join(out, "cache"), "--null", a.null)
+        print(row(seed, knob, truth, os.path.join(report, "report.json"), time.time() - start), flush=True)
     return 0
 
 

@@ -121,16 +121,18 @@ void TestFit(const AnalysisInputs& in, const Baseline& base, const NullShortfall
   GapClosed(base.heldout_sim, corrected, base.heldout_ceiling, in.real.episode, &out->gap_closed, &out->gap_closed_se);
   // Only what lies beyond the sim set's own estimation error (ceiling.h) is the correction's doubt.
   out->excess_shortfall = out->shortfall - null.mean;
-  // Two estimates of the shortfall's spread, the larger counts: the null's draws (sim model's
-  // estimation and real sampling, executions independent) and the real samples' clustered SE.
-  out->excess_shortfall_se = std::max(out->shortfall_se, null.sd);
+  // The spread of a null pair's shortfall. Drawn from the sim model (executions independent but
+  // for the placements' intraclass correlation) it can fall short where the model is a poor
+  // description of the recordings, so the real samples' clustered SE counts when larger; a
+  // recorded null's spread is the null's own, with the SE of its mean beside it (few draws).
+  out->excess_shortfall_se = null.recorded ? std::hypot(null.sd, null.mean_se) : std::max(out->shortfall_se, null.sd);
   out->below_ceiling = out->excess_shortfall > options.min_shortfall_nats &&
                        out->excess_shortfall > options.shortfall_z * out->excess_shortfall_se;
   if (out->below_ceiling) {
     out->doubts.push_back(Fmt("the corrected model stays %.3f nats per real sample (SE %.3f) below the real-trained "
                               "ceiling, ", out->shortfall, out->shortfall_se) +
-                          Fmt("%.3f of it (SE %.3f) beyond what the sim set's own size explains", out->excess_shortfall,
-                              out->excess_shortfall_se) +
+                          Fmt("%.3f of it (SE %.3f) beyond ", out->excess_shortfall, out->excess_shortfall_se) +
+                          (null.recorded ? "what re-recordings of the nominal show" : "what the sim set's own size explains") +
                           (std::isfinite(out->gap_closed) ? Fmt(" (%.0f%% of the gap closed)", 100 * out->gap_closed) : ""));
   }
   std::mt19937_64 rng(options.seed + 7);

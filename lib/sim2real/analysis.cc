@@ -138,6 +138,20 @@ std::string ScreenedPart(const KnobSimulator& simulator, const std::vector<int>&
          Fmt("; %.0f other candidates kept their first-look signatures", kept);
 }
 
+// The adequacy's null shortfall, drawn or recorded (AnalysisOptions::null_source).
+NullShortfall MeasureNull(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                          const AnalysisOptions& options) {
+  const bool recorded = options.null_source == NullSource::kRecorded ||
+                        (options.null_source == NullSource::kAuto && options.locate.uneven_ground);
+  if (!recorded) return MeasureNullShortfall(in, base, options.locate.model, options.adequacy);
+  RecordedNullOptions o = options.recorded_null;
+  o.seed = options.seed + 13;
+  o.folds = options.locate.folds;
+  o.model = options.locate.model;
+  o.recording = options.candidates.recording;
+  return RecordNullShortfall(simulator, in, base, o);
+}
+
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
@@ -150,6 +164,7 @@ bool AnalysisOptions::IsValid(std::string* error) const {
     return false;
   }
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
+         recorded_null.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
          runoff.IsValid(error);
 }
@@ -239,7 +254,7 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   }
   a.knobs_analysed = true;
   const auto null_start = Clock::now();
-  a.null_shortfall = MeasureNullShortfall(a.inputs, a.baseline, options.locate.model, options.adequacy);
+  a.null_shortfall = MeasureNull(*simulator, a.inputs, a.baseline, options);
   a.seconds.adequacy += Since(null_start);
   KnobStages(*simulator, options, stage, &a);
   a.every_execution_because = EveryExecutionBecause(a, options);

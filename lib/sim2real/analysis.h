@@ -7,7 +7,8 @@
 //   4. refine      (refine.h)        selection by held-out likelihood, refined by re-recording;
 //   5. confidence  (confidence.h)    bootstrap inclusion per family, the values' intervals;
 //   6. adequacy    (adequacy.h)      locate again on the correction, the fit against the ceiling
-//                                    less its null (drawn once per analysis),
+//                                    less its null (once per analysis: drawn from the
+//                                    sim model, or recorded on uneven ground),
 //                                    values pinned or impossible, residual structure and drift;
 //   7. ties        (ties.h)          what the data cannot tell apart, and the experiment that would;
 //   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence; 3-8 once more
@@ -26,6 +27,7 @@
 
 #include "sim2real/correction.h"
 #include "sim2real/leg_search.h"
+#include "sim2real/recorded_null.h"
 #include "sim2real/runoff.h"
 #include "sim2real/verdict_stage.h"
 
@@ -64,6 +66,11 @@ struct AnalysisOptions {
   // from two, and one that may overtake the best scores at least a quarter of the best's z.
   double confirm_screen_z = 0.8;
   double confirm_screen_share = 0.25;
+  // Where the adequacy's null shortfall comes from: drawn from the sim model (ceiling.h) or
+  // recorded by the simulator (recorded_null.h). kAuto: recorded on uneven ground
+  // (locate.uneven_ground), where the drawn null falls short of what null pairs measure, else drawn.
+  NullSource null_source = NullSource::kAuto;
+  RecordedNullOptions recorded_null;  // seed, folds, model and recording: the analysis's
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };

@@ -43,6 +43,11 @@ struct NullShortfall {
   double mean = 0;  // expected ceiling - sim model when the physics agree, nats per real sample
   double sd = 0;    // its spread over the draws (sim model's estimation and real sampling)
   int draws = 0;    // 0: not measured; mean and sd are 0
+  // The SE of `mean` itself: recorded nulls (recorded_null.h) have few draws; the parametric
+  // null's 20 draws leave it 0 (sd / sqrt(20) would widen the excess's SE by 2.5%).
+  double mean_se = 0;
+  bool recorded = false;  // recorded by the simulator (recorded_null.h), not drawn from the sim model
+  int recordings = 0, from_cache = 0;  // the recorded null's re-recordings: recorded, read from the cache
 };
 
 // The null shortfall of the comparison of `sim_model` (fitted on `sim` with `model`) with `real`

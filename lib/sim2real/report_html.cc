@@ -32,6 +32,15 @@ std::string F(const char* fmt, double v) {
 
 // The share of the nominal's misfit a named point removes. Above 1 the real samples fit the point's
 // model better than its recording's own unseen samples do: all of the misfit, not more than all.
+// Where the null shortfall comes from, in words (ceiling.h, recorded_null.h).
+std::string NullWhere(const NullShortfall& n) {
+  return n.recorded ? "the nominal re-recorded with the real set's design" : "the sim set's own size";
+}
+std::string NullHow(const NullShortfall& n) {
+  return n.recorded ? F("%.0f re-recordings", n.draws) + ", SE of their mean " + F("%.3f", n.mean_se)
+                    : std::string("sets drawn from the sim model");
+}
+
 std::string MisfitRemoved(double share) { return share > 1 ? "all" : F("%.0f%%", 100 * share); }
 
 std::string Base64(const std::string& in) {
@@ -229,9 +238,9 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
     << (std::isfinite(q.gap_closed) ? F("%.0f%%", 100 * q.gap_closed) + " (SE " + F("%.0f%%", 100 * q.gap_closed_se) + ")"
                                     : std::string("no gap (the sim model is at or above the ceiling)"))
     << "; the corrected model is " << F("%.3f", q.shortfall) << " nats per sample (SE " << F("%.3f", q.shortfall_se)
-    << ") below the ceiling; where the physics agree, the sim set's own size puts the sim model "
-    << F("%.3f", a.null_shortfall.mean) << " below it (SD " << F("%.3f", a.null_shortfall.sd)
-    << ", sets drawn from the sim model). The corrected model is written as <code>" << Escape(ctx.corrected_model_file)
+    << ") below the ceiling; where the physics agree, " << NullWhere(a.null_shortfall) << " puts the sim model "
+    << F("%.3f", a.null_shortfall.mean) << " below it (SD " << F("%.3f", a.null_shortfall.sd) << ", "
+    << NullHow(a.null_shortfall) << "). The corrected model is written as <code>" << Escape(ctx.corrected_model_file)
     << "</code> (readable by <code>dgmm score</code> and <code>dgmm render</code>).</p>\n"
     << "<h3>Locate again, on the corrected model</h3>"
     << RegionTable(q.after.regions, {"terrain", "sequence", "command"}, 12)

@@ -197,6 +197,23 @@ TEST(Analysis, TheNullShortfallIsDrawnOnceForTheAdequacy) {
   EXPECT_NEAR(a.adequacy.excess_shortfall, a.adequacy.shortfall - a.null_shortfall.mean, 1e-12);
 }
 
+// A recorded null (on uneven ground by default, here asked for) replaces the drawn one: the
+// adequacy subtracts the re-recordings' mean and counts the SE of that mean.
+TEST(Analysis, ARecordedNullReplacesTheDrawnOne) {
+  const auto pair = test::MakeFakePair(Fake(), {{test::kFriction, 0.6}});
+  AnalysisOptions options = test::FastOptions();
+  options.null_source = NullSource::kRecorded;
+  options.recorded_null.draws = 3;
+  const Analysis a = Analyse(pair.sim, pair.real, &Fake(), options);
+  ASSERT_TRUE(a.knobs_analysed);
+  EXPECT_TRUE(a.null_shortfall.recorded);
+  EXPECT_EQ(a.null_shortfall.draws, 3);
+  EXPECT_NEAR(a.adequacy.excess_shortfall, a.adequacy.shortfall - a.null_shortfall.mean, 1e-12);
+  EXPECT_GE(a.adequacy.excess_shortfall_se, a.null_shortfall.mean_se);
+  options.null_source = NullSource::kAuto;  // a plane: drawn
+  EXPECT_FALSE(Analyse(pair.sim, pair.real, &Fake(), options).null_shortfall.recorded);
+}
+
 // When stages 3-8 run again with every execution (EveryExecutionBecause): an analysis of a
 // fake null pair whose verdict, selection steps and options each test sets.
 class EveryExecution : public ::testing::Test {

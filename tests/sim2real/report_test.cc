@@ -147,5 +147,23 @@ TEST(Report, TheRunoffsJsonNamesKnobsNotLegs) {
   EXPECT_EQ(j["contenders"].size(), 2u);
 }
 
+// The null's source is said where its value is: the JSON's source and count, the HTML's words.
+TEST(Report, TheNullSaysWhereItCameFrom) {
+  const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
+  for (const bool recorded : {false, true}) {
+    a.null_shortfall.recorded = recorded;
+    a.null_shortfall.draws = recorded ? 3 : 20;
+    a.null_shortfall.mean_se = recorded ? 0.25 : 0;
+    const auto j = nlohmann::json::parse(ReportJson(a, ReportContext{}))["adequacy"];
+    const std::string html = ReportHtml(a, ReportContext{}, ".");
+    EXPECT_EQ(j["null_shortfall_source"], recorded ? "recorded" : "drawn");
+    EXPECT_EQ(j["null_shortfall_draws"], recorded ? 3 : 20);
+    EXPECT_EQ(j["null_shortfall_se"], recorded ? 0.25 : 0.0);
+    EXPECT_EQ(html.find("3 re-recordings, SE of their mean 0.250") != std::string::npos, recorded);
+    EXPECT_EQ(html.find("sets drawn from the sim model") != std::string::npos, !recorded);
+  }
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real
