@@ -103,6 +103,8 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     stage("runoff (contenders scored by models of their own)");
     RunoffOptions runoff = options.runoff;
     runoff.search.model = options.locate.model;
+    runoff.search.misfit_elsewhere = options.locate.uneven_ground;
+    runoff.search.elsewhere_seed = options.seed + 17;
     a->runoff = RunRunoff(simulator, a->inputs, a->candidates, a->refinement, options.candidates, runoff);
     AddRunoff(simulator, &a->runoff, &a->verdict);
     a->seconds.runoff = Since(t);
@@ -112,6 +114,8 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     stage("leg search (every leg's gain)");
     LegSearchOptions legs = options.legs;
     legs.model = options.locate.model;
+    legs.misfit_elsewhere = options.locate.uneven_ground;
+    legs.elsewhere_seed = options.seed + 17;
     a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs);
     if (!a->naming.named.empty()) {
       std::vector<std::string> named;

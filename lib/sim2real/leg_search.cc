@@ -7,8 +7,10 @@
 #include <memory>
 #include <optional>
 
+#include "sim2real/recorded_null.h"
 #include "sim2real/refine_search.h"
 #include "sim2real/sag_mode.h"
+#include "sim2real/selection.h"
 #include "sim2real/sentence_format.h"
 #include "sim2real/units.h"
 #include "util/error.h"
@@ -83,6 +85,22 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
   const OwnModel m = FitOwnModel(recording, fit_rows, options, ref);
   return OwnLogLikelihood(m, SubsetSamples(recording, held), options, ref).mean() -
          OwnLogLikelihood(m, in.real, options, ref).mean();
+}
+
+// The same with a recording of the point at other places, `elsewhere`, as its unseen samples (the
+// own model fitted on all of `recording`, as the score's is):
+//   misfit = mean robust l(elsewhere) - mean robust l(real).
+// Its SE from the two sets' placement-clustered SEs (independent recordings).
+double MisfitElsewhere(const Samples& recording, const Samples& elsewhere, const AnalysisInputs& in,
+                       const LegSearchOptions& options, const SagReference* ref, double* se) {
+  *se = NAN;
+  if (recording.size() == 0 || elsewhere.size() == 0) return NAN;
+  const OwnModel m = FitOwnModel(recording, {}, options, ref);
+  double own = 0, own_se = 0, real = 0, real_se = 0;
+  ClusteredMean(OwnLogLikelihood(m, elsewhere, options, ref), elsewhere.episode, &own, &own_se);
+  ClusteredMean(OwnLogLikelihood(m, in.real, options, ref), in.real.episode, &real, &real_se);
+  *se = std::hypot(own_se, real_se);
+  return own - real;
 }
 
 Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, const LegSearchOptions& options,
@@ -257,18 +275,48 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
       (ResidualVariance(state->scored[out->best]).array() / ResidualVariance(state->nominal).array()).log().matrix();
 }
 
+// The nominal's and the best point's misfits against second recordings at other places.
+void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
+                      const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
+  std::uint64_t seed = options.elsewhere_seed;
+  if (seed == in.recording.seed) ++seed;
+  const RecordingBatch b =
+      RecordBatch(simulator, RealDesign(in, seed), {{}, {{out->knob_index, out->value}}}, recording.recording);
+  out->recorded += b.recorded;
+  out->from_cache += b.from_cache;
+  double se = NAN;
+  out->nominal_misfit =
+      MisfitElsewhere(state.nominal.samples, RealCommandsOf(b.sets[0], in), in, options, state.Ref(), &se);
+  out->best_misfit = MisfitElsewhere(state.scored[out->best].samples, RealCommandsOf(b.sets[1], in), in, options,
+                                     state.Ref(), &out->best_misfit_se);
+}
+
 // Does the best point remove enough of the nominal's misfit? Else the leg is not named.
-void CheckMisfit(const AnalysisInputs& in, const SearchState& state, const LegSearchOptions& options,
-                 const Knob& knob, LegSearch* out) {
-  out->nominal_misfit = Misfit(state.nominal.samples, in, options, state.Ref());
-  out->best_misfit = Misfit(state.scored[out->best].samples, in, options, state.Ref());
+void CheckMisfit(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
+                 const SearchState& state, const LegSearchOptions& options, const Knob& knob, LegSearch* out) {
+  if (options.misfit_elsewhere) {
+    MisfitsElsewhere(simulator, in, recording, state, options, out);
+  } else {
+    out->nominal_misfit = Misfit(state.nominal.samples, in, options, state.Ref());
+    out->best_misfit = Misfit(state.scored[out->best].samples, in, options, state.Ref());
+  }
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
+  if (options.misfit_elsewhere) {
+    if (out->best_misfit <= options.z * out->best_misfit_se) return;
+    out->named = false;
+    out->why = "the real samples fit the model of the best point (" + PointName(knob, out->value) +
+               Fmt(") worse than its own recording at other places does (by %.3g nats per sample, ", out->best_misfit) +
+               Fmt("%.1f SE)", out->best_misfit / out->best_misfit_se) +
+               (knob.leg.empty() ? ": the mismatch is not this knob alone" : ": the mismatch is not a weak leg alone");
+    return;
+  }
   if (out->gap_closed >= options.min_gap_closed) return;
   out->named = false;
+  const char* unseen = options.misfit_elsewhere ? "a second recording of it at other places"
+                                                : "the recording's own unseen samples";
   out->why = "the best point (" + PointName(knob, out->value) +
-             Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against the recording's own "
-                 "unseen samples, %.3g nats per sample; the best's: %.3g)", 100 * out->gap_closed, out->nominal_misfit,
-                 out->best_misfit) +
+             Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against ", 100 * out->gap_closed) +
+             unseen + Fmt(", %.3g nats per sample; the best's: %.3g)", out->nominal_misfit, out->best_misfit) +
              (knob.leg.empty() ? ": the mismatch is not this knob alone" : ": the mismatch is not a weak leg alone");
 }
 
@@ -343,7 +391,7 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
     RecordPoints(simulator, in, set, recording, options, more, &state, &out);
     Decide(in, knobs, options, &state, &out);
   }
-  if (out.named) CheckMisfit(in, state, options, knobs[out.knob_index], &out);
+  if (out.named) CheckMisfit(simulator, in, recording, state, options, knobs[out.knob_index], &out);
   out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
   return out;
 }

@@ -12,15 +12,6 @@
 namespace dgmm::sim2real {
 namespace {
 
-// The re-recording's samples with the real set's commands only (the sim set's command table).
-Samples RealCommandsOf(const SampleSet& set, const AnalysisInputs& in) {
-  std::vector<int> map(set.num_commands(), -1);
-  for (int c : in.real_commands) {
-    if (c < set.num_commands()) map[c] = c;
-  }
-  return MakeSamples(set, map);
-}
-
 // ceiling - sim model on one re-recording, nats per sample, and its SE clustered by placement;
 // false when it has too few samples.
 bool Shortfall(const Samples& s, const Baseline& base, const RecordedNullOptions& options, std::mt19937_64& rng,
@@ -35,6 +26,14 @@ bool Shortfall(const Samples& s, const Baseline& base, const RecordedNullOptions
 }
 
 }  // namespace
+
+Samples RealCommandsOf(const SampleSet& set, const AnalysisInputs& in) {
+  std::vector<int> map(set.num_commands(), -1);
+  for (int c : in.real_commands) {
+    if (c < set.num_commands()) map[c] = c;
+  }
+  return MakeSamples(set, map);
+}
 
 bool RecordedNullOptions::IsValid(std::string* error) const {
   if (draws < 2 || folds < 2) {

@@ -40,4 +40,8 @@ NullShortfall RecordNullShortfall(const KnobSimulator& simulator, const Analysis
 // each (the analysis then treats every sample as its own placement).
 Recording RealDesign(const AnalysisInputs& in, std::uint64_t seed);
 
+// A recording of RealDesign's samples with the real set's commands only (the sim set's command
+// table), as the analysis's samples are.
+Samples RealCommandsOf(const SampleSet& set, const AnalysisInputs& in);
+
 }  // namespace dgmm::sim2real

@@ -6,6 +6,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include "tests/sim2real/stage_fixture.h"
 
 namespace dgmm::sim2real::test {
@@ -78,6 +80,47 @@ TEST(Runoff, ARunoffThatNamesNothingLeavesTheNameWithItsDoubt) {
   ASSERT_FALSE(v.named[0].doubts.empty());
   EXPECT_NE(v.named[0].doubts.back().find("b fits the real samples as well"), std::string::npos);
   EXPECT_NE(v.sentence.find("names no knob"), std::string::npos) << v.sentence;
+}
+
+// On ground whose placements share an offset (the fake's ground_sd), the misfit measured against
+// a second recording at other places is near 0 for the planted point and stands above it for the
+// nominal, and costs two recordings.
+TEST(Runoff, OnUnevenGroundTheMisfitIsMeasuredAtOtherPlaces) {
+  FakeSimulator rough;
+  rough.ground_sd = 1.0;
+  const Stages s = RunStages(rough, {{kFriction, 0.6}}, 4);
+  RunoffOptions o = Options(s);
+  o.search.refine_steps = 0;
+  o.search.misfit_elsewhere = true;
+  const int before = rough.records();
+  const Runoff r = RunRunoff(rough, s.in, s.set, s.refinement, s.options.candidates, o);
+  ASSERT_TRUE(r.ran) << r.why_not;
+  ASSERT_EQ(r.search.knob_index, kFriction) << r.search.why;
+  EXPECT_NEAR(r.search.value, 0.6, 0.25 * 0.6);
+  EXPECT_GT(r.search.nominal_misfit, 0.1) << "the nominal's misfit is the planted mismatch";
+  EXPECT_LT(std::fabs(r.search.best_misfit), 0.5 * r.search.nominal_misfit) << "the planted point's is near 0";
+  EXPECT_LE(r.search.best_misfit, o.search.z * r.search.best_misfit_se);
+  EXPECT_TRUE(r.search.named) << r.search.why;
+  EXPECT_EQ(rough.records() - before, static_cast<int>(r.search.points.size()) + 3)
+      << "the nominal and the points, then the nominal and the best point at other places";
+}
+
+// A point on the way to the planted physics, not at it (friction 0.4 planted, 0.8 and 0.9
+// searched): it fits better than the nominal, but the real samples fit its model worse than its own
+// recording at other places does, and it is not named.
+TEST(Runoff, OnUnevenGroundAPointShortOfThePlantedPhysicsIsNotNamed) {
+  FakeSimulator rough;
+  rough.ground_sd = 1.0;
+  const Stages s = RunStages(rough, {{kFriction, 0.4}}, 4);
+  LegSearchOptions o = Options(s).search;
+  o.refine_steps = 0;
+  o.misfit_elsewhere = true;
+  const LegSearch r = SearchOwnModels(rough, s.in, s.set, s.options.candidates, o, {{kFriction, 0.8}, {kFriction, 0.9}});
+  ASSERT_TRUE(r.ran) << r.why;
+  EXPECT_GT(r.z_vs_nominal, o.z) << "the point fits better than the nominal";
+  EXPECT_GT(r.best_misfit, o.z * r.best_misfit_se);
+  EXPECT_FALSE(r.named) << r.knob << " at " << r.value;
+  EXPECT_NE(r.why.find("at other places"), std::string::npos) << r.why;
 }
 
 TEST(Runoff, RejectsOptionsThatCannotRun) {
