@@ -278,6 +278,7 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
 // The nominal's and the best point's misfits against second recordings at other places.
 void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
                       const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
+  out->misfit_elsewhere = true;
   std::uint64_t seed = options.elsewhere_seed;
   if (seed == in.recording.seed) ++seed;
   const RecordingBatch b =

@@ -98,6 +98,7 @@ struct LegSearch {
                                       // comparable with locate's sim model and ceiling
   double nominal_misfit = NAN, best_misfit = NAN;  // own unseen samples minus real, per sample (leg_search.cc)
   double best_misfit_se = NAN;  // misfit_elsewhere: its SE, placements as units
+  bool misfit_elsewhere = false;  // the misfits are against recordings at other places
   int best = -1;                      // index into points
   bool named = false;
   std::string leg, knob;              // the named leg and its gain knob
@@ -154,8 +155,9 @@ Correction LegSearchCorrection(const LegSearch& search);
 // well and the pinned flags.
 VerdictNamed SearchNamed(const LegSearch& search, const std::string& family, const std::string& unit);
 
-// When the named point removes under 90% of the nominal's misfit, the doubt that some mismatch
-// remains ("<subject> removes N% ..."); the same share marks the verdict's unexplained_present.
+// When the named point removes under 90% of the nominal's misfit (against recordings at other
+// places: leaves the real samples more than 1 SE below its own), the doubt that some mismatch
+// remains ("<subject> removes N% ..."); the same rule marks the verdict's unexplained_present.
 void AddRemainingMismatchDoubt(const LegSearch& search, const std::string& subject, VerdictNamed* named);
 
 // The verdict's one story when a search named a knob: `named` alone, status partly_explained, its

@@ -39,8 +39,20 @@ VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const st
   return n;
 }
 
+// Against recordings at other places (uneven ground): the real samples fit the point's model more
+// than 1 SE worse than its own recording there does; else under 90% of the nominal's misfit removed.
+bool MismatchRemains(const LegSearch& s) {
+  if (s.misfit_elsewhere) return s.best_misfit > s.best_misfit_se;
+  return s.gap_closed < kMostOfTheMisfit;
+}
+
 void AddRemainingMismatchDoubt(const LegSearch& s, const std::string& subject, VerdictNamed* n) {
-  if (s.gap_closed < kMostOfTheMisfit) {
+  if (!MismatchRemains(s)) return;
+  if (s.misfit_elsewhere) {
+    n->doubts.push_back(subject + Fmt(" leaves the real samples %.3g nats per sample", s.best_misfit) +
+                        Fmt(" below its own recording at other places (%.1f SE): some mismatch may remain",
+                            s.best_misfit / s.best_misfit_se));
+  } else {
     n->doubts.push_back(subject + Fmt(" removes %.0f%% of the nominal's misfit: some mismatch remains", 100 * s.gap_closed));
   }
 }
@@ -51,7 +63,7 @@ void ReplaceNamed(const LegSearch& s, const VerdictNamed& n, Verdict* v) {
   v->doubts = n.doubts;
   v->weak.clear();
   v->gap_closed = s.gap_closed;
-  v->unexplained_present = s.gap_closed < kMostOfTheMisfit;
+  v->unexplained_present = MismatchRemains(s);
   v->sentence = VerdictSentence(*v, nullptr, nullptr, nullptr);
 }
 

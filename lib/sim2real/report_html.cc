@@ -43,6 +43,14 @@ std::string NullHow(const NullShortfall& n) {
 
 std::string MisfitRemoved(double share) { return share > 1 ? "all" : F("%.0f%%", 100 * share); }
 
+// "it removes 41% of the nominal's misfit", or on uneven ground "the real samples fit its model as
+// well as its own recording at other places (misfit 0.041, 0.6 SE)".
+std::string MisfitSaid(const LegSearch& own) {
+  if (!own.misfit_elsewhere) return "it removes " + MisfitRemoved(own.gap_closed) + " of the nominal's misfit";
+  return "the real samples fit its model as well as its own recording at other places does (misfit " +
+         F("%.3f", own.best_misfit) + " nats per sample, " + F("%.1f SE", own.best_misfit / own.best_misfit_se) + ")";
+}
+
 std::string Base64(const std::string& in) {
   static const char* k = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
@@ -173,8 +181,8 @@ std::string PhysicsSection(const Analysis& a) {
                  : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
       << Escape(own->knob) << F(" = %.4g", own->value) << ": its recording fits the real samples "
       << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, no other "
-      << (runoff ? "contender's" : "leg's") << " as well, and it removes " << MisfitRemoved(own->gap_closed)
-      << " of the nominal's misfit. It has no bootstrap: inclusion is not computed.</p>\n";
+      << (runoff ? "contender's" : "leg's") << " as well, and " << MisfitSaid(*own)
+      << ". It has no bootstrap: inclusion is not computed.</p>\n";
   }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
   else o << NamedTable(a.verdict);
@@ -224,6 +232,13 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
     << F("%.3f", b.ll_ceiling) << "</td></tr><tr><td>real-trained from real data alone</td><td>" << F("%.3f", b.ll_real_only)
     << "</td></tr></table>\n";
   if (!a.knobs_analysed) return o.str();
+  if (own && own->misfit_elsewhere) {
+    o << "<p>Misfit of " << Escape(own->knob) << " (the real samples against its own recording at other places): "
+      << F("%.3f", own->best_misfit) << " nats per sample, SE " << F("%.3f", own->best_misfit_se) << "; the nominal's "
+      << F("%.3f", own->nominal_misfit) << ". The corrected model is written as <code>" << Escape(ctx.corrected_model_file)
+      << "</code>.</p>\n";
+    return o.str();
+  }
   if (own) {
     o << "<p>Share of the nominal recording's misfit (" << F("%.3f", own->nominal_misfit)
       << " nats per sample: the real samples against the recording's own unseen samples) removed by "
@@ -348,7 +363,8 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   }
   o << ", ceiling " << F("%.3f", a.baseline.ll_ceiling);
   if (own) {
-    o << " (" << MisfitRemoved(own->gap_closed) << " of the nominal recording's misfit removed)";
+    o << " (" << (own->misfit_elsewhere ? MisfitSaid(*own) : MisfitRemoved(own->gap_closed) + " of the nominal recording's misfit removed")
+      << ")";
   } else if (a.knobs_analysed && std::isfinite(a.adequacy.gap_closed)) {
     o << " (" << F("%.0f%%", 100 * a.adequacy.gap_closed) << " of the gap closed, SE " << F("%.0f%%", 100 * a.adequacy.gap_closed_se)
       << ")";

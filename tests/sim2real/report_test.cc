@@ -121,6 +121,20 @@ TEST(Report, ALegNamedByTheLegSearchIsOneStoryInEveryOutput) {
   EXPECT_EQ(summary_all.find("209%"), std::string::npos) << summary_all;
   EXPECT_NE(summary_all.find("(all of the nominal recording's misfit removed)"), std::string::npos) << summary_all;
   EXPECT_NE(html_all.find("removes all of the nominal's misfit"), std::string::npos);
+  // On uneven ground the misfit is against a recording at other places and says so, with its SE,
+  // and no share of a nominal misfit that may be negative there.
+  a.leg_search.misfit_elsewhere = true;
+  a.leg_search.nominal_misfit = -0.144, a.leg_search.best_misfit = -0.026, a.leg_search.best_misfit_se = 0.05;
+  a.leg_search.gap_closed = NAN;
+  const std::string html_else = ReportHtml(a, ctx, ".");
+  const std::string summary_else = ReportSummary(a, ctx, "out/report.html");
+  const auto json_else = nlohmann::json::parse(ReportJson(a, ctx));
+  EXPECT_EQ(json_else["leg_search"]["misfit_against"], "other_places");
+  EXPECT_DOUBLE_EQ(json_else["leg_search"]["best_misfit_se"].get<double>(), 0.05);
+  EXPECT_NE(summary_else.find("as well as its own recording at other places does (misfit -0.026"), std::string::npos)
+      << summary_else;
+  EXPECT_EQ(html_else.find("nan%"), std::string::npos);
+  EXPECT_EQ(summary_else.find("nan%"), std::string::npos) << summary_else;
 }
 
 // The runoff's JSON speaks of knobs: no leg for a knob that is not a leg's, the knobs that fit as
