@@ -279,10 +279,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
 void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
                       const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
   out->misfit_elsewhere = true;
-  std::uint64_t seed = options.elsewhere_seed;
-  if (seed == in.recording.seed) ++seed;
-  const RecordingBatch b =
-      RecordBatch(simulator, RealDesign(in, seed), {{}, {{out->knob_index, out->value}}}, recording.recording);
+  const RecordingBatch b = RecordBatch(simulator, RealDesign(in, options.elsewhere_seed),
+                                       {{}, {{out->knob_index, out->value}}}, recording.recording);
   out->recorded += b.recorded;
   out->from_cache += b.from_cache;
   double se = NAN;

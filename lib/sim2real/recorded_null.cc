@@ -46,7 +46,7 @@ bool RecordedNullOptions::IsValid(std::string* error) const {
 Recording RealDesign(const AnalysisInputs& in, std::uint64_t seed) {
   Recording r;
   r.protocol = in.recording.protocol;
-  r.seed = seed;
+  r.seed = seed == in.recording.seed ? seed + 1 : seed;  // never the sim set's own recording
   if (!in.real_set.has_sequence()) {  // each sample its own placement, as the analysis treats it
     r.placements = in.real_set.size();
     r.executions_per_placement = 1;
@@ -70,9 +70,7 @@ NullShortfall RecordNullShortfall(const KnobSimulator& simulator, const Analysis
   NullShortfall out;
   out.recorded = true;
   for (int d = 0; d < options.draws; ++d) {
-    std::uint64_t seed = rng() % 2000000000ull;
-    if (seed == in.recording.seed) ++seed;
-    const RecordingBatch batch = RecordBatch(simulator, RealDesign(in, seed), {{}}, options.recording);
+    const RecordingBatch batch = RecordBatch(simulator, RealDesign(in, rng() % 2000000000ull), {{}}, options.recording);
     out.recordings += batch.recorded, out.from_cache += batch.from_cache;
     double mean = 0, se = 0;
     if (Shortfall(RealCommandsOf(batch.sets[0], in), base, options, rng, &mean, &se)) {

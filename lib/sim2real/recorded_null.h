@@ -35,8 +35,9 @@ struct RecordedNullOptions {
 NullShortfall RecordNullShortfall(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                                   const RecordedNullOptions& options);
 
-// The real set's design as a recording of the sim set's protocol: its number of placements and
-// its executions per placement; without sequence data as many placements as samples, one execution
+// The real set's design as a recording of the sim set's protocol at `seed` (moved one on when it is
+// the sim set's own, so never the sim set's places): its number of placements and its executions
+// per placement; without sequence data as many placements as samples, one execution
 // each (the analysis then treats every sample as its own placement).
 Recording RealDesign(const AnalysisInputs& in, std::uint64_t seed);
 

@@ -30,8 +30,6 @@ std::string F(const char* fmt, double v) {
   return buf;
 }
 
-// The share of the nominal's misfit a named point removes. Above 1 the real samples fit the point's
-// model better than its recording's own unseen samples do: all of the misfit, not more than all.
 // Where the null shortfall comes from, in words (ceiling.h, recorded_null.h).
 std::string NullWhere(const NullShortfall& n) {
   return n.recorded ? "the nominal re-recorded with the real set's design" : "the sim set's own size";
@@ -41,6 +39,8 @@ std::string NullHow(const NullShortfall& n) {
                     : std::string("sets drawn from the sim model");
 }
 
+// The share of the nominal's misfit a named point removes. Above 1 the real samples fit the point's
+// model better than its recording's own unseen samples do: all of the misfit, not more than all.
 std::string MisfitRemoved(double share) { return share > 1 ? "all" : F("%.0f%%", 100 * share); }
 
 // "it removes 41% of the nominal's misfit", or on uneven ground "the real samples fit its model as

@@ -101,7 +101,7 @@ TEST(RecordedNull, IsSeededAndNeverTheSimSetsOwnRecording) {
   EXPECT_EQ(a.mean, b.mean);
   EXPECT_EQ(a.sd, b.sd);
   EXPECT_NE(a.mean, c.mean);
-  EXPECT_NE(RealDesign(in, in.recording.seed).seed, 0u);
+  EXPECT_NE(RealDesign(in, in.recording.seed).seed, in.recording.seed) << "never the sim set's own places";
 }
 
 TEST(RecordedNull, RefusesFewerThanTwoDraws) {
