@@ -25,7 +25,10 @@ Usage: scripts/sim2real_robots.py [--build build] [--config datasets/robots/hexa
                                   [--seeds 13000-13002] [--threads 2] [--out DIR]
                                   [--sim2real-args 'ARGS'] [--kinds leg,friction,payload]
                                   [--sim-seed N] [--sim-placements 166] [--real-placements 78]
-                                  [--cache DIR]
+                                  [--cache DIR] [--follow-advice]
+With --follow-advice, where a report advises more placements (report.json more_data: the evidence
+stopped short of a name), the real set is recorded again with that many placements (same seed,
+same planted physics) and analysed: a second row "seed (N placements)", as a user would do.
 """
 import argparse, json, os, random, re, subprocess, sys, tempfile, time
 
@@ -114,6 +117,36 @@ def metadata(path, key):
     return float(v.decode() if isinstance(v, bytes) else v)
 
 
+def analyse(a, d, sim, real_cfg, real, placements, seed, knob, truth, report):
+    """Records the real set (`placements` placements, seed 2 s + 1) and analyses it into d/report;
+    returns the row's cells after the truth."""
+    dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--placements", str(placements),
+         "--seed", str(2 * seed + 1), "-o", real)
+    start = time.time()
+    dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", os.path.join(d, report), "--no-figures",
+         "--threads", a.threads, *(["--cache", a.cache] if a.cache else []), *a.sim2real_args.split())
+    wall = time.time() - start
+    out = json.load(open(os.path.join(d, report, "report.json")))
+    v = out["verdict"]
+    named = [n for n in v["named"]]
+    hit = next((n for n in named if n["knob"] == knob or n["knob"].startswith(knob + "@")), None)
+    value = hit["value"] if hit else float("nan")
+    ok = hit is not None and abs(value - truth) <= 0.25 * abs(truth)
+    names = ", ".join(f"{n['knob']}" for n in named) or "-"
+    span = hit.get("fits_as_well") if hit else None
+    as_well = f"{span['values'][0]:.3g} to {span['values'][1]:.3g}" if span else "-"
+    more = out.get("more_data")
+    advice = (f"{more['placements_needed']} ({more['knob']}, {more['reason']})" if more and more["placements_needed"]
+              else f"- ({more['knob']}: too small)" if more else "-")
+    return f"{names} | {value:.3g} | {'yes' if ok else 'no'} | {as_well} | {v['status']} | {advice} | {wall:.0f} |"
+
+
+def row_advice(d, report):
+    """The placements the report's more_data advises (None: no advice or too small an effect)."""
+    more = json.load(open(os.path.join(d, report, "report.json"))).get("more_data")
+    return more["placements_needed"] if more and more["placements_needed"] else None
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--build", default="build")
@@ -135,6 +168,9 @@ def main():
                     help="placements of the real set (the paper protocol's 78: 390 samples); more asks what a "
                          "longer real log can see")
     ap.add_argument("--cache", default=None, help="dgmm sim2real --cache (default its own)")
+    ap.add_argument("--follow-advice", action="store_true",
+                    help="where a report advises more placements (report.json more_data), record the real set "
+                         "again with that many and analyse it (a second row, 'seed (N placements)')")
     a = ap.parse_args()
     kinds = a.kinds.split(",")
     unknown = sorted(set(kinds) - set(KINDS))
@@ -150,8 +186,8 @@ def main():
     for rec in base["robot"].get("controller", {}).get("recordings", []):  # a replayed controller's files
         rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
     print(f"Robot {a.config}, seeds {lo}-{hi}, sim2real with --threads {a.threads}\n")
-    print("| seed | planted | truth | named | value | within 25% | fit as well | status | wall s |")
-    print("|---|---|---|---|---|---|---|---|---|")
+    print("| seed | planted | truth | named | value | within 25% | fit as well | status | more placements advised | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)
@@ -166,23 +202,13 @@ def main():
         real_cfg = os.path.join(d, "real.json")
         json.dump(cfg, open(real_cfg, "w"))
         real = os.path.join(d, "real.h5")
-        dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--placements", str(a.real_placements),
-             "--seed", str(2 * seed + 1), "-o", real)
-        start = time.time()
-        dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", os.path.join(d, "report"), "--no-figures",
-             "--threads", a.threads, *(["--cache", a.cache] if a.cache else []), *a.sim2real_args.split())
-        wall = time.time() - start
-        v = json.load(open(os.path.join(d, "report", "report.json")))["verdict"]
-        named = [n for n in v["named"]]
-        hit = next((n for n in named if n["knob"] == knob or n["knob"].startswith(knob + "@")), None)
-        value = hit["value"] if hit else float("nan")
-        ok = hit is not None and abs(value - truth) <= 0.25 * abs(truth)
-        names = ", ".join(f"{n['knob']}" for n in named) or "-"
-        span = hit.get("fits_as_well") if hit else None
-        as_well = f"{span['values'][0]:.3g} to {span['values'][1]:.3g}" if span else "-"
-        print(f"| {seed} | {knob} | {truth:.3g} | {names} | {value:.3g} | {'yes' if ok else 'no'} | {as_well} | "
-              f"{v['status']} | {wall:.0f} |",
-              flush=True)
+        row = analyse(a, d, sim, real_cfg, real, a.real_placements, seed, knob, truth, "report")
+        print(f"| {seed} | {knob} | {truth:.3g} | " + row, flush=True)
+        advice = row_advice(d, "report")
+        if a.follow_advice and advice:
+            more = os.path.join(d, f"real-{advice}.h5")
+            row = analyse(a, d, sim, real_cfg, more, advice, seed, knob, truth, f"report-{advice}")
+            print(f"| {seed} ({advice} placements) | {knob} | {truth:.3g} | " + row, flush=True)
     return 0
 
 

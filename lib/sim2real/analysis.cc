@@ -170,7 +170,7 @@ bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
          recorded_null.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
-         runoff.IsValid(error);
+         runoff.IsValid(error) && more_data.IsValid(error);
 }
 
 const LegSearch* NamedByOwnModels(const Analysis& a) {
@@ -281,6 +281,8 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
     a.refinement.recorded += refined, a.refinement.from_cache += refined_from_cache;
   }
   SearchByOwnModels(*simulator, options, stage, &a);
+  a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, options.more_data);
+  a.verdict.sentence += MoreDataSentence(a.more_data);
   if (const LegSearch* own = NamedByOwnModels(a)) {
     a.correction = LegSearchCorrection(*own);
     a.named_values = {{own->knob_index, own->value}};

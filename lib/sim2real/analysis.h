@@ -18,6 +18,8 @@
 //                                    recorded again, each recording scored by its own model;
 //      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
 //                                    searched, each recording scored by its own model;
+//      more data   (more_data.h)     when still nothing is named but a knob came near: how many
+//                                    placements the real set would need to decide it;
 //   9. report      (report.h)        report.json, report.html, the stdout summary (in the app).
 // Without a simulator the analysis stops after stage 2 and says so.
 #include <cstdint>
@@ -27,6 +29,7 @@
 
 #include "sim2real/correction.h"
 #include "sim2real/leg_search.h"
+#include "sim2real/more_data.h"
 #include "sim2real/recorded_null.h"
 #include "sim2real/runoff.h"
 #include "sim2real/verdict_stage.h"
@@ -71,6 +74,7 @@ struct AnalysisOptions {
   // (locate.uneven_ground), where the drawn null falls short of what null pairs measure, else drawn.
   NullSource null_source = NullSource::kAuto;
   RecordedNullOptions recorded_null;  // seed, folds, model and recording: the analysis's
+  MoreDataOptions more_data;          // the advice where the evidence stops short of a name
   std::function<void(const std::string&)> on_stage;  // progress: called with each stage's name
   bool IsValid(std::string* error) const;
 };
@@ -97,6 +101,7 @@ struct Analysis {
   Verdict verdict;
   Runoff runoff;                   // ran only on uneven ground with a mismatch left (Runoff::ran)
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
+  MoreData more_data;              // how many placements would decide a near miss (MoreData::advised)
   Correction correction;           // the knob correction (empty without a simulator)
   std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)
   StageTimes seconds;

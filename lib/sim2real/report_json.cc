@@ -214,6 +214,16 @@ json RunoffJson(const Runoff& r) {
   return out;
 }
 
+// The advice where the evidence stopped short of a name (more_data.h); null when not advised.
+json MoreDataJson(const MoreData& m) {
+  if (!m.advised) return nullptr;
+  return {{"knob", m.knob}, {"family", m.family}, {"reason", m.reason}, {"z", JsonNumber(m.z)},
+          {"z_required", JsonNumber(m.z_required)}, {"inclusion", JsonNumber(m.inclusion)},
+          {"z_effective", JsonNumber(m.z_effective)}, {"placements", m.placements},
+          {"executions_per_placement", m.executions_per_placement}, {"placements_are_samples", !m.sequence},
+          {"placements_needed", m.placements_needed < 0 ? json(nullptr) : json(m.placements_needed)}};
+}
+
 }  // namespace
 
 std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
@@ -228,6 +238,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"adequacy", a.knobs_analysed ? AdequacyJson(a) : json(nullptr)},
               {"runoff", RunoffJson(a.runoff)},
               {"leg_search", LegSearchJson(a.leg_search)},
+              {"more_data", MoreDataJson(a.more_data)},
               {"fit", FitJson(a)},
               {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},
                              {"fingerprint", ctx.simulator_fingerprint},

@@ -7,9 +7,7 @@
 #include <set>
 
 namespace dgmm::sim2real {
-namespace {
 
-// z with P(Z > z) = p for a standard normal (bisection on erfc; p in (0, 1)).
 double UpperQuantile(double p) {
   double lo = -10, hi = 10;
   for (int i = 0; i < 100; ++i) {
@@ -18,6 +16,8 @@ double UpperQuantile(double p) {
   }
   return 0.5 * (lo + hi);
 }
+
+namespace {
 
 double Correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
   const double na = a.norm(), nb = b.norm();

@@ -88,6 +88,9 @@ struct BootstrapResult {
   std::vector<Eigen::VectorXd> lower, upper;      // per selected effect, 95% percentile interval
 };
 
+// z with P(Z > z) = p for a standard normal (bisection on erfc; p in (0, 1)).
+double UpperQuantile(double p);
+
 BootstrapResult Bootstrap(const FitProblem& problem, const SelectionResult& selection,
                           const SelectionOptions& options, std::mt19937_64& rng);
 

@@ -179,5 +179,29 @@ TEST(Report, TheNullSaysWhereItCameFrom) {
   }
 }
 
+// The advice where the evidence stopped short of a name is in report.json as written, null
+// without advice, and says the same in the verdict's sentence of every output.
+TEST(Report, TheAdviceOfMorePlacementsIsOneStory) {
+  const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
+  ASSERT_FALSE(a.more_data.advised) << a.verdict.sentence;
+  EXPECT_TRUE(nlohmann::json::parse(ReportJson(a, ReportContext{}))["more_data"].is_null());
+  a.more_data.advised = true;
+  a.more_data.knob = "payload.mass_kg", a.more_data.family = "payload", a.more_data.reason = "near_miss";
+  a.more_data.z = a.more_data.z_effective = 2.4, a.more_data.z_required = 2.81;
+  a.more_data.placements = 48, a.more_data.executions_per_placement = 5, a.more_data.placements_needed = 121;
+  a.verdict.sentence += MoreDataSentence(a.more_data);
+  const auto j = nlohmann::json::parse(ReportJson(a, ReportContext{}));
+  EXPECT_EQ(j["more_data"]["placements_needed"], 121);
+  EXPECT_EQ(j["more_data"]["reason"], "near_miss");
+  EXPECT_TRUE(j["more_data"]["inclusion"].is_null()) << "a near miss has no inclusion";
+  const std::string advice = "at least about 121 placements would be needed to decide it";
+  EXPECT_EQ(Count(j["verdict"]["sentence"].get<std::string>(), advice), 1u);
+  EXPECT_EQ(Count(ReportHtml(a, ReportContext{}, "."), advice), 1u);
+  EXPECT_EQ(Count(ReportSummary(a, ReportContext{}, "report.html"), advice), 1u);
+  a.more_data.placements_needed = -1;
+  EXPECT_TRUE(nlohmann::json::parse(ReportJson(a, ReportContext{}))["more_data"]["placements_needed"].is_null());
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real

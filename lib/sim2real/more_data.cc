@@ -1,0 +1,105 @@
+#include "sim2real/more_data.h"
+
+#include <algorithm>
+
+#include "sim2real/recorded_null.h"
+#include "sim2real/selection.h"
+#include "sim2real/sentence_format.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+// The step that chose library effect k (nullptr: none).
+const SelectionStep* ChoosingStep(const SelectionResult& s, int k) {
+  for (const SelectionStep& step : s.steps) {
+    if (step.chosen == k) return &step;
+  }
+  return nullptr;
+}
+
+// The first weak knob's evidence: its z where it was chosen, z_eff from its family's inclusion.
+bool FromWeak(const CandidateSet& set, const Refinement& r, const Naming& naming, const Verdict& v,
+              int resamples, MoreData* m) {
+  if (naming.weak.empty() || v.weak.empty()) return false;
+  const int k = naming.weak.front();
+  const SelectionStep* step = ChoosingStep(r.selection, k);
+  if (!step) return false;
+  const auto own = std::find_if(step->candidates.begin(), step->candidates.end(),
+                                [k](const CandidateScore& c) { return c.effect == k; });
+  if (own == step->candidates.end()) return false;
+  const double floor = 0.5 / std::max(resamples, 1);  // the share one resample in 2B would give
+  m->reason = "inclusion";
+  m->knob = set.candidates[k].knob, m->family = set.candidates[k].family;
+  m->z = own->z, m->z_required = step->threshold_z;
+  m->inclusion = v.weak.front().inclusion;
+  m->z_effective = m->z_required - UpperQuantile(std::clamp(m->inclusion, floor, 1 - floor));
+  return true;
+}
+
+// The first step's best candidate when it came near significance.
+bool FromNearMiss(const CandidateSet& set, const Refinement& r, const MoreDataOptions& options, MoreData* m) {
+  const std::vector<SelectionStep>& steps = r.selection.steps;
+  if (steps.empty() || steps[0].candidates.empty() || steps[0].chosen >= 0) return false;
+  const auto best = std::max_element(steps[0].candidates.begin(), steps[0].candidates.end(),
+                                     [](const CandidateScore& x, const CandidateScore& y) { return x.z < y.z; });
+  if (!(best->z >= options.from_z && best->z < steps[0].threshold_z)) return false;
+  m->reason = "near_miss";
+  m->knob = set.candidates.at(best->effect).knob, m->family = set.candidates.at(best->effect).family;
+  m->z = m->z_effective = best->z, m->z_required = steps[0].threshold_z;
+  return true;
+}
+
+}  // namespace
+
+bool MoreDataOptions::IsValid(std::string* error) const {
+  if (!(from_z > 0) || !(margin >= 0) || !(max_factor > 1)) {
+    *error = "more data: from_z > 0, margin >= 0 and max_factor > 1 expected";
+    return false;
+  }
+  return true;
+}
+
+MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, const Naming& naming,
+                        const Verdict& v, const MoreDataOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "analysis options", error);
+  MoreData m;
+  if (!options.enabled || !v.named.empty()) return m;
+  if (!FromWeak(set, r, naming, v, r.selection_options.bootstrap_selection, &m) && !FromNearMiss(set, r, options, &m)) return MoreData{};
+  const Recording design = RealDesign(in, in.recording.seed + 1);
+  m.sequence = in.real_set.has_sequence();
+  m.placements = design.placements, m.executions_per_placement = design.executions_per_placement;
+  const double factor = m.z_effective > 0 ? std::pow((m.z_required + options.margin) / m.z_effective, 2) : INFINITY;
+  m.placements_needed = factor > options.max_factor ? -1 : static_cast<int>(std::ceil(m.placements * factor));
+  m.max_factor = options.max_factor;
+  m.advised = true;
+  return m;
+}
+
+std::string MoreDataSentence(const MoreData& m) {
+  if (!m.advised) return "";
+  const std::string unit = m.sequence ? "placements" : "samples";
+  std::string s = " The evidence stops short of a name: " + m.family + " (" + m.knob + ")";
+  s += m.reason == "inclusion"
+           ? Fmt(" was selected (held-out z %.2f", m.z) + Fmt(", significant from %.2f) but held in %.0f%% of the resamples",
+                                                             m.z_required, 100 * m.inclusion)
+           : Fmt(" reached held-out z %.2f at the first selection step (significant from %.2f)", m.z, m.z_required);
+  s += Fmt(". The real set has %.0f ", m.placements) + unit;
+  if (m.sequence) s += Fmt(" of %.0f executions", m.executions_per_placement);
+  if (m.placements_needed < 0) {
+    return s + Fmt("; the effect is too small for this protocol: more than %.0f times as many ", m.max_factor) + unit +
+           " would be needed to name it.";
+  }
+  const double z_then = m.z_effective * std::sqrt(static_cast<double>(m.placements_needed) / m.placements);
+  s += "; a held-out z grows with the square root of the " + unit;
+  if (m.reason == "near_miss") {  // the best of the first step, picked for being high: it overstates its effect
+    return s + Fmt(", so at least about %.0f ", m.placements_needed) + unit +
+           Fmt(" would be needed to decide it (z %.1f at the near miss's size, which the best of several candidates "
+               "tends to overstate).", z_then);
+  }
+  return s + Fmt(", so about %.0f ", m.placements_needed) + unit +
+         Fmt(" would decide it (z %.1f expected at the effect's present size).", z_then);
+}
+
+}  // namespace dgmm::sim2real

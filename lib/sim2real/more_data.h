@@ -1,0 +1,50 @@
+#pragma once
+// Stage 8's advice where the evidence stops short of a name (docs/sim2real.md, "More
+// placements"): nothing named, and either a knob that forward selection took but the bootstrap
+// resamples did not agree on (its family's inclusion p under the threshold), or the first
+// selection step's best candidate short of significance by a near miss (held-out z >= from_z).
+// A held-out z grows with the square root of the real set's placements (the units of its folds):
+//   n_needed = ceil(n ((z_sig + margin) / z_eff)^2),  z_eff = z (near miss) or z_sig - Q(p) (weak knob),
+// Q the standard normal's upper quantile (selection in a resample read as z* ~ N(z_eff, 1) passing
+// z_sig); margin 1 is about 84% power at the effect's present size, which a near miss tends to
+// overstate. Beyond max_factor n the effect is too small for this protocol, and the advice says so.
+#include <cmath>
+#include <string>
+
+#include "sim2real/candidates.h"
+#include "sim2real/inputs.h"
+#include "sim2real/refine.h"
+#include "sim2real/verdict_stage.h"
+
+namespace dgmm::sim2real {
+
+struct MoreDataOptions {
+  bool enabled = true;
+  double from_z = 2.0;      // a near miss: the first step's best held-out z at least this
+  double margin = 1.0;      // z aimed at: significance + margin
+  double max_factor = 16;   // more placements than this many times the real set's: too small
+  bool IsValid(std::string* error) const;
+};
+
+struct MoreData {
+  bool advised = false;
+  std::string knob, family;
+  std::string reason;        // "inclusion" (selected, resamples disagree) or "near_miss"
+  double z = NAN;            // held-out z at the step that chose it (inclusion) or the first step's best
+  double z_required = NAN;   // that step's significance
+  double inclusion = NAN;    // the family's (inclusion only)
+  double z_effective = NAN;  // the z the advice scales from
+  bool sequence = true;      // false: no sequence data, every sample its own placement
+  int placements = 0, executions_per_placement = 0;  // the real set's
+  int placements_needed = 0;  // -1: more than max_factor times the placements
+  double max_factor = 0;      // the options'
+};
+
+// `v` is the final verdict (after the runoff and the leg search): no advice once anything is named.
+MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, const Naming& naming,
+                        const Verdict& v, const MoreDataOptions& options);
+
+// " The evidence stops short of a name: ... would decide it ..." ("" when not advised).
+std::string MoreDataSentence(const MoreData& m);
+
+}  // namespace dgmm::sim2real
