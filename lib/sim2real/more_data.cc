@@ -65,7 +65,8 @@ MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "analysis options", error);
   MoreData m;
-  if (!options.enabled || !v.named.empty()) return m;
+  if (!options.enabled || !v.named.empty() || v.status != "unexplained") return m;
+  if (v.uneven_ground && !options.on_uneven_ground) return m;
   if (!FromWeak(set, r, naming, v, r.selection_options.bootstrap_selection, &m) && !FromNearMiss(set, r, options, &m)) return MoreData{};
   const Recording design = RealDesign(in, in.recording.seed + 1);
   m.sequence = in.real_set.has_sequence();

@@ -1,6 +1,6 @@
 #pragma once
-// Stage 8's advice where the evidence stops short of a name (docs/sim2real.md, "More
-// placements"): nothing named, and either a knob that forward selection took but the bootstrap
+// Stage 8's advice where the evidence stops short of a name (docs/sim2real.md, "When the evidence
+// stops short"): a mismatch nothing named accounts for (`unexplained`), on a plane, and either a knob that forward selection took but the bootstrap
 // resamples did not agree on (its family's inclusion p under the threshold), or the first
 // selection step's best candidate short of significance by a near miss (held-out z >= from_z).
 // A held-out z grows with the square root of the real set's placements (the units of its folds):
@@ -23,6 +23,10 @@ struct MoreDataOptions {
   double from_z = 2.0;      // a near miss: the first step's best held-out z at least this
   double margin = 1.0;      // z aimed at: significance + margin
   double max_factor = 16;   // more placements than this many times the real set's: too small
+  // On uneven ground the first step's near misses are no evidence: on rough pairs 540-559 a null
+  // and a pair of higher stones came near (backlash, z 2.29 and 2.55), and the weak legs came
+  // near as backlash, the wrong physics (docs/sim2real.md).
+  bool on_uneven_ground = false;
   bool IsValid(std::string* error) const;
 };
 
@@ -40,7 +44,8 @@ struct MoreData {
   double max_factor = 0;      // the options'
 };
 
-// `v` is the final verdict (after the runoff and the leg search): no advice once anything is named.
+// `v` is the final verdict (after the runoff and the leg search): advice only when it is
+// `unexplained` (nothing named; a clean verdict has no mismatch for a near miss to explain).
 MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, const Naming& naming,
                         const Verdict& v, const MoreDataOptions& options);
 

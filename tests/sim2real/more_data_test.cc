@@ -14,6 +14,13 @@ namespace dgmm::sim2real {
 namespace {
 
 // Inputs whose real set has 30 placements of 3 executions (the fake honours the executions asked for).
+// A verdict that names nothing for a mismatch on a plane.
+Verdict Unexplained() {
+  Verdict v;
+  v.status = "unexplained";
+  return v;
+}
+
 const AnalysisInputs& Inputs() {
   static const AnalysisInputs in = [] {
     test::FakeSimulator fake;
@@ -45,7 +52,7 @@ Refinement FirstStep(int chosen, double z0, double z1) {
 }
 
 TEST(MoreData, ANearMissScalesWithTheSquareRootOfThePlacements) {
-  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, {}, {});
+  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {});
   ASSERT_TRUE(m.advised);
   EXPECT_EQ(m.reason, "near_miss");
   EXPECT_EQ(m.knob, "payload.mass_kg");
@@ -61,7 +68,7 @@ TEST(MoreData, ANearMissScalesWithTheSquareRootOfThePlacements) {
 TEST(MoreData, AKnobTheResamplesDisagreedOnScalesFromItsInclusion) {
   Naming naming;
   naming.weak = {1};
-  Verdict v;
+  Verdict v = Unexplained();
   v.weak.push_back({"friction", "geoms.friction_scale", 0.5, 0.4});
   const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(1, 1.2, 3.6), naming, v, {});
   ASSERT_TRUE(m.advised);
@@ -74,25 +81,36 @@ TEST(MoreData, AKnobTheResamplesDisagreedOnScalesFromItsInclusion) {
   EXPECT_GT(m.placements_needed, 60);
 }
 
-TEST(MoreData, NoAdviceOnceSomethingIsNamedOrWhenNothingCameNear) {
+TEST(MoreData, NoAdviceOnceSomethingIsNamedWithoutAMismatchOrWhenNothingCameNear) {
   Verdict named;
   named.named.resize(1);
   EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, named, {}).advised);
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 1.9, 1.1), {}, {}, {}).advised)
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 1.9, 1.1), {}, Unexplained(), {}).advised)
       << "under from_z: nothing came near";
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 3.4, 1.1), {}, {}, {}).advised)
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 3.4, 1.1), {}, Unexplained(), {}).advised)
       << "selected and not weak: a drift or a withheld noise, not a matter of evidence";
   MoreDataOptions off;
   off.enabled = false;
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, {}, off).advised);
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), off).advised);
+  Verdict clean = Unexplained();
+  clean.status = "clean";
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, clean, {}).advised)
+      << "clean: no mismatch for a near miss to explain";
+  Verdict uneven = Unexplained();
+  uneven.uneven_ground = true;
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, uneven, {}).advised)
+      << "on uneven ground near misses are no evidence";
+  MoreDataOptions uneven_too;
+  uneven_too.on_uneven_ground = true;
+  EXPECT_TRUE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, uneven, uneven_too).advised);
   off.enabled = true, off.max_factor = 1;
-  EXPECT_THROW(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, {}, off), std::exception);
+  EXPECT_THROW(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), off), std::exception);
 }
 
 TEST(MoreData, AnEffectTooSmallForTheProtocolIsSaidSo) {
   Naming naming;
   naming.weak = {0};
-  Verdict v;
+  Verdict v = Unexplained();
   v.weak.push_back({"payload", "payload.mass_kg", 0.3, 0.0});  // held in no resample
   const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 2.9, 1.1), naming, v, {});
   ASSERT_TRUE(m.advised);
@@ -103,7 +121,7 @@ TEST(MoreData, AnEffectTooSmallForTheProtocolIsSaidSo) {
 TEST(MoreData, WithoutSequenceDataTheUnitsAreSamples) {
   AnalysisInputs in = Inputs();
   in.real_set.episode.resize(0), in.real_set.step.resize(0);
-  const MoreData m = AdviseMoreData(in, TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, {}, {});
+  const MoreData m = AdviseMoreData(in, TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {});
   ASSERT_TRUE(m.advised);
   EXPECT_EQ(m.placements, 90);
   EXPECT_FALSE(m.sequence);
