@@ -127,6 +127,16 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   }
 }
 
+// The knobs the runoff or the leg search recorded without naming them.
+std::vector<std::string> SearchedWithoutName(const Analysis& a) {
+  std::vector<std::string> knobs;
+  for (const LegSearch* s : {&a.runoff.search, &a.leg_search}) {
+    if (!s->ran || s->named) continue;
+    for (const LegSearchPoint& p : s->points) AddUnique(&knobs, p.knob);
+  }
+  return knobs;
+}
+
 // "; recorded again: the 4 of 23 knobs the first look screened in (held-out z >= 0.8 and >= 0.25 of
 // the step's best at some step, selected or confusable): a, b, c, d; 9 other candidates kept their
 // first-look signatures".
@@ -281,7 +291,8 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
     a.refinement.recorded += refined, a.refinement.from_cache += refined_from_cache;
   }
   SearchByOwnModels(*simulator, options, stage, &a);
-  a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, options.more_data);
+  a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, SearchedWithoutName(a),
+                               options.more_data);
   a.verdict.sentence += MoreDataSentence(a.more_data);
   if (const LegSearch* own = NamedByOwnModels(a)) {
     a.correction = LegSearchCorrection(*own);

@@ -61,13 +61,14 @@ bool MoreDataOptions::IsValid(std::string* error) const {
 }
 
 MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, const Naming& naming,
-                        const Verdict& v, const MoreDataOptions& options) {
+                        const Verdict& v, const std::vector<std::string>& searched, const MoreDataOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "analysis options", error);
   MoreData m;
   if (!options.enabled || !v.named.empty() || v.status != "unexplained") return m;
   if (v.uneven_ground && !options.on_uneven_ground) return m;
   if (!FromWeak(set, r, naming, v, r.selection_options.bootstrap_selection, &m) && !FromNearMiss(set, r, options, &m)) return MoreData{};
+  if (std::find(searched.begin(), searched.end(), m.knob) != searched.end()) return MoreData{};
   const Recording design = RealDesign(in, in.recording.seed + 1);
   m.sequence = in.real_set.has_sequence();
   m.placements = design.placements, m.executions_per_placement = design.executions_per_placement;
@@ -88,6 +89,10 @@ std::string MoreDataSentence(const MoreData& m) {
            : Fmt(" reached held-out z %.2f at the first selection step (significant from %.2f)", m.z, m.z_required);
   s += Fmt(". The real set has %.0f ", m.placements) + unit;
   if (m.sequence) s += Fmt(" of %.0f executions", m.executions_per_placement);
+  if (m.placements_needed < 0 && m.reason == "inclusion") {  // selected, yet the resamples rarely agree
+    return s + Fmt("; more placements alone are unlikely to settle it: at the rate the resamples agree, more than %.0f "
+                   "times as many ", m.max_factor) + unit + " would be needed.";
+  }
   if (m.placements_needed < 0) {
     return s + Fmt("; the effect is too small for this protocol: more than %.0f times as many ", m.max_factor) + unit +
            " would be needed to name it.";

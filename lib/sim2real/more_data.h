@@ -7,9 +7,12 @@
 //   n_needed = ceil(n ((z_sig + margin) / z_eff)^2),  z_eff = z (near miss) or z_sig - Q(p) (weak knob),
 // Q the standard normal's upper quantile (selection in a resample read as z* ~ N(z_eff, 1) passing
 // z_sig); margin 1 is about 84% power at the effect's present size, which a near miss tends to
-// overstate. Beyond max_factor n the effect is too small for this protocol, and the advice says so.
+// overstate. Beyond max_factor n the advice says so: for a near miss the effect is too small for
+// this protocol; for a selected knob the resamples disagree too often for more placements alone to
+// settle it (hexapod pair 45006: a payload selected at z 3.2, held in no resample).
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "sim2real/candidates.h"
 #include "sim2real/inputs.h"
@@ -46,8 +49,12 @@ struct MoreData {
 
 // `v` is the final verdict (after the runoff and the leg search): advice only when it is
 // `unexplained` (nothing named; a clean verdict has no mismatch for a near miss to explain).
+// `searched`: knobs a search scored by models of their own (runoff, leg search) recorded without
+// naming them; a closer look has spoken there, so they are not advised (on hexapod pair 45007 a
+// leg's gain came near by its mean shift where the leg search had just found that leg's recording
+// no better than the nominal's).
 MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, const Naming& naming,
-                        const Verdict& v, const MoreDataOptions& options);
+                        const Verdict& v, const std::vector<std::string>& searched, const MoreDataOptions& options);
 
 // " The evidence stops short of a name: ... would decide it ..." ("" when not advised).
 std::string MoreDataSentence(const MoreData& m);

@@ -52,7 +52,7 @@ Refinement FirstStep(int chosen, double z0, double z1) {
 }
 
 TEST(MoreData, ANearMissScalesWithTheSquareRootOfThePlacements) {
-  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {});
+  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {}, {});
   ASSERT_TRUE(m.advised);
   EXPECT_EQ(m.reason, "near_miss");
   EXPECT_EQ(m.knob, "payload.mass_kg");
@@ -70,7 +70,7 @@ TEST(MoreData, AKnobTheResamplesDisagreedOnScalesFromItsInclusion) {
   naming.weak = {1};
   Verdict v = Unexplained();
   v.weak.push_back({"friction", "geoms.friction_scale", 0.5, 0.4});
-  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(1, 1.2, 3.6), naming, v, {});
+  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(1, 1.2, 3.6), naming, v, {}, {});
   ASSERT_TRUE(m.advised);
   EXPECT_EQ(m.reason, "inclusion");
   EXPECT_EQ(m.knob, "geoms.friction_scale");
@@ -84,44 +84,51 @@ TEST(MoreData, AKnobTheResamplesDisagreedOnScalesFromItsInclusion) {
 TEST(MoreData, NoAdviceOnceSomethingIsNamedWithoutAMismatchOrWhenNothingCameNear) {
   Verdict named;
   named.named.resize(1);
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, named, {}).advised);
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 1.9, 1.1), {}, Unexplained(), {}).advised)
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, named, {}, {}).advised);
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 1.9, 1.1), {}, Unexplained(), {}, {}).advised)
       << "under from_z: nothing came near";
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 3.4, 1.1), {}, Unexplained(), {}).advised)
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 3.4, 1.1), {}, Unexplained(), {}, {}).advised)
       << "selected and not weak: a drift or a withheld noise, not a matter of evidence";
   MoreDataOptions off;
   off.enabled = false;
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), off).advised);
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {}, off).advised);
   Verdict clean = Unexplained();
   clean.status = "clean";
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, clean, {}).advised)
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, clean, {}, {}).advised)
       << "clean: no mismatch for a near miss to explain";
   Verdict uneven = Unexplained();
   uneven.uneven_ground = true;
-  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, uneven, {}).advised)
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, uneven, {}, {}).advised)
       << "on uneven ground near misses are no evidence";
   MoreDataOptions uneven_too;
   uneven_too.on_uneven_ground = true;
-  EXPECT_TRUE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, uneven, uneven_too).advised);
+  EXPECT_TRUE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, uneven, {}, uneven_too).advised);
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(),
+                              {"payload.mass_kg"}, {}).advised)
+      << "a search by models of their own recorded it and named nothing: the closer look has spoken";
   off.enabled = true, off.max_factor = 1;
-  EXPECT_THROW(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), off), std::exception);
+  EXPECT_THROW(AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {}, off), std::exception);
 }
 
-TEST(MoreData, AnEffectTooSmallForTheProtocolIsSaidSo) {
+TEST(MoreData, BeyondSixteenTimesThePlacementsItSaysSo) {
   Naming naming;
   naming.weak = {0};
   Verdict v = Unexplained();
   v.weak.push_back({"payload", "payload.mass_kg", 0.3, 0.0});  // held in no resample
-  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 2.9, 1.1), naming, v, {});
+  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(0, 2.9, 1.1), naming, v, {}, {});
   ASSERT_TRUE(m.advised);
   EXPECT_EQ(m.placements_needed, -1) << "z_eff " << m.z_effective;
-  EXPECT_NE(MoreDataSentence(m).find("too small for this protocol"), std::string::npos) << MoreDataSentence(m);
+  EXPECT_NE(MoreDataSentence(m).find("more placements alone are unlikely to settle it"), std::string::npos)
+      << MoreDataSentence(m);
+  MoreData near = m;
+  near.reason = "near_miss";
+  EXPECT_NE(MoreDataSentence(near).find("too small for this protocol"), std::string::npos) << MoreDataSentence(near);
 }
 
 TEST(MoreData, WithoutSequenceDataTheUnitsAreSamples) {
   AnalysisInputs in = Inputs();
   in.real_set.episode.resize(0), in.real_set.step.resize(0);
-  const MoreData m = AdviseMoreData(in, TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {});
+  const MoreData m = AdviseMoreData(in, TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {}, {});
   ASSERT_TRUE(m.advised);
   EXPECT_EQ(m.placements, 90);
   EXPECT_FALSE(m.sequence);
