@@ -119,7 +119,8 @@ def metadata(path, key):
 
 def analyse(a, d, sim, real_cfg, real, placements, seed, knob, truth, report):
     """Records the real set (`placements` placements, seed 2 s + 1) and analyses it into d/report;
-    returns the row's cells after the truth."""
+    returns the row's cells after the truth and the placements the report advises (None: no advice,
+    or more than its bound)."""
     dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--placements", str(placements),
          "--seed", str(2 * seed + 1), "-o", real)
     start = time.time()
@@ -136,15 +137,10 @@ def analyse(a, d, sim, real_cfg, real, placements, seed, knob, truth, report):
     span = hit.get("fits_as_well") if hit else None
     as_well = f"{span['values'][0]:.3g} to {span['values'][1]:.3g}" if span else "-"
     more = out.get("more_data")
-    advice = (f"{more['placements_needed']} ({more['knob']}, {more['reason']})" if more and more["placements_needed"]
-              else f"- ({more['knob']}: too small)" if more else "-")
-    return f"{names} | {value:.3g} | {'yes' if ok else 'no'} | {as_well} | {v['status']} | {advice} | {wall:.0f} |"
-
-
-def row_advice(d, report):
-    """The placements the report's more_data advises (None: no advice or too small an effect)."""
-    more = json.load(open(os.path.join(d, report, "report.json"))).get("more_data")
-    return more["placements_needed"] if more and more["placements_needed"] else None
+    needed = more["placements_needed"] if more else None
+    advice = (f"{needed} ({more['knob']}, {more['reason']})" if needed
+              else f"- ({more['knob']}, {more['reason']}: beyond its bound)" if more else "-")
+    return f"{names} | {value:.3g} | {'yes' if ok else 'no'} | {as_well} | {v['status']} | {advice} | {wall:.0f} |", needed
 
 
 def main():
@@ -202,12 +198,11 @@ def main():
         real_cfg = os.path.join(d, "real.json")
         json.dump(cfg, open(real_cfg, "w"))
         real = os.path.join(d, "real.h5")
-        row = analyse(a, d, sim, real_cfg, real, a.real_placements, seed, knob, truth, "report")
+        row, advice = analyse(a, d, sim, real_cfg, real, a.real_placements, seed, knob, truth, "report")
         print(f"| {seed} | {knob} | {truth:.3g} | " + row, flush=True)
-        advice = row_advice(d, "report")
         if a.follow_advice and advice:
             more = os.path.join(d, f"real-{advice}.h5")
-            row = analyse(a, d, sim, real_cfg, more, advice, seed, knob, truth, f"report-{advice}")
+            row, _ = analyse(a, d, sim, real_cfg, more, advice, seed, knob, truth, f"report-{advice}")
             print(f"| {seed} ({advice} placements) | {knob} | {truth:.3g} | " + row, flush=True)
     return 0
 

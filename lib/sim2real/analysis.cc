@@ -235,10 +235,8 @@ std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& opti
     return "a first look named " + named + " from signatures of " + of_real + "; a name is confirmed with every execution";
   }
   const std::vector<SelectionStep>& steps = a.refinement.selection.steps;
-  if (steps.empty() || steps[0].candidates.empty()) return "";
-  const auto best = std::max_element(steps[0].candidates.begin(), steps[0].candidates.end(),
-                                     [](const CandidateScore& x, const CandidateScore& y) { return x.z < y.z; });
-  if (!(best->z >= options.every_execution_from_z)) return "";
+  const CandidateScore* best = FirstStepBest(a.refinement.selection);
+  if (!best || !(best->z >= options.every_execution_from_z)) return "";
   const std::string& key = a.candidates.candidates.at(best->effect).key;
   const std::string z = Fmt("held-out z %.2f", best->z) + Fmt(", significant from %.2f", steps[0].threshold_z);
   if (best->z >= steps[0].threshold_z) {

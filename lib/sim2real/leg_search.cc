@@ -311,11 +311,10 @@ void CheckMisfit(const KnobSimulator& simulator, const AnalysisInputs& in, const
   }
   if (out->gap_closed >= options.min_gap_closed) return;
   out->named = false;
-  const char* unseen = options.misfit_elsewhere ? "a second recording of it at other places"
-                                                : "the recording's own unseen samples";
   out->why = "the best point (" + PointName(knob, out->value) +
-             Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against ", 100 * out->gap_closed) +
-             unseen + Fmt(", %.3g nats per sample; the best's: %.3g)", out->nominal_misfit, out->best_misfit) +
+             Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against the recording's own "
+                 "unseen samples, %.3g nats per sample; the best's: %.3g)", 100 * out->gap_closed, out->nominal_misfit,
+                 out->best_misfit) +
              (knob.leg.empty() ? ": the mismatch is not this knob alone" : ": the mismatch is not a weak leg alone");
 }
 

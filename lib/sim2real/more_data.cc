@@ -39,14 +39,13 @@ bool FromWeak(const CandidateSet& set, const Refinement& r, const Naming& naming
 
 // The first step's best candidate when it came near significance.
 bool FromNearMiss(const CandidateSet& set, const Refinement& r, const MoreDataOptions& options, MoreData* m) {
-  const std::vector<SelectionStep>& steps = r.selection.steps;
-  if (steps.empty() || steps[0].candidates.empty() || steps[0].chosen >= 0) return false;
-  const auto best = std::max_element(steps[0].candidates.begin(), steps[0].candidates.end(),
-                                     [](const CandidateScore& x, const CandidateScore& y) { return x.z < y.z; });
-  if (!(best->z >= options.from_z && best->z < steps[0].threshold_z)) return false;
+  const CandidateScore* best = FirstStepBest(r.selection);
+  if (!best || r.selection.steps[0].chosen >= 0) return false;
+  const SelectionStep& first = r.selection.steps[0];
+  if (!(best->z >= options.from_z && best->z < first.threshold_z)) return false;
   m->reason = "near_miss";
   m->knob = set.candidates.at(best->effect).knob, m->family = set.candidates.at(best->effect).family;
-  m->z = m->z_effective = best->z, m->z_required = steps[0].threshold_z;
+  m->z = m->z_effective = best->z, m->z_required = first.threshold_z;
   return true;
 }
 

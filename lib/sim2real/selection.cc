@@ -17,6 +17,12 @@ double UpperQuantile(double p) {
   return 0.5 * (lo + hi);
 }
 
+const CandidateScore* FirstStepBest(const SelectionResult& selection) {
+  if (selection.steps.empty() || selection.steps[0].candidates.empty()) return nullptr;
+  const std::vector<CandidateScore>& c = selection.steps[0].candidates;
+  return &*std::max_element(c.begin(), c.end(), [](const CandidateScore& x, const CandidateScore& y) { return x.z < y.z; });
+}
+
 namespace {
 
 double Correlation(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {

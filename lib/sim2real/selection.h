@@ -91,6 +91,9 @@ struct BootstrapResult {
 // z with P(Z > z) = p for a standard normal (bisection on erfc; p in (0, 1)).
 double UpperQuantile(double p);
 
+// The candidate with the largest held-out z at the first selection step (nullptr: no step or none).
+const CandidateScore* FirstStepBest(const SelectionResult& selection);
+
 BootstrapResult Bootstrap(const FitProblem& problem, const SelectionResult& selection,
                           const SelectionOptions& options, std::mt19937_64& rng);
 
