@@ -58,6 +58,20 @@ Recording SimRecording(const SampleSet& sim, std::uint64_t fallback_seed, bool* 
   return r;
 }
 
+// The real set's recording seed when its metadata has one (a simulated "real" set); a recorded log's
+// metadata may hold anything under that name, so what does not read as a seed is ignored.
+std::optional<std::uint64_t> RealSeed(const SampleSet& real) {
+  const auto seed = real.metadata.find("seed");
+  if (seed == real.metadata.end()) return std::nullopt;
+  try {
+    size_t used = 0;
+    const std::uint64_t s = std::stoull(seed->second, &used);
+    if (used == seed->second.size() && seed->second.find('-') == std::string::npos) return s;
+  } catch (const std::exception&) {
+  }
+  return std::nullopt;
+}
+
 }  // namespace
 
 AnalysisInputs PrepareInputs(const SampleSet& sim_in, const SampleSet& real_in, std::uint64_t fallback_seed) {
@@ -86,6 +100,7 @@ AnalysisInputs PrepareInputs(const SampleSet& sim_in, const SampleSet& real_in, 
   for (int f : in.real.first_execution) first += f;
   in.first_execution_share = first / in.real.size();
   in.recording = SimRecording(in.sim_set, fallback_seed, &in.recording_from_metadata);
+  in.real_seed = RealSeed(in.real_set);
   DetectTerrainColumns(in.real_set, &in.pitch_col, &in.roll_col);
   return in;
 }

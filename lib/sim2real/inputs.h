@@ -4,6 +4,7 @@
 // dropped and listed), the pose layout, and the sim set's own recording (protocol and seed from
 // its metadata, which `dgmm simulate` writes) for re-recordings at other knob values.
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,7 @@ struct AnalysisInputs {
   double first_execution_share = 0;          // of the real samples
   Recording recording;                       // the sim set's own
   bool recording_from_metadata = false;      // false: protocol "paper", seed = fallback
+  std::optional<std::uint64_t> real_seed;    // the real set's own recording seed, when its metadata has one
   int pitch_col = -1, roll_col = -1;         // terrain columns (-1: absent)
 };
 

@@ -46,7 +46,8 @@ bool RecordedNullOptions::IsValid(std::string* error) const {
 Recording RealDesign(const AnalysisInputs& in, std::uint64_t seed) {
   Recording r;
   r.protocol = in.recording.protocol;
-  r.seed = seed == in.recording.seed ? seed + 1 : seed;  // never the sim set's own recording
+  r.seed = seed;  // never the sim set's own recording, nor the real set's
+  while (r.seed == in.recording.seed || r.seed == in.real_seed) ++r.seed;
   if (!in.real_set.has_sequence()) {  // each sample its own placement, as the analysis treats it
     r.placements = in.real_set.size();
     r.executions_per_placement = 1;

@@ -35,10 +35,10 @@ struct RecordedNullOptions {
 NullShortfall RecordNullShortfall(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                                   const RecordedNullOptions& options);
 
-// The real set's design as a recording of the sim set's protocol at `seed` (moved one on when it is
-// the sim set's own, so never the sim set's places): its number of placements and its executions
-// per placement; without sequence data as many placements as samples, one execution
-// each (the analysis then treats every sample as its own placement).
+// The real set's design as a recording of the sim set's protocol at `seed` (moved on while it is the
+// sim set's own or, when its metadata says, the real set's, so never their places): its number of
+// placements and its executions per placement; without sequence data as many placements as
+// samples, one execution each (the analysis then treats every sample as its own placement).
 Recording RealDesign(const AnalysisInputs& in, std::uint64_t seed);
 
 // A recording of RealDesign's samples with the real set's commands only (the sim set's command

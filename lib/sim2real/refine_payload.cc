@@ -5,13 +5,19 @@
 // added masses m0 {1/f, 1, f} and forward offsets x0 + {-h, 0, h}, each scored by
 //   l(m, x) = max_theta log p(real | sim model + s(m, x) + D_others theta),
 // the recording's own shift taken at face value (coefficient 1), the other selected effects refit.
-// The sideways offset is not searched: what the probes' reading measures is the sideways moment
-// M0 y0 (M: the payload's mass), so a point of mass M sits at y = y_n + (y0 - y_n) M0 / M (y_n the
-// nominal), not at y0, which would charge a heavier payload for a roll the real robot never had.
-// When the best point lies on the grid's edge, a second grid is recorded around it (the points
-// already recorded reused). A quadratic in (log m, x) through the last grid's nine scores gives the
-// maximum, recorded once more (within twice the grid); the best-scoring recording becomes the
-// payload's signature.
+// The sideways offset is searched in two ways only: what the probes' reading measures is the
+// sideways moment M0 y0 (M: the payload's mass), so a point of mass M kept at that moment sits at
+// y = y_n + (y0 - y_n) M0 / M (y_n the nominal), not at y0, which would charge a heavier payload
+// for a roll the real robot never had; but the reading's moment can itself be a linear reading's
+// artefact (a forward offset that bends the walk reads as a sideways one), and a search that keeps
+// it drives the mass up to make the moment's offset small. So the first grid is recorded twice,
+// once keeping the moment and once with the payload on the middle line (y = y_n), the search goes
+// on along the better of the two, and once centred it records the other way at its best's mass
+// and offset, going on along that way when it fits better.
+// While the best point lies on the grid's edge, a further grid is recorded around it (the points
+// already recorded reused; RefineOptions::refine_iterations such steps at most). A quadratic in
+// (log m, x) through the scores around the best gives the maximum, recorded once more (within twice
+// the grid); the best-scoring recording becomes the payload's signature.
 #include <algorithm>
 #include <cmath>
 
@@ -24,10 +30,14 @@ namespace {
 
 constexpr double kMassFactor = 1.6;  // grid spacing in added mass (ratio)
 constexpr double kOffsetShare = 0.25;  // grid spacing in x: this share of the x probe's offset
+// The middle line is searched too when the reading's sideways offset is at least this share of the
+// y probe's (below it the two ways differ by less than the probes can tell).
+constexpr double kSidewaysShare = 0.05;
 
 struct PayloadPoint {
   double mass = 0, x = 0, y = 0;
   double u = 0, v = 0;   // grid coordinates: mass steps (factor kMassFactor) and offset steps from the reading
+  bool moment = true;    // kept at the reading's sideways moment (else on the middle line)
   int shift = -1;        // index into CandidateSet::shifts
   double score = -INFINITY;
   Eigen::VectorXd rows;  // the score per real sample
@@ -44,6 +54,17 @@ std::string PointLabel(const std::string& knob, double x, double y) {
 // end with the x and y probes' and the centre probe's, which stay.
 std::vector<int> WithMassShift(const std::vector<int>& probes, int shift) {
   return {shift, probes[probes.size() - 3], probes[probes.size() - 2], probes[probes.size() - 1]};
+}
+
+// True when p lies strictly inside the box of the grid's points on its sideways way, in both grid
+// coordinates.
+bool Inside(const std::vector<PayloadPoint>& grid, const PayloadPoint& p) {
+  double ulo = INFINITY, uhi = -INFINITY, vlo = INFINITY, vhi = -INFINITY;
+  for (const PayloadPoint& q : grid) {
+    if (q.moment != p.moment) continue;
+    ulo = std::min(ulo, q.u), uhi = std::max(uhi, q.u), vlo = std::min(vlo, q.v), vhi = std::max(vhi, q.v);
+  }
+  return ulo < p.u && p.u < uhi && vlo < p.v && p.v < vhi;
 }
 
 // The maximum of ll = a + b u + c v + d u^2 + e v^2 + g u v fitted to the points (u, v, ll), within
@@ -72,12 +93,15 @@ bool QuadraticMaximum(const std::vector<Eigen::Vector3d>& pts, double u_max, dou
 struct SearchFrame {
   const Knob *mass, *x, *y;
   double nominal = 0, added = 0, x0 = 0, y0 = 0, h = 0;
-  PayloadPoint At(double u, double v) const {
+  double ky_probe = 0;  // the y probe's offset from the nominal
+  PayloadPoint At(double u, double v, bool moment) const {
     const double m = std::clamp(nominal + added * std::exp(u * std::log(kMassFactor)), mass->lo, mass->hi);
     const double m0 = std::clamp(nominal + added, mass->lo, mass->hi);
-    const double side = m > 0 ? y->nominal + (y0 - y->nominal) * m0 / m : y0;
-    return {m, std::clamp(x0 + v * h, x->lo, x->hi), std::clamp(side, y->lo, y->hi), u, v};
+    const double side = !moment ? y->nominal : m > 0 ? y->nominal + (y0 - y->nominal) * m0 / m : y0;
+    return {m, std::clamp(x0 + v * h, x->lo, x->hi), std::clamp(side, y->lo, y->hi), u, v, moment};
   }
+  // Is the middle line worth a grid of its own?
+  bool Sideways() const { return std::abs(y0 - y->nominal) >= kSidewaysShare * std::abs(ky_probe); }
 };
 
 SearchFrame LinearReading(const std::vector<Knob>& knobs, const CandidateSet& set, const KnobCandidate& c,
@@ -89,7 +113,23 @@ SearchFrame LinearReading(const std::vector<Knob>& knobs, const CandidateSet& se
   f.x0 = std::clamp(kx.nominal + t(1) / t(0) * (kx.probes[0] - kx.nominal), kx.lo, kx.hi);
   f.y0 = std::clamp(ky.nominal + t(2) / t(0) * (ky.probes[0] - ky.nominal), ky.lo, ky.hi);
   f.h = kOffsetShare * std::abs(kx.probes[0] - kx.nominal);
+  f.ky_probe = ky.probes[0] - ky.nominal;
   return f;
+}
+
+// The 3 x 3 grid around (cu, cv) on one sideways way, less the points already recorded.
+std::vector<PayloadPoint> GridAround(const SearchFrame& f, const std::vector<PayloadPoint>& grid, int cu, int cv,
+                                     bool moment) {
+  std::vector<PayloadPoint> fresh;
+  for (int iu = cu - 1; iu <= cu + 1; ++iu) {
+    for (int iv = cv - 1; iv <= cv + 1; ++iv) {
+      const bool known = std::any_of(grid.begin(), grid.end(), [&](const PayloadPoint& p) {
+        return p.u == iu && p.v == iv && p.moment == moment;
+      });
+      if (!known) fresh.push_back(f.At(iu, iv, moment));
+    }
+  }
+  return fresh;
 }
 
 // Records the points in one batch and scores each.
@@ -109,6 +149,72 @@ void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, co
     r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, (*pts)[i].y), (*pts)[i].mass, NAN,
                         (*pts)[i].score / in.real.size()});
   }
+}
+
+// The search's grids so far: every point recorded, the best one's grid coordinates and way, and
+// whether the last grid's centre scored best.
+struct Walk {
+  std::vector<PayloadPoint> grid;
+  int cu = 0, cv = 0;
+  bool moment = true;
+  bool centred = false;
+};
+
+// Round 1 around the reading, on both sideways ways when they differ; each further round
+// (refine_iterations at most) around the last round's best, on its way, while that lies on its
+// grid's edge. Once centred, the other way is recorded at the same mass and offset (the first grid
+// compared the two ways at the reading only); when it fits better, the walk goes on along it
+// (one further round allowed).
+Walk WalkGrids(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+               const CandidateOptions& recording, const RefineOptions& options, int pay, const SearchFrame& f,
+               CandidateSet* set, Refinement* r) {
+  Walk w;
+  bool crossed = false;
+  for (int round = 0; round <= options.refine_iterations + crossed && !w.centred; ++round) {
+    std::vector<PayloadPoint> fresh = GridAround(f, w.grid, w.cu, w.cv, w.moment);
+    if (round == 0 && f.Sideways()) {
+      const std::vector<PayloadPoint> middle = GridAround(f, w.grid, w.cu, w.cv, false);
+      fresh.insert(fresh.end(), middle.begin(), middle.end());
+    }
+    RecordAndScore(simulator, in, base, recording, options, pay, set, r, &fresh);
+    w.grid.insert(w.grid.end(), fresh.begin(), fresh.end());
+    auto top = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
+    w.centred = top->u == w.cu && top->v == w.cv && top->moment == w.moment;
+    if (w.centred && f.Sideways() && !crossed) {
+      crossed = true;
+      const bool known = std::any_of(w.grid.begin(), w.grid.end(), [&](const PayloadPoint& p) {
+        return p.u == w.cu && p.v == w.cv && p.moment != w.moment;
+      });
+      std::vector<PayloadPoint> other;
+      if (!known) other.push_back(f.At(w.cu, w.cv, !w.moment));
+      RecordAndScore(simulator, in, base, recording, options, pay, set, r, &other);
+      w.grid.insert(w.grid.end(), other.begin(), other.end());
+      top = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
+      w.centred = top->moment == w.moment;
+    }
+    w.cu = static_cast<int>(top->u), w.cv = static_cast<int>(top->v), w.moment = top->moment;
+  }
+  return w;
+}
+
+// The maximum of a quadratic through the points around the best (on its way; a full 3 x 3 once
+// centred), recorded and added to the grid; true when it was recorded strictly inside the box of
+// that way's points.
+bool RecordQuadraticMaximum(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
+                            const CandidateOptions& recording, const RefineOptions& options, int pay,
+                            const SearchFrame& f, CandidateSet* set, Refinement* r, Walk* w) {
+  std::vector<Eigen::Vector3d> scored;
+  for (const auto& p : w->grid) {
+    if (p.moment == w->moment && std::abs(p.u - w->cu) <= 1 && std::abs(p.v - w->cv) <= 1) {
+      scored.emplace_back(p.u - w->cu, p.v - w->cv, p.score);
+    }
+  }
+  double u = 0, v = 0;
+  if (scored.size() < 6 || !QuadraticMaximum(scored, 2, 2, &u, &v)) return false;
+  std::vector<PayloadPoint> extra = {f.At(w->cu + u, w->cv + v, w->moment)};
+  RecordAndScore(simulator, in, base, recording, options, pay, set, r, &extra);
+  w->grid.push_back(extra[0]);
+  return Inside(w->grid, extra[0]);
 }
 
 // The masses and forward offsets of the searched points that fit as well as the best (refine_search.h).
@@ -167,41 +273,13 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
                                             : FitEffects(r->problem, {pay}, {}, options.selection.fit).theta[0];
   if (t(0) <= 0.05) return;  // a payload heavier than nominal (a lighter one has no position to fit)
   const SearchFrame f = LinearReading(simulator.knobs(), *set, *found, t);
-  // Round 1 around the reading; round 2 around round 1's best when that lies on the grid's edge.
-  std::vector<PayloadPoint> grid;
-  int cu = 0, cv = 0;
-  for (int round = 0; round < 2; ++round) {
-    std::vector<PayloadPoint> fresh;
-    for (int iu = cu - 1; iu <= cu + 1; ++iu) {
-      for (int iv = cv - 1; iv <= cv + 1; ++iv) {
-        const bool known = std::any_of(grid.begin(), grid.end(), [&](const PayloadPoint& p) {
-          return p.u == iu && p.v == iv;
-        });
-        if (!known) fresh.push_back(f.At(iu, iv));
-      }
-    }
-    RecordAndScore(simulator, in, base, recording, options, pay, set, r, &fresh);
-    grid.insert(grid.end(), fresh.begin(), fresh.end());
-    const auto top = std::max_element(grid.begin(), grid.end(), ByScore);
-    if (top->u == cu && top->v == cv) break;
-    cu = static_cast<int>(top->u), cv = static_cast<int>(top->v);
-  }
-  std::vector<Eigen::Vector3d> scored;
-  for (const auto& p : grid) {
-    if (std::abs(p.u - cu) <= 1 && std::abs(p.v - cv) <= 1) scored.emplace_back(p.u - cu, p.v - cv, p.score);
-  }
-  double u = 0, v = 0;
-  const bool concave = QuadraticMaximum(scored, 2, 2, &u, &v);
-  if (concave) {
-    std::vector<PayloadPoint> extra = {f.At(cu + u, cv + v)};
-    RecordAndScore(simulator, in, base, recording, options, pay, set, r, &extra);
-    grid.push_back(extra[0]);
-  }
-  const auto best = std::max_element(grid.begin(), grid.end(), ByScore);
+  Walk w = WalkGrids(simulator, in, base, recording, options, pay, f, set, r);
+  const bool peak_inside = RecordQuadraticMaximum(simulator, in, base, recording, options, pay, f, set, r, &w);
+  const auto best = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
   // Converged: the search brackets the maximum (the last grid's centre scored best, or the
-  // quadratic's maximum lies inside the searched box).
-  const bool converged = (best->u == cu && best->v == cv) || (concave && std::abs(u) < 2 && std::abs(v) < 2);
-  Adopt(in, base, pay, grid, *best, converged, options.as_well_z, set, r);
+  // quadratic's maximum, recorded, scored best strictly inside the recorded points' box).
+  const bool converged = w.centred || (peak_inside && best == w.grid.end() - 1);
+  Adopt(in, base, pay, w.grid, *best, converged, options.as_well_z, set, r);
 }
 
 }  // namespace dgmm::sim2real

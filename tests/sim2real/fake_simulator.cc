@@ -55,7 +55,7 @@ Eigen::Vector3d Gravity(double pitch, double roll) {
 
 // The mean pose change of one execution.
 Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, double roll, bool first,
-                     const FakeExtras& extras, double friction_threshold) {
+                     const FakeExtras& extras, double friction_threshold, const Eigen::Vector3d& payload) {
   const Eigen::Vector3d g = Gravity(pitch, roll);
   Eigen::Vector3d x(0.2 * c(0) + 0.05 * g(0) * std::abs(c(0)), 0.15 * c(1) + 0.04 * g(1) * std::abs(c(1)),
                     0.3 * c(2) + 0.02 * g(1));
@@ -72,10 +72,11 @@ Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, do
                              side * (0.05 * c(0) + 0.01) + 0.03 * front * c(1));
   }
   if (first) x *= 1 - k.v[kLatency] / 0.1;  // motion lost at the first execution after a command change
-  const double m = k.v[kPayloadMass];
+  const double m = payload(0) * std::pow(k.v[kPayloadMass], payload(1));
   x += m * Eigen::Vector3d(-0.01 * std::abs(c(0)) + 0.02 * k.v[kPayloadY] * g(0), 0.05 * k.v[kPayloadY] * std::abs(c(0)) +
                                                                            0.01 * g(1),
-                           0.2 * k.v[kPayloadY] * c(0) - 0.1 * k.v[kPayloadX] * c(2));
+                           0.2 * k.v[kPayloadY] * c(0) - 0.1 * k.v[kPayloadX] * c(2) +
+                               payload(2) * std::abs(k.v[kPayloadX]) * c(0));
   x += extras.tracker_bias;
   x += extras.geometry * Eigen::Vector3d(-std::abs(c(2)), c(0) * (1 + 2 * roll), 0);
   return x;
@@ -160,7 +161,8 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
       Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
       s.z.row(i) << pitch, roll;
-      s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras, friction_threshold_) +
+      s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras, friction_threshold_,
+                     Eigen::Vector3d(payload_gain, payload_power, payload_bend)) +
                     k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise) + stands).transpose();
     }
   }
@@ -192,7 +194,8 @@ CellRecording FakeSimulator::RecordCell(const Cell& cell, const std::vector<Knob
     const double pitch = cell.terrain(0) + 0.01 * unit(rng), roll = cell.terrain(1) + 0.01 * unit(rng);
     Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
     out.set.z.row(i) << pitch, roll;
-    out.set.x.row(i) = (Mean(k, cell.command, pitch, roll, out.set.step(i) == 0, FakeExtras{}, friction_threshold_) +
+    out.set.x.row(i) = (Mean(k, cell.command, pitch, roll, out.set.step(i) == 0, FakeExtras{}, friction_threshold_,
+                            Eigen::Vector3d(payload_gain, payload_power, payload_bend)) +
                         k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise)).transpose();
   }
   out.placement = "the fake plane";

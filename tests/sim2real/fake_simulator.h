@@ -53,7 +53,11 @@ class FakeSimulator : public KnobSimulator {
   std::string Fingerprint() const override {
     return (friction_threshold_ > 0 ? "fake-simulator-v1-threshold-" + std::to_string(friction_threshold_)
                                     : "fake-simulator-v1") +
-           (ground_sd > 0 ? "-ground-" + std::to_string(ground_sd) : "") + (honour_executions ? "-executions" : "");
+           (ground_sd > 0 ? "-ground-" + std::to_string(ground_sd) : "") + (honour_executions ? "-executions" : "") +
+           (payload_power != 1 || payload_gain != 1 || payload_bend != 0
+                ? "-payload-" + std::to_string(payload_gain) + "-" + std::to_string(payload_power) + "-" +
+                      std::to_string(payload_bend)
+                : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -75,6 +79,12 @@ class FakeSimulator : public KnobSimulator {
   // Rough ground: every execution at a placement shares an offset of this many noise sds, drawn
   // per (recording seed, placement): where the robot stands, which z does not tell.
   double ground_sd = 0;
+  // The payload's effect is payload_gain mass^payload_power times its signature (power 1: linear in
+  // the mass, as its probes' reading assumes).
+  double payload_gain = 1, payload_power = 1;
+  // A forward offset either way bends the walk: dyaw += payload_bend mass |x| long (a sideways
+  // offset's signature, so the probes' linear reading of a payload behind the middle is sideways too).
+  double payload_bend = 0;
   // Record as many executions per placement as the recording asks for (else always 5, the
   // protocol's own number, whatever it asks for).
   bool honour_executions = false;

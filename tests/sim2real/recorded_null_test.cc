@@ -56,6 +56,25 @@ TEST(RecordedNull, RepeatsTheRealSetsDesign) {
   EXPECT_EQ(each.executions_per_placement, 1);
 }
 
+// A re-recording never repeats the sim set's or the real set's own places and noise (both seeds from
+// their metadata); a real log whose metadata seed does not read as one is recorded at the seed asked.
+TEST(RecordedNull, NeverTheSimSetsNorTheRealSetsOwnSeed) {
+  const SampleSet sim = RoughFake().Record({"paper", 7, 0}, {}, 1);
+  Recording design = kRealDesign;
+  design.seed = 8;
+  SampleSet real = RoughFake().Record(design, {}, 1);
+  const AnalysisInputs in = PrepareInputs(sim, real, 1);
+  ASSERT_EQ(in.recording.seed, 7u);
+  ASSERT_EQ(in.real_seed, std::optional<std::uint64_t>(8));
+  EXPECT_EQ(RealDesign(in, 7).seed, 9u) << "past the sim set's 7 and the real set's 8";
+  EXPECT_EQ(RealDesign(in, 8).seed, 9u);
+  EXPECT_EQ(RealDesign(in, 10).seed, 10u);
+  real.metadata["seed"] = "log-2026-12-02";
+  const AnalysisInputs log = PrepareInputs(sim, real, 1);
+  EXPECT_FALSE(log.real_seed.has_value());
+  EXPECT_EQ(RealDesign(log, 8).seed, 8u);
+}
+
 // Null pairs of one sim set (real sets of the sim's physics at other seeds, 30 placements of 3
 // executions against the sim set's 72 of 5): their mean shortfall lies within 3 SE of the
 // recorded null's mean, and each one within 3 of the null's SD of it.

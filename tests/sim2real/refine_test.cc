@@ -67,23 +67,56 @@ TEST(Refine, ThePayloadIsRecordedAtItsFittedPosition) {
   EXPECT_TRUE(traced);
 }
 
-// The sideways offset is not searched: every point of the search keeps the sideways moment the
-// probes read (mass x y), so a heavier point sits nearer the middle, not at the same y.
+// The sideways offset is searched two ways: every point of the first grid's one keeps the sideways
+// moment the probes read (mass x y), so a heavier point sits nearer the middle, not at the same y;
+// the other's points sit on the middle line. A payload planted 0.1 m sideways is searched on the first.
 TEST(Refine, ThePayloadsSearchKeepsItsSidewaysMoment) {
   const test::Stages s = test::RunStages({{test::kPayloadMass, 2.5}, {test::kPayloadY, 0.1}}, 4);
   std::vector<double> moments, masses;
+  int middle = 0;
   for (const auto& t : s.refinement.trace) {
     double x = 0, y = 0;
     if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
+    if (y == 0) {
+      ++middle;
+      continue;
+    }
     moments.push_back(t.value * y);
     masses.push_back(t.value);
   }
   ASSERT_GE(moments.size(), 9u);
+  EXPECT_EQ(middle, 9) << "the first grid on the middle line too, and no further";
   EXPECT_GT(*std::max_element(masses.begin(), masses.end()), 2 * *std::min_element(masses.begin(), masses.end()))
       << "the grid spans masses";
   // Within the label's three significant digits.
   EXPECT_LT(*std::max_element(moments.begin(), moments.end()), 1.02 * *std::min_element(moments.begin(), moments.end()));
   EXPECT_NEAR(s.refinement.payload_mass * s.refinement.payload_y, 0.25, 0.25 * 0.25);
+}
+
+// A payload behind the middle on a fake whose forward offset bends the walk either way: the probes'
+// reading puts it sideways, the middle line fits better, and the search finds the mass there
+// (kept at the reading's moment, it would climb to shrink the moment's offset).
+TEST(Refine, ASidewaysReadingThatTheMiddleLineFitsBetterIsLeft) {
+  test::FakeSimulator fake;
+  fake.payload_bend = 0.1;
+  const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 2.5}, {test::kPayloadX, -0.12}}, 4);
+  const Refinement& r = s.refinement;
+  double best_moment = -INFINITY, best_middle = -INFINITY;
+  bool crossed = false;  // the other way recorded at the best's mass and offset
+  for (const auto& t : r.trace) {
+    double x = 0, y = 0;
+    if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
+    (y == 0 ? best_middle : best_moment) = std::max(y == 0 ? best_middle : best_moment, t.score);
+    crossed |= y != 0 && t.value == r.payload_mass && std::abs(x - r.payload_x) < 1e-3;
+  }
+  EXPECT_TRUE(crossed);
+  ASSERT_TRUE(std::isfinite(best_moment)) << "the reading is sideways";
+  EXPECT_GT(best_middle, best_moment);
+  EXPECT_EQ(r.payload_y, 0.0);
+  EXPECT_NEAR(r.payload_mass, 2.5, 0.25 * 2.5);
+  EXPECT_NEAR(r.payload_x, -0.12, 0.03);
+  ASSERT_FALSE(r.refined.empty());
+  EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
 }
 
 TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
@@ -111,6 +144,32 @@ TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
   EXPECT_GE(a.x_upper, r.payload_x);
   EXPECT_LT(a.upper / a.lower, 1.6 * 1.6) << "not every mass searched";
   EXPECT_LT(a.points, a.searched);
+}
+
+// A payload whose effect grows as mass^0.25: the probes' linear reading (about 0.96 kg for 0.25)
+// lies three mass steps (x 1.6) off, so the search walks grid by grid to it and says it bracketed it.
+TEST(Refine, ThePayloadsSearchFollowsItsBestPointBeyondTheFirstGrids) {
+  test::FakeSimulator fake;
+  fake.payload_gain = 4, fake.payload_power = 0.25;
+  const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 0.25}}, 4);
+  const Refinement& r = s.refinement;
+  ASSERT_FALSE(r.refined.empty());
+  int scored = 0;
+  for (const auto& t : r.trace) scored += t.knob.find("payload.mass_kg at (x") == 0;
+  EXPECT_GT(scored, 14) << "more than two grids";
+  EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
+  // The effect hardly changes with the mass there (0.32^0.25 is 1.06 times 0.25^0.25): within a
+  // mass step (x 1.5), where two grids stop at 0.40.
+  EXPECT_LT(r.payload_mass, 1.5 * 0.25);
+  EXPECT_GT(r.payload_mass, 0.25 / 1.5);
+  // With one step beyond the first grid the search stops short and says so.
+  AnalysisOptions once = test::FastOptions();
+  once.refine.refine_iterations = 1;
+  const test::Stages t = test::RunStages(fake, {{test::kPayloadMass, 0.25}}, 4, {}, once);
+  ASSERT_FALSE(t.refinement.refined.empty());
+  EXPECT_FALSE(t.refinement.refined.back().converged);
+  EXPECT_NE(t.refinement.refined.back().why.find("edge"), std::string::npos);
+  EXPECT_GT(t.refinement.payload_mass, 1.5 * 0.25) << "two grids do not reach it";
 }
 
 TEST(Refine, APayloadCloseBehindTheFirstChoiceIsSearchedToo) {

@@ -27,8 +27,9 @@ struct Stages {
 // Runs the stages up to and including `last` (2 baseline, 3 candidates, 4 refine, 5 confidence,
 // 6 adequacy and naming).
 inline Stages RunStages(const FakeSimulator& fake, const std::vector<KnobValue>& planted, int last,
-                        const FakeExtras& extras = {}) {
+                        const FakeExtras& extras = {}, const AnalysisOptions& options = FastOptions()) {
   Stages s;
+  s.options = options;
   const FakePair pair = MakeFakePair(fake, planted, extras);
   s.in = PrepareInputs(pair.sim, pair.real, s.options.seed);
   s.base = LocateMismatch(s.in, s.options.locate);
