@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <set>
+#include <stdexcept>
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -40,6 +43,17 @@ void KeepSharedCommands(AnalysisInputs* in, const std::vector<int>& real_map) {
   }
 }
 
+// A seed as metadata holds it: digits only ("12abc" and "-5", which std::stoull reads as 12 and as
+// 2^64 - 5, are not seeds).
+std::optional<std::uint64_t> ParseSeed(const std::string& text) {
+  if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos) return std::nullopt;
+  try {
+    return std::stoull(text);
+  } catch (const std::out_of_range&) {
+    return std::nullopt;
+  }
+}
+
 Recording SimRecording(const SampleSet& sim, std::uint64_t fallback_seed, bool* from_metadata) {
   Recording r;
   r.protocol = "paper";
@@ -49,11 +63,9 @@ Recording SimRecording(const SampleSet& sim, std::uint64_t fallback_seed, bool* 
   *from_metadata = protocol != sim.metadata.end() && seed != sim.metadata.end();
   if (protocol != sim.metadata.end()) r.protocol = protocol->second;
   if (seed != sim.metadata.end()) {
-    try {
-      r.seed = std::stoull(seed->second);
-    } catch (const std::exception&) {
-      throw MakeInputError("--sim", "metadata seed", "'" + seed->second + "' is not a non-negative integer");
-    }
+    const auto parsed = ParseSeed(seed->second);
+    if (!parsed) throw MakeInputError("--sim", "metadata seed", "'" + seed->second + "' is not a non-negative integer");
+    r.seed = *parsed;
   }
   return r;
 }
@@ -62,14 +74,7 @@ Recording SimRecording(const SampleSet& sim, std::uint64_t fallback_seed, bool* 
 // metadata may hold anything under that name, so what does not read as a seed is ignored.
 std::optional<std::uint64_t> RealSeed(const SampleSet& real) {
   const auto seed = real.metadata.find("seed");
-  if (seed == real.metadata.end()) return std::nullopt;
-  try {
-    size_t used = 0;
-    const std::uint64_t s = std::stoull(seed->second, &used);
-    if (used == seed->second.size() && seed->second.find('-') == std::string::npos) return s;
-  } catch (const std::exception&) {
-  }
-  return std::nullopt;
+  return seed == real.metadata.end() ? std::nullopt : ParseSeed(seed->second);
 }
 
 }  // namespace
@@ -157,6 +162,14 @@ std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_pat
          ": locate compares the real residuals with the sim set's cross-fitted ones, which hold whole placements "
          "out, and then finds mismatch between two recordings of the same robot; record the sim set with more "
          "placements (e.g. dgmm simulate --protocol paper --placements 166)";
+}
+
+PlacementCount RealPlacements(const AnalysisInputs& in) {
+  if (!in.real_set.has_sequence()) return {in.real_set.size(), 1};
+  const std::set<int> placements(in.real_set.episode.data(), in.real_set.episode.data() + in.real_set.size());
+  int executions = 0;
+  for (int i = 0; i < in.real_set.size(); ++i) executions = std::max(executions, in.real_set.step(i) + 1);
+  return {static_cast<int>(placements.size()), executions};
 }
 
 std::vector<int> RealSteps(const AnalysisInputs& in) {

@@ -38,6 +38,13 @@ AnalysisInputs PrepareInputs(const SampleSet& sim, const SampleSet& real, std::u
 // sequence data.
 std::vector<int> RealSteps(const AnalysisInputs& in);
 
+// The real set's placements and executions per placement (without sequence data each sample is
+// its own placement, as the analysis treats it).
+struct PlacementCount {
+  int placements = 0, executions_per_placement = 1;
+};
+PlacementCount RealPlacements(const AnalysisInputs& in);
+
 // How closely the sim set's placements cover the settings (terrain z) of each command: per
 // placement its mean z; medians over the real set's commands of
 //   sim_to_sim  = |z_p - nearest other sim placement of its command|  (infinite when it has none),

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 
-#include "sim2real/recorded_null.h"
 #include "sim2real/selection.h"
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
@@ -68,9 +67,9 @@ MoreData AdviseMoreData(const AnalysisInputs& in, const CandidateSet& set, const
   if (v.uneven_ground && !options.on_uneven_ground) return m;
   if (!FromWeak(set, r, naming, v, r.selection_options.bootstrap_selection, &m) && !FromNearMiss(set, r, options, &m)) return MoreData{};
   if (std::find(searched.begin(), searched.end(), m.knob) != searched.end()) return MoreData{};
-  const Recording design = RealDesign(in, in.recording.seed + 1);
+  const PlacementCount count = RealPlacements(in);
   m.sequence = in.real_set.has_sequence();
-  m.placements = design.placements, m.executions_per_placement = design.executions_per_placement;
+  m.placements = count.placements, m.executions_per_placement = count.executions_per_placement;
   const double factor = m.z_effective > 0 ? std::pow((m.z_required + options.margin) / m.z_effective, 2) : INFINITY;
   m.placements_needed = factor > options.max_factor ? -1 : static_cast<int>(std::ceil(m.placements * factor));
   m.max_factor = options.max_factor;

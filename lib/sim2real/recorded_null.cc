@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <random>
-#include <set>
 #include <vector>
 
 #include "sim2real/selection.h"
@@ -48,16 +47,9 @@ Recording RealDesign(const AnalysisInputs& in, std::uint64_t seed) {
   r.protocol = in.recording.protocol;
   r.seed = seed;  // never the sim set's own recording, nor the real set's
   while (r.seed == in.recording.seed || r.seed == in.real_seed) ++r.seed;
-  if (!in.real_set.has_sequence()) {  // each sample its own placement, as the analysis treats it
-    r.placements = in.real_set.size();
-    r.executions_per_placement = 1;
-    return r;
-  }
-  const std::set<int> placements(in.real_set.episode.data(), in.real_set.episode.data() + in.real_set.size());
-  int executions = 0;
-  for (int i = 0; i < in.real_set.size(); ++i) executions = std::max(executions, in.real_set.step(i) + 1);
-  r.placements = static_cast<int>(placements.size());
-  r.executions_per_placement = executions;
+  const PlacementCount count = RealPlacements(in);
+  r.placements = count.placements;
+  r.executions_per_placement = count.executions_per_placement;
   return r;
 }
 

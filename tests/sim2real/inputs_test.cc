@@ -33,6 +33,27 @@ TEST(Inputs, TheSimSetsRecordingAndTheRealCommandsItLacks) {
   EXPECT_EQ(PrepareInputs(pair.sim, pair.real, 99).recording.seed, 99u);
 }
 
+// A sim set's metadata seed is digits or refused, naming it ("-5" would wrap round to 2^64 - 5, "7x"
+// read as 7); a real set's is read the same way and ignored when it is not one.
+TEST(Inputs, AMetadataSeedIsDigitsOnly) {
+  const test::FakeSimulator fake;
+  test::FakePair pair = test::MakeFakePair(fake, {});
+  for (const char* bad : {"-5", "7x", "", "99999999999999999999999"}) {
+    pair.sim.metadata["seed"] = bad;
+    try {
+      PrepareInputs(pair.sim, pair.real, 99);
+      ADD_FAILURE() << "seed '" << bad << "' accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("metadata seed"), std::string::npos) << e.what();
+    }
+    pair.real.metadata["seed"] = bad;
+  }
+  pair.sim.metadata["seed"] = "18446744073709551615";
+  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, 99);
+  EXPECT_EQ(in.recording.seed, 18446744073709551615u);
+  EXPECT_FALSE(in.real_seed.has_value()) << "the real set's last seed was too large";
+}
+
 TEST(Inputs, SetsThatShareNoCommandAreRefused) {
   const test::FakeSimulator fake;
   test::FakePair pair = test::MakeFakePair(fake, {});
