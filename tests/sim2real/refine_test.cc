@@ -6,6 +6,10 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <map>
+#include <set>
+#include <string>
+#include <utility>
 
 #include "tests/sim2real/stage_fixture.h"
 
@@ -73,19 +77,20 @@ TEST(Refine, ThePayloadIsRecordedAtItsFittedPosition) {
 TEST(Refine, ThePayloadsSearchKeepsItsSidewaysMoment) {
   const test::Stages s = test::RunStages({{test::kPayloadMass, 2.5}, {test::kPayloadY, 0.1}}, 4);
   std::vector<double> moments, masses;
-  int middle = 0;
+  std::set<std::pair<double, std::string>> middle;  // (mass, label): the walks share their reading's row
   for (const auto& t : s.refinement.trace) {
     double x = 0, y = 0;
     if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
     if (y == 0) {
-      ++middle;
+      middle.insert({t.value, t.knob});
       continue;
     }
     moments.push_back(t.value * y);
     masses.push_back(t.value);
   }
   ASSERT_GE(moments.size(), 9u);
-  EXPECT_EQ(middle, 9) << "the first grid on the middle line too, and no further";
+  EXPECT_EQ(middle.size(), 15u) << "the first grid on the middle line too (both columns' ways: its other masses' "
+                                  "rows differ), and no further";
   EXPECT_GT(*std::max_element(masses.begin(), masses.end()), 2 * *std::min_element(masses.begin(), masses.end()))
       << "the grid spans masses";
   // Within the label's three significant digits.
@@ -102,13 +107,21 @@ TEST(Refine, ASidewaysReadingThatTheMiddleLineFitsBetterIsLeft) {
   const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 2.5}, {test::kPayloadX, -0.12}}, 4);
   const Refinement& r = s.refinement;
   double best_moment = -INFINITY, best_middle = -INFINITY;
-  bool crossed = false;  // the other way recorded at the best's mass and offset
+  std::vector<Eigen::Vector3d> moment_way;  // (mass, x, score) of the points keeping the moment
+  Eigen::Vector3d middle_grid(NAN, NAN, -INFINITY);  // the middle line's best grid point
+  std::map<double, int> rows;  // a grid's mass has a row of points; a quadratic's maximum's, one
+  for (const auto& t : r.trace) ++rows[t.value];
   for (const auto& t : r.trace) {
     double x = 0, y = 0;
     if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
     (y == 0 ? best_middle : best_moment) = std::max(y == 0 ? best_middle : best_moment, t.score);
-    crossed |= y != 0 && t.value == r.payload_mass && std::abs(x - r.payload_x) < 1e-3;
+    if (y != 0) moment_way.emplace_back(t.value, x, t.score);
+    if (y == 0 && rows[t.value] >= 3 && t.score > middle_grid(2)) middle_grid << t.value, x, t.score;
   }
+  // The other way recorded at the middle line's best grid point's mass and offset.
+  const bool crossed = std::any_of(moment_way.begin(), moment_way.end(), [&](const Eigen::Vector3d& p) {
+    return p(0) == middle_grid(0) && std::abs(p(1) - middle_grid(1)) < 1e-3;
+  });
   EXPECT_TRUE(crossed);
   ASSERT_TRUE(std::isfinite(best_moment)) << "the reading is sideways";
   EXPECT_GT(best_middle, best_moment);
@@ -170,6 +183,25 @@ TEST(Refine, ThePayloadsSearchFollowsItsBestPointBeyondTheFirstGrids) {
   EXPECT_FALSE(t.refinement.refined.back().converged);
   EXPECT_NE(t.refinement.refined.back().why.find("edge"), std::string::npos);
   EXPECT_GT(t.refinement.payload_mass, 1.5 * 0.25) << "two grids do not reach it";
+}
+
+// A payload of 2.5 kg 15 cm behind the middle whose mass's own effect grows as mass^0.25: the
+// probes' linear reading is light, and the likelihood is a ridge along which the mass hardly
+// matters. Where the offset acts through the moment M x (as gravity's torque does), the walk whose
+// columns keep their moments follows the ridge (columns of fixed offsets alone stopped at 1.78 kg
+// on the offset's 20 cm bound); where it acts by itself, the walk whose columns keep their offsets
+// does (columns of moments alone named 1.78 kg, 15.5 cm back). The better walk is kept either way.
+TEST(Refine, ThePayloadsSearchKeepsTheWalkAlongItsRidge) {
+  for (const bool offset_alone : {false, true}) {
+    test::FakeSimulator fake;
+    fake.payload_gain = 4, fake.payload_power = 0.25, fake.payload_offset_alone = offset_alone;
+    const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 2.5}, {test::kPayloadX, -0.15}}, 4);
+    const Refinement& r = s.refinement;
+    ASSERT_FALSE(r.refined.empty());
+    EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
+    EXPECT_NEAR(r.payload_mass, 2.5, 0.25 * 2.5) << "offset alone " << offset_alone;
+    EXPECT_NEAR(r.payload_x, -0.15, 0.03) << "offset alone " << offset_alone;
+  }
 }
 
 TEST(Refine, APayloadCloseBehindTheFirstChoiceIsSearchedToo) {
