@@ -95,6 +95,15 @@ bool WantRunoff(const Analysis& a, const RunoffOptions& options) {
   return a.verdict.status == "partly_explained" || a.verdict.status == "unexplained";
 }
 
+// A search by models of their own (the runoff's or the leg search's) with the analysis's model,
+// its ground and the seed of its recordings at other places.
+LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
+  o.model = options.locate.model;
+  o.misfit_elsewhere = options.locate.uneven_ground;
+  o.elsewhere_seed = options.seed + 17;
+  return o;
+}
+
 // Stages 8a and 8b: the runoff on uneven ground, then the leg search when still nothing is named.
 template <typename Stage>
 void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
@@ -102,9 +111,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     const auto t = Clock::now();
     stage("runoff (contenders scored by models of their own)");
     RunoffOptions runoff = options.runoff;
-    runoff.search.model = options.locate.model;
-    runoff.search.misfit_elsewhere = options.locate.uneven_ground;
-    runoff.search.elsewhere_seed = options.seed + 17;
+    runoff.search = OwnModels(runoff.search, options);
     a->runoff = RunRunoff(simulator, a->inputs, a->candidates, a->refinement, options.candidates, runoff);
     AddRunoff(simulator, &a->runoff, &a->verdict);
     a->seconds.runoff = Since(t);
@@ -112,10 +119,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   if (!a->runoff.search.named && WantLegSearch(*a, options.legs)) {
     const auto t = Clock::now();
     stage("leg search (every leg's gain)");
-    LegSearchOptions legs = options.legs;
-    legs.model = options.locate.model;
-    legs.misfit_elsewhere = options.locate.uneven_ground;
-    legs.elsewhere_seed = options.seed + 17;
+    const LegSearchOptions legs = OwnModels(options.legs, options);
     a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs);
     if (!a->naming.named.empty()) {
       std::vector<std::string> named;

@@ -153,28 +153,60 @@ std::vector<PayloadPoint> GridAround(const SearchFrame& f, const std::vector<Pay
   return fresh;
 }
 
-// Records the points in one batch and scores each.
-void RecordAndScore(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
-                    const CandidateOptions& recording, const RefineOptions& options, int pay, CandidateSet* set,
-                    Refinement* r, std::vector<PayloadPoint>* pts) {
-  std::vector<std::vector<KnobValue>> requests;
+// One payload search's context: what records and scores its points.
+struct Search {
+  const KnobSimulator& simulator;
+  const AnalysisInputs& in;
+  const Baseline& base;
+  const CandidateOptions& recording;
+  const RefineOptions& options;
+  int pay;
+  CandidateSet* set;
+  Refinement* r;
+  std::vector<PayloadPoint> recorded = {};  // every point recorded so far, by either walk
+  void RecordAndScore(std::vector<PayloadPoint>* pts);
+};
+
+// The point of `grid` that places the payload exactly as p does (grid points on a bound clamp to
+// one place), or null.
+const PayloadPoint* SamePlace(const std::vector<PayloadPoint>& grid, const PayloadPoint& p) {
+  const auto at = std::find_if(grid.begin(), grid.end(), [&](const PayloadPoint& q) {
+    return q.mass == p.mass && q.x == p.x && q.y == p.y;
+  });
+  return at == grid.end() ? nullptr : &*at;
+}
+
+// Records the points in one batch and scores each; a point placed as one recorded before (by
+// either walk, or earlier in the batch) takes its recording and score.
+void Search::RecordAndScore(std::vector<PayloadPoint>* pts) {
+  std::vector<PayloadPoint> fresh;
   for (const auto& p : *pts) {
+    if (!SamePlace(recorded, p) && !SamePlace(fresh, p)) fresh.push_back(p);
+  }
+  std::vector<std::vector<KnobValue>> requests;
+  for (const auto& p : fresh) {
     requests.push_back({{set->payload_knob[0], p.mass}, {set->payload_knob[1], p.x}, {set->payload_knob[2], p.y}});
   }
   auto shifts = RecordShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
-  for (size_t i = 0; i < pts->size(); ++i) {
+  for (size_t i = 0; i < fresh.size(); ++i) {
+    PayloadPoint& p = fresh[i];
     set->shifts.push_back(std::move(shifts[i]));
-    (*pts)[i].shift = static_cast<int>(set->shifts.size()) - 1;
-    (*pts)[i].score = FaceValueScore(in, base, set, *r, pay, WithMassShift(set->externals[pay].shifts, (*pts)[i].shift),
-                                     {}, options, &(*pts)[i].rows);
-    r->trace.push_back({PointLabel(set->candidates[pay].knob, (*pts)[i].x, (*pts)[i].y), (*pts)[i].mass, NAN,
-                        (*pts)[i].score / in.real.size()});
+    p.shift = static_cast<int>(set->shifts.size()) - 1;
+    p.score = FaceValueScore(in, base, set, *r, pay, WithMassShift(set->externals[pay].shifts, p.shift), {}, options,
+                             &p.rows);
+    r->trace.push_back({PointLabel(set->candidates[pay].knob, p.x, p.y), p.mass, NAN, p.score / in.real.size()});
+  }
+  recorded.insert(recorded.end(), fresh.begin(), fresh.end());
+  for (auto& p : *pts) {
+    const PayloadPoint* same = SamePlace(recorded, p);
+    p.shift = same->shift, p.score = same->score, p.rows = same->rows;
   }
 }
 
 // The search's grids so far: every point recorded, the best one's grid coordinates and way, and
 // whether the last grid's centre scored best.
 struct Walk {
+  explicit Walk(const SearchFrame& f) : frame(f) {}
   SearchFrame frame;  // with its columns' k
   std::vector<PayloadPoint> grid;
   int cu = 0, cv = 0;
@@ -191,27 +223,24 @@ double BestScore(const std::vector<PayloadPoint>& grid) {
 // (refine_iterations at most) around the last round's best, on its way, while that lies on its
 // grid's edge. Once centred, the other way is recorded at the same mass and offset (the first grid
 // compared the two ways at the reading only); when it fits better, the walk goes on along it
-// (one further round allowed).
-Walk WalkGrids(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
-               const CandidateOptions& recording, const RefineOptions& options, int pay, const SearchFrame& f,
-               CandidateSet* set, Refinement* r) {
-  Walk w{f};
+// (one further round allowed). Grid points already in w's grid are not asked for again.
+Walk WalkGrids(Search* s, Walk w) {
   bool crossed = false;
-  for (int round = 0; round <= options.refine_iterations + crossed && !w.centred; ++round) {
+  for (int round = 0; round <= s->options.refine_iterations + crossed && !w.centred; ++round) {
     std::vector<PayloadPoint> fresh = GridAround(w.frame, w.grid, w.cu, w.cv, w.moment);
-    if (round == 0 && f.Sideways()) {
-      const std::vector<PayloadPoint> middle = GridAround(f, w.grid, w.cu, w.cv, false);
+    if (round == 0 && w.frame.Sideways()) {
+      const std::vector<PayloadPoint> middle = GridAround(w.frame, w.grid, w.cu, w.cv, false);
       fresh.insert(fresh.end(), middle.begin(), middle.end());
     }
-    RecordAndScore(simulator, in, base, recording, options, pay, set, r, &fresh);
+    s->RecordAndScore(&fresh);
     w.grid.insert(w.grid.end(), fresh.begin(), fresh.end());
     auto top = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
     w.centred = top->u == w.cu && top->v == w.cv && top->moment == w.moment;
-    if (w.centred && f.Sideways() && !crossed) {
+    if (w.centred && w.frame.Sideways() && !crossed) {
       crossed = true;
       std::vector<PayloadPoint> other;
       if (!Known(w.grid, w.cu, w.cv, !w.moment)) other.push_back(w.frame.At(w.cu, w.cv, !w.moment));
-      RecordAndScore(simulator, in, base, recording, options, pay, set, r, &other);
+      s->RecordAndScore(&other);
       w.grid.insert(w.grid.end(), other.begin(), other.end());
       top = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
       w.centred = top->moment == w.moment;
@@ -224,9 +253,7 @@ Walk WalkGrids(const KnobSimulator& simulator, const AnalysisInputs& in, const B
 // The maximum of a quadratic through the points around the best (on its way; a full 3 x 3 once
 // centred), recorded and added to the grid (Walk::peak_inside: recorded strictly inside the box
 // of that way's points).
-void RecordQuadraticMaximum(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
-                            const CandidateOptions& recording, const RefineOptions& options, int pay,
-                            CandidateSet* set, Refinement* r, Walk* w) {
+void RecordQuadraticMaximum(Search* s, Walk* w) {
   std::vector<Eigen::Vector3d> scored;
   for (const auto& p : w->grid) {
     if (p.moment == w->moment && std::abs(p.u - w->cu) <= 1 && std::abs(p.v - w->cv) <= 1) {
@@ -236,9 +263,16 @@ void RecordQuadraticMaximum(const KnobSimulator& simulator, const AnalysisInputs
   double u = 0, v = 0;
   if (scored.size() < 6 || !QuadraticMaximum(scored, 2, 2, &u, &v)) return;
   std::vector<PayloadPoint> extra = {w->frame.At(w->cu + u, w->cv + v, w->moment)};
-  RecordAndScore(simulator, in, base, recording, options, pay, set, r, &extra);
+  s->RecordAndScore(&extra);
   w->grid.push_back(extra[0]);
   w->peak_inside = Inside(w->grid, extra[0]);
+}
+
+// One walk to its best point and its quadratic's maximum.
+Walk SearchWith(Search* s, const SearchFrame& f) {
+  Walk w = WalkGrids(s, Walk(f));
+  RecordQuadraticMaximum(s, &w);
+  return w;
 }
 
 // The masses and forward offsets of the searched points that fit as well as the best (refine_search.h).
@@ -296,14 +330,13 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   const Eigen::VectorXd t = at != sel.end() ? r->selection.fit.theta[at - sel.begin()]
                                             : FitEffects(r->problem, {pay}, {}, options.selection.fit).theta[0];
   if (t(0) <= 0.05) return;  // a payload heavier than nominal (a lighter one has no position to fit)
-  const SearchFrame f = LinearReading(simulator.knobs(), *set, *found, t);
-  // Both columns' walks (their first grids share the reading's row, read back from the cache).
-  SearchFrame offsets = f;
-  offsets.keep_moment = false;
-  Walk w = WalkGrids(simulator, in, base, recording, options, pay, f, set, r);
-  RecordQuadraticMaximum(simulator, in, base, recording, options, pay, set, r, &w);
-  Walk o = WalkGrids(simulator, in, base, recording, options, pay, offsets, set, r);
-  RecordQuadraticMaximum(simulator, in, base, recording, options, pay, set, r, &o);
+  // Both columns' walks (a point either records is not recorded again); the payload is the best
+  // point of the walk that ends better.
+  Search search{simulator, in, base, recording, options, pay, set, r};
+  SearchFrame frame = LinearReading(simulator.knobs(), *set, *found, t);
+  Walk w = SearchWith(&search, frame);
+  frame.keep_moment = false;
+  Walk o = SearchWith(&search, frame);
   if (BestScore(o.grid) > BestScore(w.grid)) w = std::move(o);
   const auto best = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
   // Converged: the search brackets the maximum (the last grid's centre scored best, or the

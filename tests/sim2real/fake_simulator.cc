@@ -55,7 +55,7 @@ Eigen::Vector3d Gravity(double pitch, double roll) {
 
 // The mean pose change of one execution.
 Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, double roll, bool first,
-                     const FakeExtras& extras, double friction_threshold, const Eigen::Vector4d& payload) {
+                     const FakeExtras& extras, double friction_threshold, const FakePayload& payload) {
   const Eigen::Vector3d g = Gravity(pitch, roll);
   Eigen::Vector3d x(0.2 * c(0) + 0.05 * g(0) * std::abs(c(0)), 0.15 * c(1) + 0.04 * g(1) * std::abs(c(1)),
                     0.3 * c(2) + 0.02 * g(1));
@@ -72,14 +72,14 @@ Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, do
                              side * (0.05 * c(0) + 0.01) + 0.03 * front * c(1));
   }
   if (first) x *= 1 - k.v[kLatency] / 0.1;  // motion lost at the first execution after a command change
-  // The mass's own effect (payload_power bends it); the offsets' go with the moments M x and M y,
-  // as gravity's torque does, or the forward offset's with the offset alone (payload(3)).
-  const double m = payload(0) * std::pow(k.v[kPayloadMass], payload(1)), torque = payload(0) * k.v[kPayloadMass];
-  const double forward = payload(3) != 0 ? 2.5 * payload(0) : torque;  // 2.5: the fake's usual mass
+  // The mass's own effect (payload.power bends it); the offsets' go with the moments M x and M y,
+  // as gravity's torque does, or the forward offset's with the offset alone.
+  const double m = payload.gain * std::pow(k.v[kPayloadMass], payload.power), torque = payload.gain * k.v[kPayloadMass];
+  const double forward = payload.offset_alone ? 2.5 * payload.gain : torque;  // 2.5: the fake's usual mass
   x += m * Eigen::Vector3d(-0.01 * std::abs(c(0)), 0.01 * g(1), 0);
   x += torque * Eigen::Vector3d(0.02 * k.v[kPayloadY] * g(0), 0.05 * k.v[kPayloadY] * std::abs(c(0)),
                                 0.2 * k.v[kPayloadY] * c(0));
-  x.z() += forward * (-0.1 * k.v[kPayloadX] * c(2) + payload(2) * std::abs(k.v[kPayloadX]) * c(0));
+  x.z() += forward * (-0.1 * k.v[kPayloadX] * c(2) + payload.bend * std::abs(k.v[kPayloadX]) * c(0));
   x += extras.tracker_bias;
   x += extras.geometry * Eigen::Vector3d(-std::abs(c(2)), c(0) * (1 + 2 * roll), 0);
   return x;
@@ -165,7 +165,7 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
       s.z.row(i) << pitch, roll;
       s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras, friction_threshold_,
-                     Eigen::Vector4d(payload_gain, payload_power, payload_bend, payload_offset_alone)) +
+                     payload) +
                     k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise) + stands).transpose();
     }
   }
@@ -198,7 +198,7 @@ CellRecording FakeSimulator::RecordCell(const Cell& cell, const std::vector<Knob
     Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
     out.set.z.row(i) << pitch, roll;
     out.set.x.row(i) = (Mean(k, cell.command, pitch, roll, out.set.step(i) == 0, FakeExtras{}, friction_threshold_,
-                            Eigen::Vector4d(payload_gain, payload_power, payload_bend, payload_offset_alone)) +
+                            payload) +
                         k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise)).transpose();
   }
   out.placement = "the fake plane";

@@ -37,6 +37,19 @@ enum FakeKnob {
 };
 
 // What a recording adds beyond the knobs (the "real" robot's extras).
+// The fake payload's effect is gain times its signature: its mass's own part (speed lost, weight)
+// taken at mass^power (power 1: linear in the mass, as its probes' reading assumes), its offsets'
+// part at the moments mass x and mass y.
+struct FakePayload {
+  double gain = 1, power = 1;
+  // A forward offset either way bends the walk: dyaw += bend mass |x| long (a sideways offset's
+  // signature, so the probes' linear reading of a payload behind the middle is sideways too).
+  double bend = 0;
+  // The forward offset acts by itself, as if the mass were always 2.5 kg (on the mammal-shaped
+  // robot's trot the data fix the offset, not the moment M x).
+  bool offset_alone = false;
+};
+
 struct FakeExtras {
   Eigen::Vector3d tracker_bias = Eigen::Vector3d::Zero();  // added to (dx, dy, dyaw); yaw entry unused
   // Physics no knob describes: dy += geometry * long * (1 + 2 roll), dx -= geometry * |turn|.
@@ -54,11 +67,11 @@ class FakeSimulator : public KnobSimulator {
     return (friction_threshold_ > 0 ? "fake-simulator-v1-threshold-" + std::to_string(friction_threshold_)
                                     : "fake-simulator-v1") +
            (ground_sd > 0 ? "-ground-" + std::to_string(ground_sd) : "") + (honour_executions ? "-executions" : "") +
-           (payload_power != 1 || payload_gain != 1 || payload_bend != 0
-                ? "-payload-" + std::to_string(payload_gain) + "-" + std::to_string(payload_power) + "-" +
-                      std::to_string(payload_bend)
+           (payload.power != 1 || payload.gain != 1 || payload.bend != 0
+                ? "-payload-" + std::to_string(payload.gain) + "-" + std::to_string(payload.power) + "-" +
+                      std::to_string(payload.bend)
                 : "") +
-           (payload_offset_alone ? "-offset-alone" : "");
+           (payload.offset_alone ? "-offset-alone" : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -80,16 +93,8 @@ class FakeSimulator : public KnobSimulator {
   // Rough ground: every execution at a placement shares an offset of this many noise sds, drawn
   // per (recording seed, placement): where the robot stands, which z does not tell.
   double ground_sd = 0;
-  // The payload's effect is payload_gain times its signature: its mass's own part (speed lost,
-  // weight) taken at mass^payload_power (power 1: linear in the mass, as its probes' reading
-  // assumes), its offsets' part at the moments mass x and mass y.
-  double payload_gain = 1, payload_power = 1;
-  // A forward offset either way bends the walk: dyaw += payload_bend mass |x| long (a sideways
-  // offset's signature, so the probes' linear reading of a payload behind the middle is sideways too).
-  double payload_bend = 0;
-  // The forward offset acts by itself, as if the mass were always 2.5 kg (on the mammal-shaped
-  // robot's trot the data fix the offset, not the moment M x).
-  bool payload_offset_alone = false;
+  // How the payload acts (FakePayload); the default is linear in its mass and moments.
+  FakePayload payload;
   // Record as many executions per placement as the recording asks for (else always 5, the
   // protocol's own number, whatever it asks for).
   bool honour_executions = false;

@@ -103,7 +103,7 @@ TEST(Refine, ThePayloadsSearchKeepsItsSidewaysMoment) {
 // (kept at the reading's moment, it would climb to shrink the moment's offset).
 TEST(Refine, ASidewaysReadingThatTheMiddleLineFitsBetterIsLeft) {
   test::FakeSimulator fake;
-  fake.payload_bend = 0.1;
+  fake.payload.bend = 0.1;
   const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 2.5}, {test::kPayloadX, -0.12}}, 4);
   const Refinement& r = s.refinement;
   double best_moment = -INFINITY, best_middle = -INFINITY;
@@ -163,7 +163,7 @@ TEST(Refine, ThePayloadsMassAndForwardOffsetComeFromALikelihoodSearch) {
 // lies three mass steps (x 1.6) off, so the search walks grid by grid to it and says it bracketed it.
 TEST(Refine, ThePayloadsSearchFollowsItsBestPointBeyondTheFirstGrids) {
   test::FakeSimulator fake;
-  fake.payload_gain = 4, fake.payload_power = 0.25;
+  fake.payload.gain = 4, fake.payload.power = 0.25;
   const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 0.25}}, 4);
   const Refinement& r = s.refinement;
   ASSERT_FALSE(r.refined.empty());
@@ -194,13 +194,18 @@ TEST(Refine, ThePayloadsSearchFollowsItsBestPointBeyondTheFirstGrids) {
 TEST(Refine, ThePayloadsSearchKeepsTheWalkAlongItsRidge) {
   for (const bool offset_alone : {false, true}) {
     test::FakeSimulator fake;
-    fake.payload_gain = 4, fake.payload_power = 0.25, fake.payload_offset_alone = offset_alone;
+    fake.payload.gain = 4, fake.payload.power = 0.25, fake.payload.offset_alone = offset_alone;
     const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 2.5}, {test::kPayloadX, -0.15}}, 4);
     const Refinement& r = s.refinement;
     ASSERT_FALSE(r.refined.empty());
     EXPECT_TRUE(r.refined.back().converged) << r.refined.back().why;
     EXPECT_NEAR(r.payload_mass, 2.5, 0.25 * 2.5) << "offset alone " << offset_alone;
     EXPECT_NEAR(r.payload_x, -0.15, 0.03) << "offset alone " << offset_alone;
+    // The two walks share the reading's row: no point is recorded twice.
+    std::set<std::pair<std::string, double>> traced;
+    for (const RefineStep& step : r.trace) {
+      if (!std::isnan(step.score)) EXPECT_TRUE(traced.insert({step.knob, step.value}).second) << step.knob;
+    }
   }
 }
 
