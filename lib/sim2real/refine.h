@@ -24,6 +24,10 @@ struct RefineOptions {
   SelectionOptions selection;     // the backward pass is always on
   int refine_iterations = 3;      // a search's steps beyond its first grid (0: no refinement)
   int refine_knobs = 2;           // knobs refined at most (most important first)
+  // The payload search's grids beyond its first, at most, while its best lies on a grid's edge (a
+  // walk stops once centred): up to 1.6^6 = 17 times the probes' linear reading, which read 0.195
+  // kg for a 2.49 kg payload on the mammal-shaped quadruped (docs/robots-sim2real-history.md).
+  int payload_rounds = 6;
   double converged_within = 0.1;  // |coefficient - 1| of a converged tracker-noise refinement
   // The payload is searched (refine_payload.cc) when selected, or when it is a contender: at the
   // first selection step significant with at least this share of the best candidate's gain (its

@@ -29,7 +29,7 @@
 // on along the better of the two, and once centred it records the other way at its best's mass
 // and offset, going on along that way when it fits better.
 // While the best point lies on the grid's edge, a further grid is recorded around it (the points
-// already recorded reused; RefineOptions::refine_iterations such steps at most). A quadratic in
+// already recorded reused; RefineOptions::payload_rounds such steps at most). A quadratic in
 // (log m, column) through the scores around the best gives the maximum, recorded once more
 // (within twice the grid); the best-scoring recording becomes the payload's signature.
 #include <algorithm>
@@ -220,13 +220,13 @@ double BestScore(const std::vector<PayloadPoint>& grid) {
 }
 
 // Round 1 around the reading, on both sideways ways when they differ; each further round
-// (refine_iterations at most) around the last round's best, on its way, while that lies on its
+// (payload_rounds at most) around the last round's best, on its way, while that lies on its
 // grid's edge. Once centred, the other way is recorded at the same mass and offset (the first grid
 // compared the two ways at the reading only); when it fits better, the walk goes on along it
 // (one further round allowed). Grid points already in w's grid are not asked for again.
 Walk WalkGrids(Search* s, Walk w) {
   bool crossed = false;
-  for (int round = 0; round <= s->options.refine_iterations + crossed && !w.centred; ++round) {
+  for (int round = 0; round <= s->options.payload_rounds + crossed && !w.centred; ++round) {
     std::vector<PayloadPoint> fresh = GridAround(w.frame, w.grid, w.cu, w.cv, w.moment);
     if (round == 0 && w.frame.Sideways()) {
       const std::vector<PayloadPoint> middle = GridAround(w.frame, w.grid, w.cu, w.cv, false);

@@ -177,12 +177,31 @@ TEST(Refine, ThePayloadsSearchFollowsItsBestPointBeyondTheFirstGrids) {
   EXPECT_GT(r.payload_mass, 0.25 / 1.5);
   // With one step beyond the first grid the search stops short and says so.
   AnalysisOptions once = test::FastOptions();
-  once.refine.refine_iterations = 1;
+  once.refine.payload_rounds = 1;
   const test::Stages t = test::RunStages(fake, {{test::kPayloadMass, 0.25}}, 4, {}, once);
   ASSERT_FALSE(t.refinement.refined.empty());
   EXPECT_FALSE(t.refinement.refined.back().converged);
   EXPECT_NE(t.refinement.refined.back().why.find("edge"), std::string::npos);
   EXPECT_GT(t.refinement.payload_mass, 1.5 * 0.25) << "two grids do not reach it";
+}
+
+// The same fake with a payload of 0.03 kg: the probes' reading (0.40 kg) lies five and a half mass
+// steps off. The search walks there and brackets it (the effect is flat: 0.048^0.25 is 1.12 times
+// 0.03^0.25, so within a factor 2); with three grids beyond the first it stopped on the edge at
+// 0.097 kg, and says so.
+TEST(Refine, ThePayloadsSearchWalksAsFarAsItsReadingIsOff) {
+  test::FakeSimulator fake;
+  fake.payload.gain = 4, fake.payload.power = 0.25;
+  const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 0.03}}, 4);
+  ASSERT_FALSE(s.refinement.refined.empty());
+  EXPECT_TRUE(s.refinement.refined.back().converged) << s.refinement.refined.back().why;
+  EXPECT_LT(s.refinement.payload_mass, 2 * 0.03);
+  AnalysisOptions three = test::FastOptions();
+  three.refine.payload_rounds = 3;
+  const test::Stages t = test::RunStages(fake, {{test::kPayloadMass, 0.03}}, 4, {}, three);
+  ASSERT_FALSE(t.refinement.refined.empty());
+  EXPECT_FALSE(t.refinement.refined.back().converged);
+  EXPECT_GT(t.refinement.payload_mass, 3 * 0.03);
 }
 
 // A payload of 2.5 kg 15 cm behind the middle whose mass's own effect grows as mass^0.25: the
