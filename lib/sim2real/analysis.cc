@@ -36,17 +36,17 @@ std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement
 
 // A challenge of named knobs (LegSearchOptions::challenge_named): on a plane (on uneven ground the
 // runoff scores contenders by their own models), knobs named, none of them a leg's, and the
-// corrected model still below the real-trained ceiling.
+// corrected model still below the real-trained ceiling or closing little of the gap.
 bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
   if (!options.challenge_named || a.baseline.permute_placements) return false;
-  if (a.verdict.status == "explained" || !a.adequacy.below_ceiling) return false;
+  const bool short_of_it = a.adequacy.below_ceiling || a.adequacy.gap_closed < options.challenge_gap_closed;
+  if (a.verdict.status == "explained" || !short_of_it) return false;
   return std::none_of(a.naming.named.begin(), a.naming.named.end(),
                       [&](int c) { return !a.candidates.candidates[c].leg.empty(); });
 }
 
-// The leg search runs when the stages before named nothing for a located mismatch whose residual
-// has heavy tails (or any residual structure, when the options do not ask for tails), or, as a
-// challenge, when they named knobs but no leg (WantChallenge).
+}  // namespace
+
 bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
   if (!options.enabled) return false;
   if (!a.naming.named.empty()) return WantChallenge(a, options);
@@ -54,6 +54,8 @@ bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
   const auto& in = a.adequacy.residual.structured_in;
   return !options.only_with_tails || std::find(in.begin(), in.end(), "tails") != in.end();
 }
+
+namespace {
 
 // Stages 3 to 8 (candidates to verdict) on the inputs and baseline in `a`.
 // A run again on only some knobs keeps the other candidates of `first_look` (their signatures as

@@ -113,6 +113,12 @@ struct Analysis {
 // else the leg search), or nullptr when the knob path's correction stands.
 const LegSearch* NamedByOwnModels(const Analysis& a);
 
+// Does the leg search run (stage 8b)? When the stages before named nothing for a located mismatch
+// (with LegSearchOptions::only_with_tails, one whose residual has heavy tails), or as a challenge
+// (challenge_named): on a plane, knobs named but no leg's, the verdict not `explained`, and the
+// corrected model below the real-trained ceiling or closing under challenge_gap_closed of the gap.
+bool WantLegSearch(const Analysis& a, const LegSearchOptions& options);
+
 // Why stages 3-8 run again with signatures of every execution of a placement (empty: they do
 // not). Only when the signatures were recorded with fewer executions per placement than the real
 // set has, and then (1) an effect fits on average but its size varies with the execution index: a

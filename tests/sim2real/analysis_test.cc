@@ -116,6 +116,32 @@ TEST(Analysis, TheLegSearchChallengesNamedKnobsWhenAMismatchIsLeft) {
   }
 }
 
+// The challenge also runs where the shortfall's SE is too wide to call the correction below the
+// ceiling but it closed little of the gap (hexapod pair 48105: an IMU offset named for a weak leg,
+// 6% of the gap closed); never for a named leg, an `explained` verdict or on uneven ground.
+TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
+  Analysis a;
+  a.candidates.candidates.resize(2);
+  a.candidates.candidates[1].leg = "middle_left";
+  a.naming.named = {0};
+  a.verdict.status = "partly_explained";
+  a.adequacy.below_ceiling = false;
+  a.adequacy.gap_closed = 0.06;
+  const LegSearchOptions options;
+  EXPECT_TRUE(WantLegSearch(a, options));
+  a.adequacy.gap_closed = 0.97;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "closed most of the gap and not below the ceiling";
+  a.adequacy.below_ceiling = true;
+  EXPECT_TRUE(WantLegSearch(a, options));
+  a.adequacy.below_ceiling = false, a.adequacy.gap_closed = 0.06;
+  a.naming.named = {1};
+  EXPECT_FALSE(WantLegSearch(a, options)) << "a leg is named";
+  a.naming.named = {0}, a.verdict.status = "explained";
+  EXPECT_FALSE(WantLegSearch(a, options));
+  a.verdict.status = "partly_explained", a.baseline.permute_placements = true;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
+}
+
 // On uneven ground a mismatch left after the mean shifts gets a runoff of the first step's
 // contenders, on a plane never; what it names is the verdict's and the correction's one story.
 TEST(Analysis, TheRunoffRunsOnUnevenGroundWhenAMismatchIsLeft) {
