@@ -45,8 +45,8 @@ bool RefineOptions::IsValid(std::string* error) const {
   if (refine_iterations < 0 || refine_knobs < 0 || payload_rounds < 0 || !(converged_within > 0) ||
       !(payload_contender_share > 0 && payload_contender_share <= 1) || !(as_well_z > 0)) {
     if (error) {
-      *error = "refine_iterations >= 0, refine_knobs >= 0, payload_rounds >= 0, converged_within > 0, payload_contender_share in (0, 1], "
-               "as_well_z > 0";
+      *error = "refine_iterations >= 0, refine_knobs >= 0, payload_rounds >= 0, converged_within > 0, "
+               "payload_contender_share in (0, 1], as_well_z > 0";
     }
     return false;
   }

@@ -36,7 +36,6 @@ enum FakeKnob {
   kNumFakeKnobs
 };
 
-// What a recording adds beyond the knobs (the "real" robot's extras).
 // The fake payload's effect is gain times its signature: its mass's own part (speed lost, weight)
 // taken at mass^power (power 1: linear in the mass, as its probes' reading assumes), its offsets'
 // part at the moments mass x and mass y.
@@ -50,6 +49,7 @@ struct FakePayload {
   bool offset_alone = false;
 };
 
+// What a recording adds beyond the knobs (the "real" robot's extras).
 struct FakeExtras {
   Eigen::Vector3d tracker_bias = Eigen::Vector3d::Zero();  // added to (dx, dy, dyaw); yaw entry unused
   // Physics no knob describes: dy += geometry * long * (1 + 2 roll), dx -= geometry * |turn|.
