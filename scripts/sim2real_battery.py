@@ -19,9 +19,11 @@ confusion matrix and the targets table) and with --write-doc the section `sim2re
 docs/sim2real.md.
 
 Seed ranges: DEV 1000-1999 (what the method may be developed on), REPORT 5000-5039 (run once).
-Draw version 2 (default; from seed range 11000) adds the solimp contact option and the backlash
-family and plants tracker noise through the config; --draw-version 1 redraws the ranges up to
-10000-10039 exactly as they were.
+Draw version 2 (from seed range 11000) adds the solimp contact option and the backlash
+family and plants tracker noise through the config; draw version 3 (the default) adds one-leg
+geometry and mass edits out of the library (a shorter tibia, a larger foot, a hip mounted off
+its place, a mass on one leg), with a quarter of the pairs out of the library and fewer two-effect pairs;
+--draw-version 1 redraws the ranges up to 10000-10039 exactly as they were.
 
 Usage: scripts/sim2real_battery.py --seeds 1000-1009 [--jobs 2] [--build build] [--out DIR]
        [--keep] [--smoke] [--generate-only] [--write-doc] [--draw-version {1,2,3}]
@@ -436,7 +438,8 @@ def main():
     ap.add_argument("--draw-version", type=int, choices=draw.DRAW_VERSIONS,
                     default=draw.DEFAULT_DRAW_VERSION,
                     help="pair generator: 1 = seed ranges up to 10000-10039 as drawn then; 2 "
-                         "(default) adds solimp and backlash, tracker noise through the config")
+                         "adds solimp and backlash, tracker noise through the config; 3 (default) "
+                         "adds leg geometry and mass out of the library")
     ap.add_argument("--protocol", default="paper", choices=["paper", "continuous"],
                     help="of the sim and real sets: continuous draws each execution's velocity command "
                          "at random (kept in z as cmd_long, cmd_lat, cmd_turn; issue #25)")

@@ -55,14 +55,7 @@ std::vector<int> SameKnob(const CandidateSet& set, int k) {
   return out;
 }
 
-struct KnobSearch {
-  const KnobSimulator& simulator;
-  const AnalysisInputs& in;
-  const Baseline& base;
-  const CandidateOptions& recording;
-  const RefineOptions& options;
-  CandidateSet* set;
-  Refinement* r;
+struct KnobSearch : SearchContext {
   int k;
   KnobFrame f;
   std::vector<int> same;  // candidates of the same knob (k among them): not refit while scoring
@@ -155,7 +148,7 @@ void SearchKnob(const KnobSimulator& simulator, const AnalysisInputs& in, const 
   const double probe_dev = c.probe - c.nominal;
   double d0 = a0 * probe_dev;
   if (std::abs(d0) < 0.1 * std::abs(probe_dev)) d0 = (a0 < 0 ? -0.1 : 0.1) * probe_dev;
-  KnobSearch s{simulator, in, base, recording, options, set, r, k, KnobFrame{&c, d0}, SameKnob(*set, k)};
+  KnobSearch s{{simulator, in, base, recording, options, set, r}, k, KnobFrame{&c, d0}, SameKnob(*set, k)};
   std::vector<KnobPoint> pts;
   for (int j : s.same) {  // the probes' own recordings, on the reading's side of the nominal
     const double v = set->candidates[j].probe;

@@ -154,15 +154,8 @@ std::vector<PayloadPoint> GridAround(const SearchFrame& f, const std::vector<Pay
 }
 
 // One payload search's context: what records and scores its points.
-struct Search {
-  const KnobSimulator& simulator;
-  const AnalysisInputs& in;
-  const Baseline& base;
-  const CandidateOptions& recording;
-  const RefineOptions& options;
+struct Search : SearchContext {
   int pay;
-  CandidateSet* set;
-  Refinement* r;
   std::vector<PayloadPoint> recorded = {};  // every point recorded so far, by either walk
   void RecordAndScore(std::vector<PayloadPoint>* pts);
 };
@@ -332,7 +325,7 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   if (t(0) <= 0.05) return;  // a payload heavier than nominal (a lighter one has no position to fit)
   // Both columns' walks (a point either records is not recorded again); the payload is the best
   // point of the walk that ends better.
-  Search search{simulator, in, base, recording, options, pay, set, r};
+  Search search{{simulator, in, base, recording, options, set, r}, pay};
   SearchFrame frame = LinearReading(simulator.knobs(), *set, *found, t);
   Walk w = SearchWith(&search, frame);
   frame.keep_moment = false;

@@ -13,6 +13,20 @@
 
 namespace dgmm::sim2real {
 
+// What a likelihood search of stage 4 reads and writes: the simulator it records with, the
+// analysis's inputs and baseline, how candidates are recorded, the refinement's options, the
+// candidate set it adds recordings to and the refinement it traces into. The payload's search
+// (refine_payload.cc) and a parameter knob's (refine_knob.cc) each extend it.
+struct SearchContext {
+  const KnobSimulator& simulator;
+  const AnalysisInputs& in;
+  const Baseline& base;
+  const CandidateOptions& recording;
+  const RefineOptions& options;
+  CandidateSet* set;
+  Refinement* r;
+};
+
 // `shifts`: candidate k's external shifts with the searched recording first (the payload keeps its
 // x and y probes after it). Returns log-likelihood summed over the real samples; `rows` (if given)
 // receives it per real sample.
