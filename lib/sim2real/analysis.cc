@@ -57,20 +57,27 @@ bool WantLegSearch(const Analysis& a, const LegSearchOptions& options) {
 
 namespace {
 
-// Stages 3 to 8 (candidates to verdict) on the inputs and baseline in `a`.
-// A run again on only some knobs keeps the other candidates of `first_look` (their signatures as
-// recorded then) as competitors, and returns how many it kept.
+// Stage 3 (the candidates' signatures) on the inputs and baseline in `a`. A run again on only some
+// knobs keeps the other candidates of `first_look` (their signatures as recorded then) as
+// competitors, and returns how many it kept.
 template <typename Stage>
-int KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a,
-               const CandidateSet* first_look = nullptr) {
-  auto t = Clock::now();
+int RecordCandidates(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a,
+                     const CandidateSet* first_look = nullptr) {
+  const auto t = Clock::now();
   stage("candidates (knob signatures)");
   a->candidates = BuildCandidates(simulator, a->inputs, a->baseline, options.candidates);
   int kept = 0;
   if (first_look && options.candidates.only_knobs) {
     kept = KeepFirstLookCandidates(*first_look, *options.candidates.only_knobs, &a->candidates);
   }
-  a->seconds.candidates += Since(t), t = Clock::now();
+  a->seconds.candidates += Since(t);
+  return kept;
+}
+
+// Stages 4 to 8 (selection and refinement to verdict) on the candidates in `a`.
+template <typename Stage>
+void SelectToVerdict(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
+  auto t = Clock::now();
   stage("selection and refinement");
   a->refinement = SelectAndRefine(simulator, a->inputs, a->baseline, options.candidates, options.refine, &a->candidates);
   a->seconds.refine += Since(t), t = Clock::now();
@@ -87,7 +94,6 @@ int KnobStages(const KnobSimulator& simulator, const AnalysisOptions& options, c
   a->seconds.ties += Since(t);
   a->verdict = ComposeVerdict(a->baseline, a->candidates, a->refinement, a->confidence, a->adequacy, a->naming,
                               a->ties, options.verdict);
-  return kept;
 }
 
 // The runoff runs on uneven ground when the stages before left a mismatch: something named but
@@ -172,6 +178,30 @@ NullShortfall MeasureNull(const KnobSimulator& simulator, const AnalysisInputs& 
   return RecordNullShortfall(simulator, in, base, o);
 }
 
+// Stages 3 to 8 again with signatures of every execution (Analysis::every_execution_because), on
+// the knobs the first look screened in when options.confirm_screened_only.
+template <typename Stage>
+void RunAgainWithEveryExecution(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage,
+                                Analysis* a) {
+  AnalysisOptions every = options;
+  every.candidates.executions_per_placement = RealExecutionsPerPlacement(a->inputs);
+  if (options.confirm_screened_only) {
+    every.candidates.only_knobs =
+        ScreenedKnobs(a->candidates, a->refinement.selection, options.confirm_screen_z, options.confirm_screen_share);
+  }
+  // The recordings of both runs are counted.
+  const int recorded = a->candidates.recorded, from_cache = a->candidates.from_cache, requests = a->candidates.requests;
+  const int refined = a->refinement.recorded, refined_from_cache = a->refinement.from_cache;
+  const CandidateSet first_look = std::move(a->candidates);
+  const int kept = RecordCandidates(simulator, every, stage, a, &first_look);
+  SelectToVerdict(simulator, every, stage, a);
+  if (every.candidates.only_knobs) {
+    a->every_execution_because += ScreenedPart(simulator, *every.candidates.only_knobs, options, kept);
+  }
+  a->candidates.recorded += recorded, a->candidates.from_cache += from_cache, a->candidates.requests += requests;
+  a->refinement.recorded += refined, a->refinement.from_cache += refined_from_cache;
+}
+
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
@@ -223,6 +253,11 @@ int RealExecutionsPerPlacement(const AnalysisInputs& in) {
   return step.empty() ? 0 : *std::max_element(step.begin(), step.end()) + 1;
 }
 
+bool FirstLookIsAScreen(const AnalysisInputs& in, const AnalysisOptions& options) {
+  const int signature = options.candidates.executions_per_placement;
+  return options.every_execution_to_confirm && signature > 0 && RealExecutionsPerPlacement(in) > signature;
+}
+
 std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options) {
   const int signature = options.candidates.executions_per_placement;
   const int real = RealExecutionsPerPlacement(a.inputs);
@@ -235,10 +270,12 @@ std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& opti
     }
   }
   if (!options.every_execution_to_confirm) return "";
+  const std::string look =
+      FirstLookIsAScreen(a.inputs, options) ? "a first look without likelihood searches" : "a first look";
   std::string named;
   for (const VerdictNamed& n : a.verdict.named) named += (named.empty() ? "" : ", ") + n.knob;
   if (!named.empty()) {
-    return "a first look named " + named + " from signatures of " + of_real + "; a name is confirmed with every execution";
+    return look + " named " + named + " from signatures of " + of_real + "; a name is confirmed with every execution";
   }
   const std::vector<SelectionStep>& steps = a.refinement.selection.steps;
   const CandidateScore* best = FirstStepBest(a.refinement.selection);
@@ -246,9 +283,9 @@ std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& opti
   const std::string& key = a.candidates.candidates.at(best->effect).key;
   const std::string z = Fmt("held-out z %.2f", best->z) + Fmt(", significant from %.2f", steps[0].threshold_z);
   if (best->z >= steps[0].threshold_z) {
-    return "a first look from signatures of " + of_real + " selected " + key + " (" + z + ") but did not name it";
+    return look + " from signatures of " + of_real + " selected " + key + " (" + z + ") but did not name it";
   }
-  return "a first look from signatures of " + of_real + " came near: " + key + " reached " + z;
+  return look + " from signatures of " + of_real + " came near: " + key + " reached " + z;
 }
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
@@ -274,25 +311,18 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   const auto null_start = Clock::now();
   a.null_shortfall = MeasureNull(*simulator, a.inputs, a.baseline, options);
   a.seconds.adequacy += Since(null_start);
-  KnobStages(*simulator, options, stage, &a);
+  // A first look whose selections will be recorded again with every execution is a screen: the
+  // run again searches what it selects, so the first look searches nothing.
+  AnalysisOptions first = options;
+  const bool screen = FirstLookIsAScreen(a.inputs, options);
+  if (screen) first.refine.refine_iterations = 0;
+  RecordCandidates(*simulator, first, stage, &a);
+  SelectToVerdict(*simulator, first, stage, &a);
   a.every_execution_because = EveryExecutionBecause(a, options);
   if (!a.every_execution_because.empty()) {
-    AnalysisOptions every = options;
-    every.candidates.executions_per_placement = RealExecutionsPerPlacement(a.inputs);
-    if (options.confirm_screened_only) {
-      every.candidates.only_knobs =
-          ScreenedKnobs(a.candidates, a.refinement.selection, options.confirm_screen_z, options.confirm_screen_share);
-    }
-    // The recordings of both runs are counted.
-    const int recorded = a.candidates.recorded, from_cache = a.candidates.from_cache, requests = a.candidates.requests;
-    const int refined = a.refinement.recorded, refined_from_cache = a.refinement.from_cache;
-    const CandidateSet first_look = std::move(a.candidates);
-    const int kept = KnobStages(*simulator, every, stage, &a, &first_look);
-    if (every.candidates.only_knobs) {
-      a.every_execution_because += ScreenedPart(*simulator, *every.candidates.only_knobs, options, kept);
-    }
-    a.candidates.recorded += recorded, a.candidates.from_cache += from_cache, a.candidates.requests += requests;
-    a.refinement.recorded += refined, a.refinement.from_cache += refined_from_cache;
+    RunAgainWithEveryExecution(*simulator, options, stage, &a);
+  } else if (screen && !a.refinement.selection.selected.empty()) {
+    SelectToVerdict(*simulator, options, stage, &a);  // not looked at again (every_execution_from_z): searched now
   }
   SearchByOwnModels(*simulator, options, stage, &a);
   a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, SearchedWithoutName(a),

@@ -137,6 +137,14 @@ std::vector<int> ScreenedKnobs(const CandidateSet& set, const SelectionResult& s
                                double share);
 // The largest execution index of a placement in the real set, plus one (0 without sequence data).
 int RealExecutionsPerPlacement(const AnalysisInputs& in);
+// Is the first look a screen? When every_execution_to_confirm holds and the signatures record
+// fewer executions per placement than the real set has, whatever the first look selects is
+// recorded again with every execution: it is named (and confirmed), or selected without a name,
+// at a z of at least the step's significance, above every_execution_from_z's default (2.0). The
+// first look then runs no likelihood search (stage 4's payload, knob and spread searches; the
+// run again does), and when it is not run again after all (every_execution_from_z raised above
+// the significance), stages 4-8 run once more with the searches.
+bool FirstLookIsAScreen(const AnalysisInputs& in, const AnalysisOptions& options);
 
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
                  const AnalysisOptions& options, const std::string& no_simulator_reason = "");

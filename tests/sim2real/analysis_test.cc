@@ -372,6 +372,37 @@ TEST(Analysis, TheStepDriftRecheckNamesWhatFewSignatureExecutionsReadAsADrift) {
   EXPECT_EQ(again.verdict.status, every_knob.verdict.status);
 }
 
+// A first look from signatures of 2 of the real set's 5 executions whose name is recorded again
+// with every execution is a screen: it records nothing between its selection and its
+// confidence stage (no likelihood search), while the run again searches the knob it names.
+TEST(Analysis, AFirstLookThatIsRecordedAgainSearchesNothing) {
+  FakeSimulator fake;
+  const auto pair = test::MakeFakePair(fake, {{test::kFriction, 0.7}});
+  AnalysisOptions options = test::FastOptions();
+  ASSERT_EQ(options.candidates.executions_per_placement, 2);
+  std::vector<std::pair<std::string, int>> stages;  // each stage's name and the recordings made before it
+  options.on_stage = [&](const std::string& name) { stages.emplace_back(name, fake.records()); };
+  const Analysis a = Analyse(pair.sim, pair.real, &fake, options);
+  ASSERT_NE(a.every_execution_because.find("a first look without likelihood searches named"), std::string::npos)
+      << a.every_execution_because;
+  std::vector<int> searched;  // recordings during each "selection and refinement" stage
+  for (size_t i = 0; i + 1 < stages.size(); ++i) {
+    if (stages[i].first == "selection and refinement") searched.push_back(stages[i + 1].second - stages[i].second);
+  }
+  ASSERT_EQ(searched.size(), 2u) << "a first look and a run again";
+  EXPECT_EQ(searched[0], 0) << "the first look searched";
+  EXPECT_GT(searched[1], 0) << "the run again did not search the friction";
+  ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
+  EXPECT_EQ(a.verdict.named[0].family, "friction") << a.verdict.sentence;
+  EXPECT_NEAR(a.verdict.named[0].value, 0.7, kValueTolerance * 0.7) << a.verdict.sentence;
+  EXPECT_TRUE(FirstLookIsAScreen(a.inputs, options));
+  options.every_execution_to_confirm = false;  // a name would stand on the first look: it searches
+  EXPECT_FALSE(FirstLookIsAScreen(a.inputs, options));
+  options.every_execution_to_confirm = true;
+  options.candidates.executions_per_placement = 5;  // every execution already: no run again
+  EXPECT_FALSE(FirstLookIsAScreen(a.inputs, options));
+}
+
 // What a first look screens in for the run again: a candidate's knob when it reached the z at some
 // step, was selected or confusable; a payload's three knobs; the tracker's spread probe always;
 // nothing for a measurement effect.
