@@ -134,6 +134,12 @@ def score_pair(pair, report):
         s["doubt_reported"] = verdict.get("status") in ("unexplained", "partly_explained") and bool(
             verdict.get("doubts") or (verdict.get("unexplained") or {}).get("structured_in"))
     s["doubts"] = verdict.get("doubts") or []
+    # Stage 8's advice to record more placements (report.json more_data; null when not advised):
+    # whether it points at a planted family is scored, not targeted.
+    more = report.get("more_data")
+    s["advice"] = None if not more else {
+        "knob": more.get("knob"), "family": more.get("family"), "reason": more.get("reason"),
+        "placements_needed": more.get("placements_needed"), "on_truth": more.get("family") in truth}
     inclusion = first.get("inclusion") if first else None
     # A stated doubt (issue #22: a value pinned or impossible, mismatch left after the correction)
     # makes an answer not confident.
@@ -188,8 +194,14 @@ def summarize(results):
     first = [r["analysis_wall_s"] for r in scored if cache_state(r) == "uncached"]
     cached = [r["analysis_wall_s"] for r in scored if cache_state(r) == "cached"]
     partial = [r["analysis_wall_s"] for r in scored if cache_state(r) == "partial"]
+    advised = [r for r in scored if r["score"].get("advice")]
     return {
         "pairs": len(scored),
+        "advised": len(advised),
+        "advised_in_library_on_truth": _rate(r["score"]["advice"]["on_truth"] for r in advised
+                                             if r["kind"] in ("single", "two")),
+        "advised_nulls": sum(r["kind"] == "null" for r in advised),
+        "advised_out_of_library": sum(r["kind"] == "out_of_library" for r in advised),
         "null_clean": _rate(r["score"]["clean"] for r in nulls),
         "in_library_correct": _rate(r["score"]["correct"] for r in singles),
         "two_effect_both_found": _rate(r["score"]["both_found"] for r in twos),

@@ -47,6 +47,12 @@ def targets_table(summary):
     part = ", ".join(f"{t:.0f} s" for t in summary.get("wall_s_partially_cached", [])) or "-"
     rows.append(f"| wall time of a partly cached analysis (some signatures simulated) | (reported) | "
                 f"{part} | - |")
+    if "advised" in summary:
+        hits, n = summary["advised_in_library_on_truth"]
+        rows.append(f"| advice to record more placements (unexplained pairs): pairs advised; in-library "
+                    f"ones pointing at a planted family; nulls; out of library | (reported) | "
+                    f"{summary['advised']}; {hits} of {n}; {summary['advised_nulls']}; "
+                    f"{summary['advised_out_of_library']} | - |")
     return "\n".join(rows)
 
 
@@ -104,11 +110,17 @@ def pair_table(results):
                    "unexplained" if s.get("unexplained_reported") else "wrong")
         if s["confident_wrong"]:
             verdict += ", confident"
+        advice = s.get("advice")
+        status = s["status"]
+        if advice:
+            needed = advice["placements_needed"]
+            status += (f"; advice: {needed} placements" if needed else "; advice: beyond 16 times the placements") + \
+                f" ({advice['knob']})"
         errs = ", ".join("-" if v is None else "other knob" if v["error"] is None
                          else f"{100 * v['error']:+.0f}%" for v in (s.get("values") or {}).values())
         g = s.get("gap_closed")
         lines.append(f"| {r['seed']} | {r['robot']} | {r['kind']} | {planted} | {det} | "
-                     f"{s['status']} | {named} | {ties} | {verdict} | {errs or '-'} | "
+                     f"{status} | {named} | {ties} | {verdict} | {errs or '-'} | "
                      f"{'-' if g is None else f'{100 * g:.0f}%'} | {r['analysis_wall_s']:.0f} s |")
     return "\n".join(lines)
 

@@ -17,6 +17,7 @@ sys.path.insert(0, HERE)
 import sim2real_battery as battery  # noqa: E402
 import sim2real_battery_draw as draw  # noqa: E402
 import sim2real_battery_score as score  # noqa: E402
+import sim2real_battery_tables as tables  # noqa: E402
 
 
 def nominals():
@@ -293,6 +294,30 @@ class ScoreTest(unittest.TestCase):
                              verdict("explained", [name("tracker_noise", inclusion=0.95)]))
         self.assertFalse(s["unexplained_reported"])
         self.assertTrue(s["confident_wrong"])
+
+    def test_advice_is_scored_against_the_truth(self):
+        def advised(family, needed):
+            return dict(verdict("unexplained"), more_data={
+                "knob": "payload.mass_kg" if family == "payload" else "geoms.friction_scale",
+                "family": family, "reason": "near_miss", "placements_needed": needed})
+        on = score.score_pair(pair("single", PAYLOAD), advised("payload", 203))
+        self.assertTrue(on["advice"]["on_truth"])
+        off = score.score_pair(pair("single", PAYLOAD), advised("friction", None))
+        self.assertFalse(off["advice"]["on_truth"])
+        self.assertIsNone(score.score_pair(pair("single", PAYLOAD), verdict("unexplained"))["advice"])
+        results = [{"kind": "single", "score": on, "analysis_wall_s": 1.0},
+                   {"kind": "single", "score": off, "analysis_wall_s": 1.0},
+                   {"kind": "null", "score": score.score_pair(pair("null"), advised("friction", 90)),
+                    "analysis_wall_s": 1.0}]
+        s = score.summarize(results)
+        self.assertEqual((s["advised"], s["advised_in_library_on_truth"], s["advised_nulls"]), (3, (1, 2), 1))
+        for r, seed in zip(results, (1, 2, 3)):
+            r.update(seed=seed, robot="scorpion", effects=[], detectability={
+                "mean_shift_z": None, "consistent_z": None, "spread_z": None})
+        table = tables.pair_table(results)
+        self.assertIn("advice: 203 placements (payload.mass_kg)", table)
+        self.assertIn("advice: beyond 16 times the placements (geoms.friction_scale)", table)
+        self.assertIn("| 3; 1 of 2; 1; 0 |", tables.targets_table(s))
 
     def test_old_reports_map_onto_families(self):
         old = {"effects": [{"effect": "slope_slip", "inclusion_probability": 1.0}],
