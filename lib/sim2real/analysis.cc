@@ -253,15 +253,25 @@ int RealExecutionsPerPlacement(const AnalysisInputs& in) {
   return step.empty() ? 0 : *std::max_element(step.begin(), step.end()) + 1;
 }
 
-bool FirstLookIsAScreen(const AnalysisInputs& in, const AnalysisOptions& options) {
+namespace {
+
+// Do the signatures record fewer executions per placement than the real set has (0: the
+// protocol's own number, all of them)?
+bool SignaturesMissExecutions(const AnalysisInputs& in, const AnalysisOptions& options) {
   const int signature = options.candidates.executions_per_placement;
-  return options.every_execution_to_confirm && signature > 0 && RealExecutionsPerPlacement(in) > signature;
+  return signature > 0 && RealExecutionsPerPlacement(in) > signature;
+}
+
+}  // namespace
+
+bool FirstLookIsAScreen(const AnalysisInputs& in, const AnalysisOptions& options) {
+  return options.every_execution_to_confirm && SignaturesMissExecutions(in, options);
 }
 
 std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& options) {
+  if (!SignaturesMissExecutions(a.inputs, options)) return "";
   const int signature = options.candidates.executions_per_placement;
   const int real = RealExecutionsPerPlacement(a.inputs);
-  if (signature == 0 || real <= signature) return "";
   const std::string of_real = std::to_string(signature) + " of the real set's " + std::to_string(real) +
                               " executions per placement";
   for (const VerdictDrifting& d : a.verdict.drifting) {
