@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "app/command.h"
+#include "app/cv_flags.h"
 #include "app/dgmm_flags.h"
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
@@ -20,23 +21,12 @@
 namespace dgmm::app {
 namespace {
 
-struct CvArgs {
-  std::string path;
+struct CvArgs : CvFlags {
   double k = 0.7;
-  int folds = 0;  // 0: chosen from the data (unless --folds was given)
-  bool folds_given = false;
-  int repeats = 10;
-  std::uint64_t seed = 1;
-  int threads = 0;
-  bool shuffle_training = false;
   bool no_em = false;
   int em_max_components = 5;
   int em_n_init = 3;
   DgmmFlags dgmm;
-  bool stratified = false;
-  bool with_terrain = false, without_terrain = false;
-  std::vector<std::string> pose_dims, terrain_dims;
-  bool json = false;
 };
 
 nlohmann::json ScoreJson(const CvScore& s) {
@@ -69,16 +59,11 @@ std::vector<Row> Rows(const CvSummary& summary) {
 
 CvOptions MakeCvOptions(const CvArgs& args, const SampleSet& set) {
   CvOptions options;
-  options.folds = CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
+  SetCvOptions(args, set, &options);
   options.without_terrain = !args.with_terrain;
   options.with_terrain = !args.without_terrain;
   options.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
   options.dgmm.k = args.k;
-  options.group_by_episode = !args.stratified;
-  options.repeats = args.repeats;
-  options.seed = args.seed;
-  options.threads = args.threads;
-  options.shuffle_training = args.shuffle_training;
   options.em_baseline = !args.no_em;
   options.em_max_components = args.em_max_components;
   options.em.n_init = args.em_n_init;
@@ -167,12 +152,7 @@ void RunCv(const CvArgs& args) {
   if (!(args.k > 0) || !std::isfinite(args.k)) {
     throw MakeInputError("", "--k", fmt::format("must be a finite number > 0, got {}", args.k));
   }
-  if (args.folds_given && args.folds < 2) {
-    throw MakeInputError("", "--folds", "must be >= 2 (omit --folds to choose from the data)");
-  }
-  if (args.repeats < 1) throw MakeInputError("", "--repeats", "must be >= 1");
-  const SampleSet set = ReadSetToCrossValidate(args.path, args.pose_dims, args.terrain_dims,
-                                               args.with_terrain, args.without_terrain);
+  const SampleSet set = ReadCvSet(args);
   const CvOptions options = MakeCvOptions(args, set);
   WarnIfUnderdetermined(set, !args.without_terrain, "cv", true);
   const CvSummary summary = CrossValidate(set, options);
@@ -189,18 +169,8 @@ void SetupCv(CLI::App& root) {
       "cv",
       "Cross-validated held-out log-likelihood (Table I): DGMM and EM-BIC, with and "
       "without terrain");
-  cmd->add_option("set", args->path, "Sample set (.h5)")->required();
+  AddCvFlags(cmd, args.get());
   cmd->add_option("--k", args->k, "DGMM merge rate k > 0")->capture_default_str();
-  cmd->add_option("--folds", args->folds,
-                  "Folds, >= 2 (whole episodes when the set has enough, else stratified by "
-                  "command); default: chosen from the data (leave-one-episode-out for up to 10 "
-                  "episodes, else 10 folds; stratified: at most the smallest command's samples)");
-  cmd->add_option("--repeats", args->repeats, "Repeats with new folds")->capture_default_str();
-  cmd->add_option("--seed", args->seed, "Seed of folds and merges")->capture_default_str();
-  cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")
-      ->capture_default_str();
-  cmd->add_flag("--shuffle-training", args->shuffle_training,
-                "Stream each training fold in a seeded random order (default: recorded order)");
   cmd->add_flag("--no-em", args->no_em, "Skip the EM-BIC baseline");
   cmd->add_option("--em-max-components", args->em_max_components,
                   "EM-BIC: largest number of components tried per command")
@@ -211,18 +181,8 @@ void SetupCv(CLI::App& root) {
                 "Only the with-terrain rows, p(x | c, z) (default: both)");
   cmd->add_flag("--without-terrain", args->without_terrain,
                 "Only the without-terrain rows, p(x | c) (as fit --without-terrain)");
-  cmd->add_flag("--stratified", args->stratified,
-                "Folds stratified by command even when the set has episodes (default: whole "
-                "episodes per fold when it has them)");
-  cmd->add_option("--pose-dims", args->pose_dims,
-                  "Pose dimensions to model, by name (default: all)")
-      ->delimiter(',');
-  cmd->add_option("--terrain-dims", args->terrain_dims,
-                  "Terrain dimensions to condition on, by name (default: all)")
-      ->delimiter(',');
-  cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([args, cmd] {
-    args->folds_given = cmd->count("--folds") > 0;
+    NoteFoldsGiven(*cmd, args.get());
     RunCv(*args);
   });
 }

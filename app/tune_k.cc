@@ -14,6 +14,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/command.h"
+#include "app/cv_flags.h"
 #include "app/dgmm_flags.h"
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
@@ -27,24 +28,14 @@
 namespace dgmm::app {
 namespace {
 
-struct TuneKArgs {
-  std::string path;
-  bool with_terrain = false, without_terrain = false;
-  int folds = 0, repeats = 10;  // folds 0: chosen from the data (unless --folds was given)
-  bool folds_given = false;
-  std::uint64_t seed = 1;
-  int threads = 0;
+struct TuneKArgs : CvFlags {
   double k_min = 1e-3, k_max = 10;
   int grid_points = 9, refine_points = 4;
-  bool shuffle_training = false;
-  bool stratified = false;
   double plateau_tolerance = 0;
   std::vector<double> init_scales = TuneKOptions{}.init_scales;
   std::vector<double> prior_counts = TuneKOptions{}.prior_counts;
   DgmmFlags dgmm;
   std::string plot, curve_csv;
-  std::vector<std::string> pose_dims, terrain_dims;
-  bool json = false;
   bool no_joint = false;
 };
 
@@ -375,13 +366,8 @@ void PrintSearch(const TuneKSummary& s) {
 TuneKOptions MakeTuneOptions(const TuneKArgs& args, const SampleSet& set) {
   TuneKOptions options;
   options.with_terrain = !args.without_terrain;
-  options.cv.folds = CheckedFolds(set, args.folds, args.folds_given, !args.stratified, args.path);
-  options.cv.repeats = args.repeats;
-  options.cv.seed = args.seed;
-  options.cv.threads = args.threads;
-  options.cv.shuffle_training = args.shuffle_training;
+  SetCvOptions(args, set, &options.cv);
   options.cv.dgmm = DgmmOptionsFromFlags(args.dgmm, set.pose_dim() + set.terrain_dim());
-  options.cv.group_by_episode = !args.stratified;
   options.plateau_tolerance = args.plateau_tolerance;
   options.init_scales = args.init_scales;
   options.prior_counts = args.prior_counts;
@@ -410,10 +396,6 @@ TuneKOptions MakeTuneOptions(const TuneKArgs& args, const SampleSet& set) {
 }
 
 void RunTuneK(const TuneKArgs& args) {
-  if (args.folds_given && args.folds < 2) {
-    throw MakeInputError(args.path, "--folds",
-                         "must be >= 2 (omit --folds to choose from the data)");
-  }
   // Unwritable output folders are reported before the long run, not after it.
   for (const auto& [output, flag] :
        {std::pair{args.plot, "--plot"}, {args.curve_csv, "--curve-csv"}}) {
@@ -422,8 +404,7 @@ void RunTuneK(const TuneKArgs& args) {
     AtomicFile probe(output);
   }
   if (!args.plot.empty()) RequireDisplay();  // before the long run, not after it
-  const SampleSet set = ReadSetToCrossValidate(args.path, args.pose_dims, args.terrain_dims,
-                                               args.with_terrain, args.without_terrain);
+  const SampleSet set = ReadCvSet(args);
   const TuneKOptions options = MakeTuneOptions(args, set);
   WarnIfUnderdetermined(set, !args.without_terrain, "tune", true);
   const TuneKSummary s = TuneK(set, options);
@@ -457,27 +438,16 @@ void SetupTuneK(CLI::App& root) {
       "Choose the DGMM merge rate k, the S0 scale and the prior strength by cross-validated "
       "log-likelihood (coordinate steps, then a joint Ceres quadratic step); reports plateaus");
   cmd->alias("tune-k");
-  cmd->add_option("set", args->path, "Sample set (.h5)")->required();
+  AddCvFlags(cmd, args.get());
   cmd->add_flag("--with-terrain", args->with_terrain, "Maximise p(x | c, z) (the default)");
   cmd->add_flag("--without-terrain", args->without_terrain, "Maximise p(x | c)");
-  cmd->add_option("--folds", args->folds,
-                  "Folds, >= 2 (default: chosen from the data, as dgmm cv)");
-  cmd->add_option("--repeats", args->repeats, "Repeats")->capture_default_str();
-  cmd->add_option("--seed", args->seed, "Seed (the same folds and merges for every k)")
-      ->capture_default_str();
-  cmd->add_option("--threads", args->threads, "Worker threads (0: all cores)")
-      ->capture_default_str();
   cmd->add_option("--k-min", args->k_min, "Smallest k of the coarse grid")->capture_default_str();
   cmd->add_option("--k-max", args->k_max, "Largest k of the coarse grid")->capture_default_str();
   cmd->add_option("--grid-points", args->grid_points, "Coarse grid points (log spaced)")
       ->capture_default_str();
   cmd->add_option("--refine-points", args->refine_points, "Extra evaluations in the bracket")
       ->capture_default_str();
-  cmd->add_flag("--shuffle-training", args->shuffle_training,
-                "Stream training folds in a seeded random order");
   AddDgmmFlags(cmd, &args->dgmm);
-  cmd->add_flag("--stratified", args->stratified,
-                "Folds stratified by command even when the set has episodes");
   cmd->add_option("--plateau-tolerance", args->plateau_tolerance,
                   "Nats of held-out log-likelihood within which evaluations are equivalent "
                   "(0: one standard error of the best)")
@@ -490,17 +460,10 @@ void SetupTuneK(CLI::App& root) {
       ->delimiter(',');
   cmd->add_option("--plot", args->plot, "Write the curve as a PNG line chart (needs X)");
   cmd->add_option("--curve-csv", args->curve_csv, "Write the curve as CSV");
-  cmd->add_option("--pose-dims", args->pose_dims,
-                  "Pose dimensions to model, by name (default: all)")
-      ->delimiter(',');
-  cmd->add_option("--terrain-dims", args->terrain_dims,
-                  "Terrain dimensions to condition on, by name (default: all)")
-      ->delimiter(',');
   cmd->add_flag("--no-joint", args->no_joint,
                 "Skip the joint Ceres step after the coordinate cycles");
-  cmd->add_flag("--json", args->json, "Print JSON");
   cmd->callback([args, cmd] {
-    args->folds_given = cmd->count("--folds") > 0;
+    NoteFoldsGiven(*cmd, args.get());
     RunTuneK(*args);
   });
 }
