@@ -139,7 +139,8 @@ def score_pair(pair, report):
     more = report.get("more_data")
     s["advice"] = None if not more else {
         "knob": more.get("knob"), "family": more.get("family"), "reason": more.get("reason"),
-        "placements_needed": more.get("placements_needed"), "on_truth": more.get("family") in truth}
+        "placements_needed": more.get("placements_needed"),
+        "max_factor": more.get("max_factor"), "on_truth": more.get("family") in truth}
     inclusion = first.get("inclusion") if first else None
     # A stated doubt (issue #22: a value pinned or impossible, mismatch left after the correction)
     # makes an answer not confident.

@@ -113,9 +113,10 @@ def pair_table(results):
         advice = s.get("advice")
         status = s["status"]
         if advice:
-            needed = advice["placements_needed"]
-            status += (f"; advice: {needed} placements" if needed else "; advice: beyond 16 times the placements") + \
-                f" ({advice['knob']})"
+            needed, factor = advice["placements_needed"], advice.get("max_factor")
+            # Reports before max_factor was written had the default, 16.
+            beyond = f"; advice: beyond {16 if factor is None else f'{factor:g}'} times the placements"
+            status += (f"; advice: {needed} placements" if needed else beyond) + f" ({advice['knob']})"
         errs = ", ".join("-" if v is None else "other knob" if v["error"] is None
                          else f"{100 * v['error']:+.0f}%" for v in (s.get("values") or {}).values())
         g = s.get("gap_closed")

@@ -299,7 +299,7 @@ class ScoreTest(unittest.TestCase):
         def advised(family, needed):
             return dict(verdict("unexplained"), more_data={
                 "knob": "payload.mass_kg" if family == "payload" else "geoms.friction_scale",
-                "family": family, "reason": "near_miss", "placements_needed": needed})
+                "family": family, "reason": "near_miss", "placements_needed": needed, "max_factor": 12})
         on = score.score_pair(pair("single", PAYLOAD), advised("payload", 203))
         self.assertTrue(on["advice"]["on_truth"])
         off = score.score_pair(pair("single", PAYLOAD), advised("friction", None))
@@ -316,7 +316,7 @@ class ScoreTest(unittest.TestCase):
                 "mean_shift_z": None, "consistent_z": None, "spread_z": None})
         table = tables.pair_table(results)
         self.assertIn("advice: 203 placements (payload.mass_kg)", table)
-        self.assertIn("advice: beyond 16 times the placements (geoms.friction_scale)", table)
+        self.assertIn("advice: beyond 12 times the placements (geoms.friction_scale)", table)
         self.assertIn("| 3; 1 of 2; 1; 0 |", tables.targets_table(s))
 
     def test_old_reports_map_onto_families(self):

@@ -221,7 +221,8 @@ json MoreDataJson(const MoreData& m) {
           {"z_required", JsonNumber(m.z_required)}, {"inclusion", JsonNumber(m.inclusion)},
           {"z_effective", JsonNumber(m.z_effective)}, {"placements", m.placements},
           {"executions_per_placement", m.executions_per_placement}, {"placements_are_samples", !m.sequence},
-          {"placements_needed", m.placements_needed < 0 ? json(nullptr) : json(m.placements_needed)}};
+          {"placements_needed", m.placements_needed < 0 ? json(nullptr) : json(m.placements_needed)},
+          {"max_factor", JsonNumber(m.max_factor)}};
 }
 
 }  // namespace

@@ -199,8 +199,10 @@ TEST(Report, TheAdviceOfMorePlacementsIsOneStory) {
   EXPECT_EQ(Count(j["verdict"]["sentence"].get<std::string>(), advice), 1u);
   EXPECT_EQ(Count(ReportHtml(a, ReportContext{}, "."), advice), 1u);
   EXPECT_EQ(Count(ReportSummary(a, ReportContext{}, "report.html"), advice), 1u);
-  a.more_data.placements_needed = -1;
-  EXPECT_TRUE(nlohmann::json::parse(ReportJson(a, ReportContext{}))["more_data"]["placements_needed"].is_null());
+  a.more_data.placements_needed = -1, a.more_data.max_factor = 12;
+  const auto beyond = nlohmann::json::parse(ReportJson(a, ReportContext{}))["more_data"];
+  EXPECT_TRUE(beyond["placements_needed"].is_null());
+  EXPECT_EQ(beyond["max_factor"], 12) << "null placements_needed means more than this many times the placements";
 }
 
 }  // namespace
