@@ -33,6 +33,7 @@ struct Sim2RealArgs {
   int signature_placements = sim2real::CandidateOptions{}.placements;  // the library's defaults
   int signature_executions = sim2real::CandidateOptions{}.executions_per_placement;
   bool step_drift_recheck = sim2real::AnalysisOptions{}.every_execution_on_step_drift;
+  bool payload_half_steps = sim2real::RefineOptions{}.payload_half_steps;
   bool confirm_every_execution = sim2real::AnalysisOptions{}.every_execution_to_confirm;
   double confirm_from_z = sim2real::AnalysisOptions{}.every_execution_from_z;
   bool confirm_screened_only = sim2real::AnalysisOptions{}.confirm_screened_only;
@@ -161,6 +162,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
+  o.refine.payload_half_steps = args.payload_half_steps;
   o.refine.selection.bootstrap_selection = args.bootstrap;
   o.adequacy.seed = args.seed;
   o.null_source = args.null_source == "drawn"      ? sim2real::NullSource::kDrawn
@@ -306,6 +308,9 @@ void Setup(CLI::App& root) {
                 "when an effect fits on average but its size varies with the execution index and the signatures "
                 "recorded fewer executions per placement than the real set has, record them again with every "
                 "execution and analyse once more (on by default; docs/sim2real.md)");
+  cmd->add_flag("--payload-half-steps,!--no-payload-half-steps", args->payload_half_steps,
+                "after the payload's grid search, record its best mass half a grid step either side and at the "
+                "quadratic's maximum between (on by default; docs/sim2real.md)");
   cmd->add_flag("--confirm-every-execution,!--no-confirm-every-execution", args->confirm_every_execution,
                 "when a knob is named from signatures of fewer executions per placement than the real set has, "
                 "record them again with every execution and analyse once more before naming it (on by default; "

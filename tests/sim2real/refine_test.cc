@@ -228,6 +228,38 @@ TEST(Refine, ThePayloadsSearchKeepsTheWalkAlongItsRidge) {
   }
 }
 
+// After the walk converges, the best mass is recorded half a grid step (a factor 1.6^0.5) either
+// side in its column, and the payload is the best of every recorded point: without the half steps
+// no recorded mass stands 1.6^0.5 from another.
+TEST(Refine, ThePayloadsBestMassIsRecordedHalfAStepEitherSide) {
+  auto half_step_pairs = [](const Refinement& r) {
+    std::vector<double> masses;
+    for (const RefineStep& step : r.trace) {
+      if (!std::isnan(step.score)) masses.push_back(step.value);
+    }
+    int pairs = 0;
+    for (double a : masses) {
+      for (double b : masses) pairs += std::abs(b / a - std::sqrt(1.6)) < 1e-6;
+    }
+    return pairs;
+  };
+  test::FakeSimulator fake;
+  fake.payload.gain = 2, fake.payload.power = 0.5;
+  AnalysisOptions off = test::FastOptions();
+  off.refine.payload_half_steps = false;
+  const test::Stages on = test::RunStages(fake, {{test::kPayloadMass, 0.7}}, 4);
+  const test::Stages without = test::RunStages(fake, {{test::kPayloadMass, 0.7}}, 4, {}, off);
+  ASSERT_FALSE(on.refinement.refined.empty());
+  ASSERT_TRUE(on.refinement.refined.back().converged) << on.refinement.refined.back().why;
+  EXPECT_GE(half_step_pairs(on.refinement), 2) << "a half step each way of the best mass";
+  EXPECT_EQ(half_step_pairs(without.refinement), 0);
+  double best = -INFINITY, at = NAN;
+  for (const RefineStep& step : on.refinement.trace) {
+    if (step.score > best) best = step.score, at = step.value;
+  }
+  EXPECT_EQ(on.refinement.payload_mass, at) << "the payload is the best recorded point";
+}
+
 TEST(Refine, APayloadCloseBehindTheFirstChoiceIsSearchedToo) {
   SelectionResult sel;
   sel.steps.push_back({3, {{3, 1.0, 0.1, 9.0}, {7, 0.6, 0.1, 5.0}, {8, 0.3, 0.1, 4.0}}, {}, 2.8});
