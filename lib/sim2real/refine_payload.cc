@@ -277,15 +277,15 @@ Walk SearchWith(Search* s, const SearchFrame& f) {
 // already lies within a tenth of a step.
 void RecordHalfSteps(Search* s, Walk* w) {
   const PayloadPoint best = *std::max_element(w->grid.begin(), w->grid.end(), ByScore);
-  auto column = [&](double du) {
+  auto column = [&] {  // the recorded points of the best's column within a step of it
     std::vector<const PayloadPoint*> near;
     for (const auto& p : w->grid) {
-      if (p.moment == best.moment && p.v == best.v && std::abs(p.u - best.u) <= du + 1e-9) near.push_back(&p);
+      if (p.moment == best.moment && p.v == best.v && std::abs(p.u - best.u) <= 1 + 1e-9) near.push_back(&p);
     }
     return near;
   };
   auto unrecorded = [&](double u) {
-    for (const PayloadPoint* p : column(1.0)) {
+    for (const PayloadPoint* p : column()) {
       if (std::abs(p->u - u) < 0.1) return false;
     }
     return true;
@@ -296,7 +296,7 @@ void RecordHalfSteps(Search* s, Walk* w) {
   }
   s->RecordAndScore(&halves);
   w->grid.insert(w->grid.end(), halves.begin(), halves.end());
-  const std::vector<const PayloadPoint*> near = column(1.0);
+  const std::vector<const PayloadPoint*> near = column();
   if (near.size() < 3) return;
   Eigen::MatrixXd a(near.size(), 3);
   Eigen::VectorXd y(near.size());
@@ -379,13 +379,12 @@ void RefinePayload(const KnobSimulator& simulator, const AnalysisInputs& in, con
   if (BestScore(o.grid) > BestScore(w.grid)) w = std::move(o);
   // Converged: the search brackets the maximum (the last grid's centre scored best, or the
   // quadratic's maximum, recorded, scored best strictly inside the recorded points' box).
-  auto top = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
-  const bool converged = w.centred || (w.peak_inside && top == w.grid.end() - 1);
+  auto best = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
+  const bool converged = w.centred || (w.peak_inside && best == w.grid.end() - 1);
   if (options.payload_half_steps && converged) {
     RecordHalfSteps(&search, &w);
-    top = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
+    best = std::max_element(w.grid.begin(), w.grid.end(), ByScore);
   }
-  const auto best = top;
   Adopt(in, base, pay, w.grid, *best, converged, options.as_well_z, set, r);
 }
 
