@@ -28,8 +28,8 @@ struct RefineOptions {
   // walk stops once centred): up to 1.6^6 = 17 times the probes' linear reading, which read 0.195
   // kg for a 2.49 kg payload on the mammal-shaped quadruped (docs/robots-sim2real-history.md).
   int payload_rounds = 6;
-  // Then the mass is recorded half a grid step either side of the best point, in its column, and
-  // at the maximum of a quadratic in log mass through that column's points (refine_payload.cc):
+  // Then the mass is recorded half a grid step either side of the best point, at its forward
+  // offset, and at the maximum of a quadratic in log mass through the points there (refine_payload.cc):
   // a grid of factor 1.6 alone left values up to a quarter off (false: the grid's best stands).
   bool payload_half_steps = true;
   double converged_within = 0.1;  // |coefficient - 1| of a converged tracker-noise refinement

@@ -229,17 +229,21 @@ TEST(Refine, ThePayloadsSearchKeepsTheWalkAlongItsRidge) {
 }
 
 // After the walk converges, the best mass is recorded half a grid step (a factor 1.6^0.5) either
-// side in its column, and the payload is the best of every recorded point: without the half steps
-// no recorded mass stands 1.6^0.5 from another.
+// side at its forward offset, and the payload is the best of every recorded point: without the
+// half steps no recorded mass stands 1.6^0.5 from another at one forward offset.
 TEST(Refine, ThePayloadsBestMassIsRecordedHalfAStepEitherSide) {
   auto half_step_pairs = [](const Refinement& r) {
-    std::vector<double> masses;
+    std::vector<Eigen::Vector2d> points;  // (mass, forward offset)
     for (const RefineStep& step : r.trace) {
-      if (!std::isnan(step.score)) masses.push_back(step.value);
+      double x = 0, y = 0;
+      if (std::isnan(step.score) || std::sscanf(step.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) {
+        continue;
+      }
+      points.emplace_back(step.value, x);
     }
     int pairs = 0;
-    for (double a : masses) {
-      for (double b : masses) pairs += std::abs(b / a - std::sqrt(1.6)) < 1e-6;
+    for (const Eigen::Vector2d& a : points) {
+      for (const Eigen::Vector2d& b : points) pairs += std::abs(b(0) / a(0) - std::sqrt(1.6)) < 1e-6 && a(1) == b(1);
     }
     return pairs;
   };
