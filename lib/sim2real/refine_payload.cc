@@ -33,8 +33,8 @@
 // (log m, column) through the scores around the best gives the maximum, recorded once more
 // (within twice the grid). Then the chosen walk's best mass is recorded half a step either side at
 // its forward offset, and at the maximum of a quadratic in log m through the points at that offset
-// within a step (RefineOptions::payload_half_steps): on the mammal-shaped robot (48000, 1.49 kg) the grid's
-// points 1.25 and 2.0 kg bracketed the truth and the best grid point named 1.25. The best-scoring
+// within a step (RefineOptions::payload_half_steps): on the mammal-shaped robot (48000, 1.49 kg)
+// the grid's points 1.25 and 2.0 kg bracketed the truth and the best grid point named 1.25. The best-scoring
 // recording becomes the payload's signature.
 #include <algorithm>
 #include <cmath>
@@ -281,7 +281,7 @@ Walk SearchWith(Search* s, const SearchFrame& f) {
 // scored below the named 1.181 kg).
 void RecordHalfSteps(Search* s, Walk* w) {
   const PayloadPoint best = *std::max_element(w->grid.begin(), w->grid.end(), ByScore);
-  auto at_place = [&](double u) {
+  auto at_offset = [&](double u) {
     PayloadPoint p = w->frame.At(u, best.v, best.moment);
     p.x = best.x;
     return p;
@@ -301,7 +301,7 @@ void RecordHalfSteps(Search* s, Walk* w) {
   };
   std::vector<PayloadPoint> halves;
   for (double du : {-0.5, 0.5}) {
-    if (unrecorded(best.u + du)) halves.push_back(at_place(best.u + du));
+    if (unrecorded(best.u + du)) halves.push_back(at_offset(best.u + du));
   }
   s->RecordAndScore(&halves);
   w->grid.insert(w->grid.end(), halves.begin(), halves.end());
@@ -318,7 +318,7 @@ void RecordHalfSteps(Search* s, Walk* w) {
   if (!(q(2) < 0)) return;
   const double u = best.u + std::clamp(-q(1) / (2 * q(2)), -0.5, 0.5);
   if (!unrecorded(u)) return;
-  std::vector<PayloadPoint> peak = {at_place(u)};
+  std::vector<PayloadPoint> peak = {at_offset(u)};
   s->RecordAndScore(&peak);
   w->grid.push_back(peak[0]);
 }

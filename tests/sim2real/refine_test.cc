@@ -16,6 +16,12 @@
 namespace dgmm::sim2real {
 namespace {
 
+// The place of a payload point from its trace label "payload.mass_kg at (x .., y ..) m" (false:
+// another step).
+bool PayloadPlace(const RefineStep& step, double* x, double* y) {
+  return std::sscanf(step.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", x, y) == 2;
+}
+
 // The value the selected friction stands for, and the refinement of it.
 double NamedFriction(const test::Stages& s, const std::string& key) {
   const Refinement& r = s.refinement;
@@ -80,7 +86,7 @@ TEST(Refine, ThePayloadsSearchKeepsItsSidewaysMoment) {
   std::set<std::pair<double, std::string>> middle;  // (mass, label): the walks share their reading's row
   for (const auto& t : s.refinement.trace) {
     double x = 0, y = 0;
-    if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
+    if (!PayloadPlace(t, &x, &y)) continue;
     if (y == 0) {
       middle.insert({t.value, t.knob});
       continue;
@@ -113,7 +119,7 @@ TEST(Refine, ASidewaysReadingThatTheMiddleLineFitsBetterIsLeft) {
   for (const auto& t : r.trace) ++rows[t.value];
   for (const auto& t : r.trace) {
     double x = 0, y = 0;
-    if (std::sscanf(t.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) continue;
+    if (!PayloadPlace(t, &x, &y)) continue;
     (y == 0 ? best_middle : best_moment) = std::max(y == 0 ? best_middle : best_moment, t.score);
     if (y != 0) moment_way.emplace_back(t.value, x, t.score);
     if (y == 0 && rows[t.value] >= 3 && t.score > middle_grid(2)) middle_grid << t.value, x, t.score;
@@ -236,10 +242,7 @@ TEST(Refine, ThePayloadsBestMassIsRecordedHalfAStepEitherSide) {
     std::vector<Eigen::Vector2d> points;  // (mass, forward offset)
     for (const RefineStep& step : r.trace) {
       double x = 0, y = 0;
-      if (std::isnan(step.score) || std::sscanf(step.knob.c_str(), "payload.mass_kg at (x %lf, y %lf) m", &x, &y) != 2) {
-        continue;
-      }
-      points.emplace_back(step.value, x);
+      if (!std::isnan(step.score) && PayloadPlace(step, &x, &y)) points.emplace_back(step.value, x);
     }
     int pairs = 0;
     for (const Eigen::Vector2d& a : points) {
