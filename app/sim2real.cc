@@ -2,6 +2,7 @@
 // measurement effects) explain it and how sure that is, the corrected model and the simulator
 // config at the named values (lib/sim2real/analysis.h, docs/sim2real.md).
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -34,6 +35,7 @@ struct Sim2RealArgs {
   int signature_executions = sim2real::CandidateOptions{}.executions_per_placement;
   bool step_drift_recheck = sim2real::AnalysisOptions{}.every_execution_on_step_drift;
   bool payload_half_steps = sim2real::RefineOptions{}.payload_half_steps;
+  double payload_middle_line_z = sim2real::RefineOptions{}.payload_middle_line_z;
   bool confirm_every_execution = sim2real::AnalysisOptions{}.every_execution_to_confirm;
   double confirm_from_z = sim2real::AnalysisOptions{}.every_execution_from_z;
   bool confirm_screened_only = sim2real::AnalysisOptions{}.confirm_screened_only;
@@ -163,6 +165,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
   o.refine.payload_half_steps = args.payload_half_steps;
+  o.refine.payload_middle_line_z = args.payload_middle_line_z;
   o.refine.selection.bootstrap_selection = args.bootstrap;
   o.adequacy.seed = args.seed;
   o.null_source = args.null_source == "drawn"      ? sim2real::NullSource::kDrawn
@@ -311,6 +314,17 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--payload-half-steps,!--no-payload-half-steps", args->payload_half_steps,
                 "after the payload's grid search, record its best mass half a grid step either side and at the "
                 "quadratic's maximum between (on by default; docs/sim2real.md)");
+  cmd->add_option("--payload-middle-line-z", args->payload_middle_line_z,
+                  "record the payload's first grid on the middle line beyond its centre unless that centre fits "
+                  "worse than the other way's best by this many standard errors (inf: always; docs/sim2real.md)")
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            char* end = nullptr;
+            const double z = std::strtod(text.c_str(), &end);
+            return end != text.c_str() && *end == 0 && z > 0 ? std::string() : "a number > 0 expected (inf: always)";
+          },
+          "Z > 0"));
   cmd->add_flag("--confirm-every-execution,!--no-confirm-every-execution", args->confirm_every_execution,
                 "when a knob is named from signatures of fewer executions per placement than the real set has, "
                 "record them again with every execution and analyse once more before naming it (on by default; "

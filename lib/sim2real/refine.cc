@@ -43,10 +43,11 @@ void RefineKnobs(const KnobSimulator& simulator, const AnalysisInputs& in, const
 
 bool RefineOptions::IsValid(std::string* error) const {
   if (refine_iterations < 0 || refine_knobs < 0 || payload_rounds < 0 || !(converged_within > 0) ||
-      !(payload_contender_share > 0 && payload_contender_share <= 1) || !(as_well_z > 0)) {
+      !(payload_contender_share > 0 && payload_contender_share <= 1) || !(as_well_z > 0) ||
+      !(payload_middle_line_z > 0)) {
     if (error) {
       *error = "refine_iterations >= 0, refine_knobs >= 0, payload_rounds >= 0, converged_within > 0, "
-               "payload_contender_share in (0, 1], as_well_z > 0";
+               "payload_contender_share in (0, 1], as_well_z > 0, payload_middle_line_z > 0";
     }
     return false;
   }

@@ -164,7 +164,8 @@ TEST(Sim2RealApp, BadInputIsOneLineAndNoOutput) {
         std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--legacy-resim"},
         std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--threads", "-1"},
         std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--null", "parametric"},
-        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--null-recordings", "1"}}) {
+        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--null-recordings", "1"},
+        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--payload-middle-line-z", "0"}}) {
     std::vector<std::string> full = {"sim2real", "-o", out.string()};
     full.insert(full.end(), args.begin(), args.end());
     RunResult r = RunDgmm(full);
