@@ -61,6 +61,16 @@ std::string RobotMjcfText(const SimConfig& config) {
   return text.str();
 }
 
+void AddFloorSolrefKnobs(const mjModel* m, int floor, std::vector<Knob>* knobs) {
+  const double tc = m->geom_solref[mjNREF * floor + 0];
+  const double dr = m->geom_solref[mjNREF * floor + 1];
+  if (!(tc > 0)) return;  // the standard (time constant, damping ratio) form only
+  knobs->push_back(MakeKnob(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s", tc,
+                            std::max(2.5 * m->opt.timestep, 0.25 * tc), 8 * tc, {3 * tc}));
+  knobs->push_back(MakeKnob(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "", dr, 0.1 * dr,
+                            4 * dr, {0.3 * dr}));
+}
+
 void AddTrackerNoiseKnob(const SimConfig& config, std::vector<Knob>* knobs) {
   const auto& n = config.noise;
   if (n.tracker_position_sd_m > 0 || n.tracker_yaw_sd_rad > 0 || n.tracker_roll_sd_rad > 0 ||
@@ -133,14 +143,7 @@ void AddFrictionKnobs(const mjModel* m, const SimConfig& config, std::vector<Kno
 }
 
 void AddFloorContactKnobs(const mjModel* m, int floor, std::vector<Knob>* knobs) {
-  const double tc = m->geom_solref[mjNREF * floor + 0];
-  const double dr = m->geom_solref[mjNREF * floor + 1];
-  if (tc > 0) {  // standard (time constant, damping ratio) form
-    knobs->push_back(MakeKnob(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s",
-                              tc, std::max(2.5 * m->opt.timestep, 0.25 * tc), 8 * tc, {3 * tc}));
-    knobs->push_back(MakeKnob(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "",
-                              dr, 0.1 * dr, 4 * dr, {0.3 * dr}));
-  }
+  AddFloorSolrefKnobs(m, floor, knobs);
   // solimp (dmin, dmax, width, midpoint, power); ranges widened to hold an unusual nominal.
   const double dmax = m->geom_solimp[mjNIMP * floor + 1];
   const double width = m->geom_solimp[mjNIMP * floor + 2];

@@ -96,6 +96,9 @@ std::string RobotMjcfText(const SimConfig& config);
 // Mass of the payload probes [kg]: 15% of the robot's mass (the model's, with a robot block).
 double PayloadProbeMass(const SimConfig& config);
 
+// The floor's contact softness shared by every robot (family "contact"): solref's time constant
+// and damping ratio as knobs when the floor geom uses the standard (positive time constant) form.
+void AddFloorSolrefKnobs(const mjModel_* m, int floor, std::vector<Knob>* knobs);
 // The measurement-side knob shared by every robot: appends tracker.noise_scale when config.noise
 // has any tracker noise, and applies a value of it (the four tracker sd's of `config` scaled into
 // out->noise; the IMU's untouched).

@@ -13,17 +13,6 @@
 namespace dgmm::sim {
 namespace {
 
-void AddContactKnobs(const mjModel* m, int floor, std::vector<Knob>* knobs) {
-  const double tc = m->geom_solref[mjNREF * floor + 0];
-  const double dr = m->geom_solref[mjNREF * floor + 1];
-  if (tc > 0) {
-    knobs->push_back(MakeKnob(KnobKind::kFloorSolrefTime, -1, "floor.solref.timeconst", "contact", "s", tc,
-                          std::max(2.5 * m->opt.timestep, 0.25 * tc), 8 * tc, {3 * tc}));
-    knobs->push_back(MakeKnob(KnobKind::kFloorSolrefDamping, -1, "floor.solref.dampratio", "contact", "", dr, 0.1 * dr,
-                          4 * dr, {0.3 * dr}));
-  }
-}
-
 // Per-leg gains (probe half the leg's gain) and per-side gains, probed at 0.4: the side probes
 // decide whether the per-leg probes are recorded at all (lib/sim2real/candidates.h), and at 0.6 a
 // leg at half its gain on the hexapod did not show through its side.
@@ -113,7 +102,7 @@ std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
   // under-predicted a factor of 0.35 so far that a wider tracker noise won the first step
   // (docs/simulation.md, "sim2real on a robot block's robot").
   knobs.push_back(MakeKnob(KnobKind::kFrictionScale, -1, "geoms.friction_scale", "friction", "", 1.0, 0.2, 2.0, {0.35, 0.6, 1.5}));
-  AddContactKnobs(m, bound.floor_geom, &knobs);
+  if (bound.floor_geom >= 0) AddFloorSolrefKnobs(m, bound.floor_geom, &knobs);
   knobs.push_back(MakeKnob(KnobKind::kMassScale, -1, "bodies.mass_scale", "mass", "", 1.0, 0.4, 2.5, {0.7, 1.4}));
   const double probe_kg = 0.15 * total_kg;
   const auto& p = config.payload;
