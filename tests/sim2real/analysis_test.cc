@@ -372,6 +372,16 @@ TEST(Analysis, TheStepDriftRecheckNamesWhatFewSignatureExecutionsReadAsADrift) {
   EXPECT_EQ(again.verdict.status, every_knob.verdict.status);
 }
 
+// The recordings made during each "selection and refinement" stage, from each stage's name and the
+// recordings made before it.
+std::vector<int> RecordedWhileSearching(const std::vector<std::pair<std::string, int>>& stages) {
+  std::vector<int> searched;
+  for (size_t i = 0; i + 1 < stages.size(); ++i) {
+    if (stages[i].first == "selection and refinement") searched.push_back(stages[i + 1].second - stages[i].second);
+  }
+  return searched;
+}
+
 // A first look from signatures of 2 of the real set's 5 executions whose name is recorded again
 // with every execution is a screen: it records nothing between its selection and its
 // confidence stage (no likelihood search), while the run again searches the knob it names.
@@ -385,10 +395,7 @@ TEST(Analysis, AFirstLookThatIsRecordedAgainSearchesNothing) {
   const Analysis a = Analyse(pair.sim, pair.real, &fake, options);
   ASSERT_NE(a.every_execution_because.find("a first look without likelihood searches named"), std::string::npos)
       << a.every_execution_because;
-  std::vector<int> searched;  // recordings during each "selection and refinement" stage
-  for (size_t i = 0; i + 1 < stages.size(); ++i) {
-    if (stages[i].first == "selection and refinement") searched.push_back(stages[i + 1].second - stages[i].second);
-  }
+  const std::vector<int> searched = RecordedWhileSearching(stages);
   ASSERT_EQ(searched.size(), 2u) << "a first look and a run again";
   EXPECT_EQ(searched[0], 0) << "the first look searched";
   EXPECT_GT(searched[1], 0) << "the run again did not search the friction";
@@ -401,6 +408,29 @@ TEST(Analysis, AFirstLookThatIsRecordedAgainSearchesNothing) {
   options.every_execution_to_confirm = true;
   options.candidates.executions_per_placement = 5;  // every execution already: no run again
   EXPECT_FALSE(FirstLookIsAScreen(a.inputs, options));
+}
+
+// A screened first look (no likelihood searches) that selected a knob but named none, with near
+// misses not confirmed (every_execution_from_z infinite): nothing is recorded again with every
+// execution, so the selection is searched afterwards, in a second "selection and refinement" stage.
+TEST(Analysis, AScreenThatSelectedButNamedNothingIsSearchedAfterwards) {
+  FakeSimulator fake;
+  FakeExtras extras;
+  extras.geometry = 0.03;
+  const auto pair = test::MakeFakePair(fake, {}, extras);
+  AnalysisOptions options = test::FastOptions();
+  options.every_execution_from_z = INFINITY;
+  std::vector<std::pair<std::string, int>> stages;
+  options.on_stage = [&](const std::string& name) { stages.emplace_back(name, fake.records()); };
+  const Analysis a = Analyse(pair.sim, pair.real, &fake, options);
+  ASSERT_TRUE(FirstLookIsAScreen(a.inputs, options));
+  ASSERT_TRUE(a.every_execution_because.empty()) << a.every_execution_because;
+  ASSERT_FALSE(a.refinement.selection.selected.empty()) << "the geometry is fitted by some knob";
+  ASSERT_TRUE(a.verdict.named.empty()) << a.verdict.sentence;
+  const std::vector<int> searched = RecordedWhileSearching(stages);
+  ASSERT_EQ(searched.size(), 2u) << "the screen's selection, then the search of what it selected";
+  EXPECT_EQ(searched[0], 0) << "the screen searched";
+  EXPECT_GT(searched[1], 0) << "the selection was not searched afterwards";
 }
 
 // What a first look screens in for the run again: a candidate's knob when it reached the z at some
