@@ -25,10 +25,10 @@
 // for a roll the real robot never had; but the reading's moment can itself be a linear reading's
 // artefact (a forward offset that bends the walk reads as a sideways one), and a search that keeps
 // it drives the mass up to make the moment's offset small. So the first grid is recorded twice,
-// once keeping the moment and once with the payload on the middle line (y = y_n) - the middle
-// line's beyond its centre only when that centre does not fit clearly worse than the first way's
-// best (MiddleLineContends) -, the search goes on along the better of the two, and once centred it records the other way at its best's mass
-// and offset, going on along that way when it fits better.
+// once keeping the moment and once with the payload on the middle line (y = y_n; beyond its
+// centre only when that centre does not fit clearly worse than the first way's best,
+// MiddleLineContends), the search goes on along the better of the two, and once centred it
+// records the other way at its best's mass and offset, going on along that way when it fits better.
 // While the best point lies on the grid's edge, a further grid is recorded around it (the points
 // already recorded reused; RefineOptions::payload_rounds such steps at most). A quadratic in
 // (log m, column) through the scores around the best gives the maximum, recorded once more
@@ -248,7 +248,7 @@ Walk WalkGrids(Search* s, Walk w) {
   for (int round = 0; round <= s->options.payload_rounds + crossed && !w.centred; ++round) {
     std::vector<PayloadPoint> fresh = GridAround(w.frame, w.grid, w.cu, w.cv, w.moment);
     const bool middle = round == 0 && w.frame.Sideways();
-    if (middle && !Known(w.grid, w.cu, w.cv, false)) fresh.push_back(w.frame.At(w.cu, w.cv, false));
+    if (middle) fresh.push_back(w.frame.At(w.cu, w.cv, false));  // a walk's grid is empty at round 0
     s->RecordAndScore(&fresh);
     w.grid.insert(w.grid.end(), fresh.begin(), fresh.end());
     if (middle && MiddleLineContends(*s, w.grid)) {
