@@ -316,7 +316,8 @@ void Setup(CLI::App& root) {
                 "quadratic's maximum between (on by default; docs/sim2real.md)");
   cmd->add_option("--payload-middle-line-z", args->payload_middle_line_z,
                   "record the payload's first grid on the middle line beyond its centre unless that centre fits "
-                  "worse than the other way's best by this many standard errors (inf: always; docs/sim2real.md)")
+                  "worse than the other way at its mass and offset by this many standard errors (inf: always; "
+                  "docs/sim2real.md)")
       ->capture_default_str()
       ->check(CLI::Validator(
           [](std::string& text) {

@@ -33,8 +33,8 @@ struct RefineOptions {
   // a grid of factor 1.6 alone left values up to a quarter off (false: the grid's best stands).
   bool payload_half_steps = true;
   // The first grid on the middle line (refine_payload.cc) beyond its centre is recorded unless that
-  // centre fits worse than the other way's best by at least this many standard errors (infinity:
-  // always recorded, as before 2026-12-03).
+  // centre fits worse than the other way's point at the same mass and offset by at least this many
+  // standard errors (infinity: always recorded, as before 2026-12-03).
   double payload_middle_line_z = 3.0;
   double converged_within = 0.1;  // |coefficient - 1| of a converged tracker-noise refinement
   // The payload is searched (refine_payload.cc) when selected, or when it is a contender: at the

@@ -44,18 +44,20 @@ PairedSum PairedDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b, c
   return out;
 }
 
+bool FitsAsWellAs(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const UnitIds& placements, double z,
+                  bool untold) {
+  if (a.size() != b.size() || placements.count < 2) return untold;
+  const PairedSum d = PairedDifference(a, b, placements);
+  const double bar = z * d.se;
+  return std::isnan(d.sum) || std::isnan(bar) ? untold : d.sum < bar;
+}
+
 std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, int best,
                                      const std::vector<int>& placement, double z) {
   const UnitIds units = NumberUnits(placement);
   std::vector<bool> out(rows.size(), false);
   for (size_t k = 0; k < rows.size(); ++k) {
-    if (static_cast<int>(k) == best) {
-      out[k] = true;
-      continue;
-    }
-    if (rows[k].size() != rows[best].size() || units.count < 2) continue;
-    const PairedSum deficit = PairedDifference(rows[best], rows[k], units);
-    out[k] = std::isfinite(deficit.sum) && deficit.sum < z * deficit.se;
+    out[k] = static_cast<int>(k) == best || FitsAsWellAs(rows[best], rows[k], units, z, false);
   }
   return out;
 }

@@ -44,6 +44,12 @@ struct PairedSum {
 };
 PairedSum PairedDifference(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const UnitIds& placements);
 
+// Does b fit the real samples as well as a? Its deficit D = sum_i (a_i - b_i) lies under z times
+// its standard error (PairedDifference). `untold` is the answer where that cannot be told: the
+// lengths differ, fewer than 2 placements, or D or z SE is not a number (z = inf with SE 0).
+bool FitsAsWellAs(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const UnitIds& placements, double z,
+                  bool untold);
+
 // Which searched points fit the real samples as well as the best one (`best`, included): those
 // whose deficit D = sum_i (l_best,i - l_i) is below z times its standard error (PairedDifference).
 // The recordings' own simulation noise is not counted, so the set errs on the narrow side.

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 namespace dgmm::sim2real {
@@ -61,6 +62,27 @@ TEST(RefineSearch, ALargerZAdmitsMorePoints) {
   r.rows.push_back(d);
   EXPECT_FALSE(FitAsWellAsTheBest(r.rows, 0, r.placement, 1.0)[1]);
   EXPECT_TRUE(FitAsWellAsTheBest(r.rows, 0, r.placement, 3.0)[1]);
+}
+
+// Where the deficit cannot be told (lengths differ, one placement, no spread with z infinite, not a
+// number), FitsAsWellAs answers what its caller asks for: "no" when collecting points that fit as
+// well, "yes" for the payload's middle line, which is recorded unless it clearly fits worse.
+TEST(RefineSearch, WhatCannotBeToldIsTheCallersAnswer) {
+  Rows r;
+  const UnitIds units = NumberUnits(r.placement);
+  const Eigen::VectorXd best = r.rows[0];
+  for (bool untold : {false, true}) {
+    EXPECT_EQ(FitsAsWellAs(best, Eigen::VectorXd::Zero(199), units, 2.0, untold), untold);
+    EXPECT_EQ(FitsAsWellAs(best, best, NumberUnits(std::vector<int>(200, 0)), 2.0, untold), untold);
+    EXPECT_EQ(FitsAsWellAs(best, best, units, INFINITY, untold), untold) << "SE 0 times infinity";
+    EXPECT_EQ(FitsAsWellAs(best, Eigen::VectorXd::Constant(200, NAN), units, 2.0, untold), untold);
+    EXPECT_FALSE(FitsAsWellAs(best, Eigen::VectorXd::Constant(200, -1.0), units, 2.0, untold))
+        << "a deficit with no spread is told";
+  }
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(200);
+  for (int g = 0; g < 40; ++g) d(5 * g) = g % 2 ? -2.0 : 1.0;  // 20 nats deficit, SE 9.5
+  EXPECT_TRUE(FitsAsWellAs(best, d, units, INFINITY, false));
+  EXPECT_FALSE(FitsAsWellAs(best, d, units, 1.0, true));
 }
 
 }  // namespace

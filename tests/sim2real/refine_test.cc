@@ -115,6 +115,26 @@ TEST(Refine, ThePayloadsSearchKeepsItsSidewaysMoment) {
   EXPECT_EQ(gated.refinement.payload_mass, all.refinement.payload_mass);
 }
 
+// The middle line's gate compares like with like: a payload behind the middle whose effect grows
+// as its mass squared, so the probes' linear reading puts it sideways at too light a mass. The
+// middle line's centre fits better than the other way at the same mass and offset, though worse
+// than that way's best at a heavier mass; the line's grid is recorded and the search ends on it
+// (held against the other way's best, the gate closed and the search named 0.11 m sideways).
+TEST(Refine, TheMiddleLinesGateComparesItsCentreAtTheSamePlace) {
+  test::FakeSimulator fake;
+  fake.payload.bend = 0.1;
+  fake.payload.power = 2;
+  const test::Stages s = test::RunStages(fake, {{test::kPayloadMass, 2.5}, {test::kPayloadX, -0.15}}, 4);
+  int middle = 0;
+  for (const auto& t : s.refinement.trace) {
+    double x = 0, y = 0;
+    middle += PayloadPlace(t, &x, &y) && y == 0;
+  }
+  EXPECT_GT(middle, 1) << "the middle line's grid beyond its centre";
+  EXPECT_EQ(s.refinement.payload_y, 0.0);
+  EXPECT_NEAR(s.refinement.payload_mass, 2.5, 0.25 * 2.5);
+}
+
 // A payload behind the middle on a fake whose forward offset bends the walk either way: the probes'
 // reading puts it sideways, the middle line fits better, and the search finds the mass there
 // (kept at the reading's moment, it would climb to shrink the moment's offset).
