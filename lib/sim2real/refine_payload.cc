@@ -26,9 +26,10 @@
 // artefact (a forward offset that bends the walk reads as a sideways one), and a search that keeps
 // it drives the mass up to make the moment's offset small. So the first grid is recorded twice,
 // once keeping the moment and once with the payload on the middle line (y = y_n; beyond its
-// centre only when that centre does not fit clearly worse than the first way at the same mass and offset,
-// MiddleLineContends), the search goes on along the better of the two, and once centred it
-// records the other way at its best's mass and offset, going on along that way when it fits better.
+// centre only when that centre does not fit clearly worse than the first way at the same mass
+// and offset, MiddleLineContends), the search goes on along the better of the two, and once
+// centred it records the other way at its best's mass and offset, going on along that way when
+// it fits better.
 // While the best point lies on the grid's edge, a further grid is recorded around it (the points
 // already recorded reused; RefineOptions::payload_rounds such steps at most). A quadratic in
 // (log m, column) through the scores around the best gives the maximum, recorded once more

@@ -130,7 +130,8 @@ TEST(Refine, TheMiddleLinesGateComparesItsCentreAtTheSamePlace) {
     double x = 0, y = 0;
     middle += PayloadPlace(t, &x, &y) && y == 0;
   }
-  EXPECT_GT(middle, 1) << "the middle line's grid beyond its centre";
+  EXPECT_GT(middle, 1) << "points on the middle line besides its centre (the former gate's crossing recorded some "
+                          "too: the sideways offset below is what tells the two gates apart)";
   EXPECT_EQ(s.refinement.payload_y, 0.0);
   EXPECT_NEAR(s.refinement.payload_mass, 2.5, 0.25 * 2.5);
 }
