@@ -8,6 +8,7 @@
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <string>
 #include <thread>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -276,6 +277,22 @@ void Run(const Sim2RealArgs& args) {
   std::cout << (args.json ? json : sim2real::ReportSummary(a, ctx, (std::filesystem::path(args.out) / "report.html").string()));
 }
 
+// A threshold in standard errors: a number above `lower` (or equal to it when `inclusive`), or inf,
+// which means `inf_means`; nan and text are refused.
+CLI::Validator ZThreshold(double lower, bool inclusive, const std::string& inf_means) {
+  const std::string bound = fmt::format("{} {}", inclusive ? ">=" : ">", lower);
+  return CLI::Validator(
+      [=](std::string& text) {
+        char* end = nullptr;
+        const double z = std::strtod(text.c_str(), &end);
+        const bool number = end != text.c_str() && *end == 0;
+        return number && (z > lower || (inclusive && z == lower))
+                   ? std::string()
+                   : fmt::format("a number {} expected (inf: {})", bound, inf_means);
+      },
+      "Z " + bound + " or inf");
+}
+
 void Setup(CLI::App& root) {
   auto args = std::make_shared<Sim2RealArgs>();
   CLI::App* cmd = root.add_subcommand(
@@ -318,22 +335,15 @@ void Setup(CLI::App& root) {
                   "record the payload's first grid on the middle line beyond its centre unless that centre fits "
                   "worse than the other way at its mass and offset by this many standard errors (inf: always; "
                   "docs/sim2real.md)")
-      ->capture_default_str()
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            char* end = nullptr;
-            const double z = std::strtod(text.c_str(), &end);
-            return end != text.c_str() && *end == 0 && z > 0 ? std::string() : "a number > 0 expected (inf: always)";
-          },
-          "Z > 0"));
+      ->capture_default_str()->check(ZThreshold(0.0, false, "always"));
   cmd->add_flag("--confirm-every-execution,!--no-confirm-every-execution", args->confirm_every_execution,
                 "when a knob is named from signatures of fewer executions per placement than the real set has, "
                 "record them again with every execution and analyse once more before naming it (on by default; "
                 "--no-confirm-every-execution keeps the first look; docs/sim2real.md)");
   cmd->add_option("--confirm-from-z", args->confirm_from_z,
                   "... and when nothing is named but the first look's best candidate reached this held-out z "
-                  "(a near miss; significance starts near 2.8)")
-      ->capture_default_str()->check(CLI::Range(0.0, 1e9));
+                  "(a near miss; significance starts near 2.8; inf: never)")
+      ->capture_default_str()->check(ZThreshold(0.0, true, "never"));
   cmd->add_flag("--confirm-screened-only,!--confirm-all-knobs", args->confirm_screened_only,
                 "the run again with every execution records only the knobs the first look screened in (held-out z "
                 "of at least --confirm-screen-z and --confirm-screen-share of the step's best at some selection "

@@ -165,7 +165,10 @@ TEST(Sim2RealApp, BadInputIsOneLineAndNoOutput) {
         std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--threads", "-1"},
         std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--null", "parametric"},
         std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--null-recordings", "1"},
-        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--payload-middle-line-z", "0"}}) {
+        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--payload-middle-line-z", "0"},
+        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--payload-middle-line-z", "nan"},
+        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--confirm-from-z", "-0.5"},
+        std::vector<std::string>{"--sim", Sim(), "--real", Real("null"), "--confirm-from-z", "2x"}}) {
     std::vector<std::string> full = {"sim2real", "-o", out.string()};
     full.insert(full.end(), args.begin(), args.end());
     RunResult r = RunDgmm(full);
@@ -174,6 +177,18 @@ TEST(Sim2RealApp, BadInputIsOneLineAndNoOutput) {
     EXPECT_LE(CountLines(r.err), 2) << r.err;
     EXPECT_FALSE(std::filesystem::exists(out)) << args.back();
   }
+}
+
+// Both z thresholds take inf (the middle line always recorded; near misses never confirmed): the
+// command gets past its flags to the first file it reads.
+TEST(Sim2RealApp, ZThresholdsTakeInfinity) {
+  const auto dir = MakeTempDir("sim2real-inf");
+  const auto missing = dir / "missing.h5";
+  const RunResult r = RunDgmm({"sim2real", "-o", (dir / "out").string(), "--sim", missing.string(), "--real",
+                               Real("null"), "--payload-middle-line-z", "inf", "--confirm-from-z", "inf"});
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.err.find(missing.string()), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("-z"), std::string::npos) << r.err;
 }
 
 }  // namespace
