@@ -54,6 +54,7 @@ struct Sim2RealArgs {
   bool runoff = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
+  double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
   std::string null_source = "auto";
   int null_recordings = sim2real::RecordedNullOptions{}.draws;
   bool locate_only = false;
@@ -162,6 +163,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.legs.sag_mode = args.leg_search_score == "sag";
   o.legs.only_with_tails = args.leg_search_on == "tails";
   o.legs.challenge_named = args.leg_search_on == "remaining";
+  o.legs.challenge_gap_closed = args.challenge_gap_closed;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -383,6 +385,10 @@ void Setup(CLI::App& root) {
                   "when it fits better), unexplained (only when nothing is named) or tails (only when nothing is "
                   "named and the residual has heavy tails)")
       ->capture_default_str()->check(CLI::IsMember({"tails", "unexplained", "remaining"}));
+  cmd->add_option("--challenge-gap-closed", args->challenge_gap_closed,
+                  "... and also when the named knobs' correction closed less than this share of the gap between "
+                  "the sim model and the ceiling")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
                "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");

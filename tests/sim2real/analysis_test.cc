@@ -117,8 +117,9 @@ TEST(Analysis, TheLegSearchChallengesNamedKnobsWhenAMismatchIsLeft) {
 }
 
 // The challenge also runs where the shortfall's SE is too wide to call the correction below the
-// ceiling but it closed little of the gap (hexapod pair 48105: an IMU offset named for a weak leg,
-// 6% of the gap closed); never for a named leg, an `explained` verdict or on uneven ground.
+// ceiling but it left a tenth of the gap or more (hexapod pair 48105: an IMU offset named for a weak
+// leg, 6% of the gap closed; sprawled quadruped 53202: a payload for a weak leg, 83%); never for a
+// named leg, an `explained` verdict or on uneven ground.
 TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
   Analysis a;
   a.candidates.candidates.resize(2);
@@ -129,6 +130,8 @@ TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
   a.adequacy.gap_closed = 0.06;
   const LegSearchOptions options;
   EXPECT_TRUE(WantLegSearch(a, options));
+  a.adequacy.gap_closed = 0.83;  // sprawled quadruped 53202: a payload named for a weak front_right leg
+  EXPECT_TRUE(WantLegSearch(a, options)) << "a tenth of the gap or more left";
   a.adequacy.gap_closed = 0.97;
   EXPECT_FALSE(WantLegSearch(a, options)) << "closed most of the gap and not below the ceiling";
   a.adequacy.below_ceiling = true;
