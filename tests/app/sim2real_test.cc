@@ -188,7 +188,8 @@ TEST(Sim2RealApp, ZThresholdsTakeInfinity) {
                                Real("null"), "--payload-middle-line-z", "inf", "--confirm-from-z", "inf"});
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.err.find(missing.string()), std::string::npos) << r.err;
-  EXPECT_EQ(r.err.find("-z"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("--confirm-from-z"), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("--payload-middle-line-z"), std::string::npos) << r.err;
 }
 
 }  // namespace
