@@ -9,7 +9,8 @@ that: it records a "sim" set of the nominal ground and "real" sets at boulder he
 the given factors (each at its own seed: its own places), and for each real set prints
 
     hang-up share = share of the samples of moving commands (the command's median planar travel in
-                    the sim set above 5 cm) that travel less than half that median,
+                    the sim set above a quarter of the largest command's: turns on the spot are
+                    left out whatever the robot's size) that travel less than half that median,
     z = (share_real - share_sim) / SE,  SE from the per-placement shares of both sets,
 
 so the placements, not the samples, are the units (a placement on a boulder hangs up in most of
@@ -56,7 +57,7 @@ def median_travel(path):
 def per_placement_hangups(path, reach):
     x, cmd, ep = load(path)
     r = np.array([reach.get(c, 0.0) for c in cmd])
-    moving = r > 0.05
+    moving = r > 0.25 * max(reach.values())
     hung = (np.hypot(x[:, 0], x[:, 1]) < 0.5 * r)[moving]
     ep = ep[moving]
     return np.array([hung[ep == u].mean() for u in np.unique(ep)])
