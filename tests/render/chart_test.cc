@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "tests/render/output_dir.h"
 #include "tests/render/png_pixels.h"
 #include "util/error.h"
 
@@ -11,12 +12,6 @@ namespace dgmm {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path TempPng(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("dgmm-chart-test-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
 
 // Pixels within +-20 of the colour in every channel (antialiasing blends edges).
 int CountColour(const test::PngImage& image, std::array<int, 3> rgb) {
@@ -40,7 +35,7 @@ TEST(ChartTest, LineChartDrawsEverySeriesAtTheRequestedSize) {
   spec.series.push_back({"improved", {0.01, 0.1, 1, 10}, {9, 5, 2, 2}, {}, {{213, 94, 0}}});
   spec.width = 500;
   spec.height = 400;
-  const fs::path png = TempPng("line.png");
+  const fs::path png = test::OutputPath("line.png");
   RenderLineChart(spec, png.string());
   const test::PngImage image = test::ReadPng(png.string());
   ASSERT_EQ(image.width, 500);
@@ -54,7 +49,7 @@ TEST(ChartTest, BarChartDrawsBars) {
   spec.title = "held-out log-likelihood";
   spec.categories = {"EM", "DGMM"};
   spec.series.push_back({"mean", {}, {-1.2, -1.5}, {0.1, 0.2}, {{0, 158, 115}}});
-  const fs::path png = TempPng("bar.png");
+  const fs::path png = test::OutputPath("bar.png");
   RenderBarChart(spec, png.string());
   const test::PngImage image = test::ReadPng(png.string());
   ASSERT_EQ(image.width, 800);
@@ -63,7 +58,7 @@ TEST(ChartTest, BarChartDrawsBars) {
 }
 
 TEST(ChartTest, InvalidSpecsThrowAndWriteNothing) {
-  const fs::path png = TempPng("bad.png");
+  const fs::path png = test::OutputPath("bad.png");
   fs::remove(png);
   LineChartSpec line;
   EXPECT_THROW(RenderLineChart(line, png.string()), InputError);  // no series

@@ -2,7 +2,6 @@
 // issue #11 (a peaked model as a black field, a spike setting the difference scale, panels with
 // their own scales, numeric axes where names belong, cut titles, faint dots, oversized windows).
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -10,18 +9,13 @@
 #include "render/density_grid.h"
 #include "render/heat_map.h"
 #include "render/text_fit.h"
+#include "tests/render/output_dir.h"
 #include "tests/render/png_pixels.h"
 
 namespace dgmm {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path Png(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("dgmm-scale-test-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
 
 // 80% of the weight in a narrow component, 20% in a broad one (peak densities 400:1): what one
 // dominant Gaussian of a DGMM looks like.
@@ -51,18 +45,18 @@ TEST(HeatMapScale, PeakedModelIsNotABlackField) {
   spec.width = 500;
   spec.height = 420;
   spec.color_scale = HeatMapSpec::ColorScale::kLinear;  // the old drawing
-  const PlotLayout linear = RenderHeatMap(spec, Png("linear.png").string());
-  const double linear_share = NonDarkShare(test::ReadPng(Png("linear.png").string()), linear);
+  const PlotLayout linear = RenderHeatMap(spec, test::OutputPath("linear.png").string());
+  const double linear_share = NonDarkShare(test::ReadPng(test::OutputPath("linear.png").string()), linear);
   spec.color_scale = HeatMapSpec::ColorScale::kAuto;
   EXPECT_EQ(ResolveColorScale(spec), HeatMapSpec::ColorScale::kLog);
-  const PlotLayout automatic = RenderHeatMap(spec, Png("auto.png").string());
-  const double auto_share = NonDarkShare(test::ReadPng(Png("auto.png").string()), automatic);
+  const PlotLayout automatic = RenderHeatMap(spec, test::OutputPath("auto.png").string());
+  const double auto_share = NonDarkShare(test::ReadPng(test::OutputPath("auto.png").string()), automatic);
   EXPECT_LT(linear_share, 0.1) << "the linear scale shows one bright spot";
   EXPECT_GT(auto_share, 0.4) << "the log scale shows where the broad component lies";
   // Quantile: every colour covers the same area, so half the plot is in the upper half.
   spec.color_scale = HeatMapSpec::ColorScale::kQuantile;
-  const PlotLayout quantile = RenderHeatMap(spec, Png("quantile.png").string());
-  EXPECT_GT(NonDarkShare(test::ReadPng(Png("quantile.png").string()), quantile), 0.5);
+  const PlotLayout quantile = RenderHeatMap(spec, test::OutputPath("quantile.png").string());
+  EXPECT_GT(NonDarkShare(test::ReadPng(test::OutputPath("quantile.png").string()), quantile), 0.5);
   // A broad model keeps the linear scale under auto.
   Mixture broad(2);
   broad.Add(1, Gaussian(Eigen::Vector2d(0, 0), Eigen::Matrix2d::Identity()));
@@ -80,12 +74,12 @@ TEST(HeatMapScale, DifferenceScaleIsSymmetricAndNotSetByOneSpike) {
   spec.palette = HeatMapSpec::Palette::kDiverging;
   spec.width = 500;
   spec.height = 420;
-  const PlotLayout l = RenderHeatMap(spec, Png("diff.png").string());
+  const PlotLayout l = RenderHeatMap(spec, test::OutputPath("diff.png").string());
   EXPECT_DOUBLE_EQ(l.color_min, -l.color_max);
   EXPECT_LT(l.color_max, 1.5) << "the 99th percentile of |diff|, not the spike";
   EXPECT_GT(l.color_max, 0.9);
   // x = 0.7 reads as clearly red (with the spike's scale it was all but grey).
-  const test::PngImage image = test::ReadPng(Png("diff.png").string());
+  const test::PngImage image = test::ReadPng(test::OutputPath("diff.png").string());
   const Eigen::Vector2d px = l.ToPixel(0.7, -0.5);
   const int r = static_cast<int>(px(1)), c = static_cast<int>(px(0));
   EXPECT_GT(image.red(r, c), image.blue(r, c) + 80);
@@ -104,10 +98,10 @@ TEST(HeatMapScale, BeforeAndAfterPanelsShareOneScale) {
     p->height = 380;
     p->color_max = pa.background.values.maxCoeff();
   }
-  const auto layouts = RenderHeatMapRow({pa, pb}, Png("shared.png").string());
+  const auto layouts = RenderHeatMapRow({pa, pb}, test::OutputPath("shared.png").string());
   EXPECT_EQ(layouts[0].color_max, layouts[1].color_max);
   // B's peak is a quarter of A's: on the shared scale it is clearly darker than A's.
-  const test::PngImage image = test::ReadPng(Png("shared.png").string());
+  const test::PngImage image = test::ReadPng(test::OutputPath("shared.png").string());
   const Eigen::Vector2d pa_px = layouts[0].ToPixel(0, 0), pb_px = layouts[1].ToPixel(0, 0);
   EXPECT_GT(image.luminance(static_cast<int>(pa_px(1)), static_cast<int>(pa_px(0))),
             image.luminance(static_cast<int>(pb_px(1)), static_cast<int>(pb_px(0))) + 60);
@@ -123,7 +117,7 @@ TEST(HeatMapScale, CategoryAxesAndAxisTitlesAreDrawn) {
   spec.y_label = "command";
   spec.width = 520;
   spec.height = 400;
-  const PlotLayout l = RenderHeatMap(spec, Png("categories.png").string());
+  const PlotLayout l = RenderHeatMap(spec, test::OutputPath("categories.png").string());
   EXPECT_EQ(l.x_ticks, spec.x_categories);
   EXPECT_EQ(l.y_ticks, spec.y_categories);
   EXPECT_EQ(l.x_title, "terrain region");
@@ -148,9 +142,9 @@ TEST(HeatMapScale, CategoryLabelsOfNeighboursDoNotOverlap) {
   for (bool row : {false, true}) {
     std::vector<PlotLayout> layouts;
     if (row) {
-      layouts = RenderHeatMapRow({spec, spec}, Png("label_row.png").string());
+      layouts = RenderHeatMapRow({spec, spec}, test::OutputPath("label_row.png").string());
     } else {
-      layouts = {RenderHeatMap(spec, Png("labels.png").string())};
+      layouts = {RenderHeatMap(spec, test::OutputPath("labels.png").string())};
     }
     for (const PlotLayout& l : layouts) {
       ASSERT_EQ(l.x_tick_boxes.size(), 3u);
@@ -213,10 +207,10 @@ TEST(HeatMapScale, LongTitlesFitTheImage) {
   spec.title = title;
   spec.width = 520;
   spec.height = 420;
-  const PlotLayout l = RenderHeatMap(spec, Png("title.png").string());
+  const PlotLayout l = RenderHeatMap(spec, test::OutputPath("title.png").string());
   EXPECT_NE(l.title.find('\n'), std::string::npos);
   // Nothing dark touches the left or right edge in the title band (a cut title does).
-  const test::PngImage image = test::ReadPng(Png("title.png").string());
+  const test::PngImage image = test::ReadPng(test::OutputPath("title.png").string());
   for (int r = image.height - 40; r < image.height; ++r) {
     for (int c : {0, 1, 2, image.width - 3, image.width - 2, image.width - 1}) {
       EXPECT_GT(image.luminance(r, c), 200) << "row " << r << " col " << c;
@@ -240,8 +234,8 @@ TEST(HeatMapScale, DataPointsAreVisibleAndInsideTheWindow) {
   spec.points = points;
   spec.width = 500;
   spec.height = 420;
-  const PlotLayout l = RenderHeatMap(spec, Png("points.png").string());
-  const test::PngImage image = test::ReadPng(Png("points.png").string());
+  const PlotLayout l = RenderHeatMap(spec, test::OutputPath("points.png").string());
+  const test::PngImage image = test::ReadPng(test::OutputPath("points.png").string());
   // The far points sit on the dark end of the ramp, drawn in cyan: clearly blue-green.
   for (int i = 1; i < 3; ++i) {
     const Eigen::Vector2d px = l.ToPixel(points(i, 0), points(i, 1));

@@ -4,6 +4,7 @@
 
 #include <filesystem>
 
+#include "tests/render/output_dir.h"
 #include "tests/render/png_pixels.h"
 #include "util/error.h"
 
@@ -11,12 +12,6 @@ namespace dgmm {
 namespace {
 
 namespace fs = std::filesystem;
-
-fs::path TempPng(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("dgmm-render-test-" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir / name;
-}
 
 // The densest bump (weight 3 at (1, 2)) dominates; a weaker one sits at (-1.5, -1).
 Mixture TwoBumps() {
@@ -46,7 +41,7 @@ constexpr double kModePixelTol = 8.0;
 
 TEST(HeatMapTest, PngHasRequestedSizeAndBrightestRegionAtTheMode) {
   const Mixture m = TwoBumps();
-  const fs::path png = TempPng("single.png");
+  const fs::path png = test::OutputPath("single.png");
   const PlotLayout layout = RenderHeatMap(SpecOf(m, 640, 480), png.string());
   const test::PngImage image = test::ReadPng(png.string());
   ASSERT_EQ(image.width, 640);
@@ -83,7 +78,7 @@ TEST(HeatMapTest, DiffRowPutsPanelsSideBySideWithSignedColours) {
   diff.palette = HeatMapSpec::Palette::kDiverging;
   diff.contours.clear();
   diff.points.resize(0, 2);
-  const fs::path png = TempPng("row.png");
+  const fs::path png = test::OutputPath("row.png");
   const auto layouts = RenderHeatMapRow({pa, pb, diff}, png.string());
   const test::PngImage image = test::ReadPng(png.string());
   ASSERT_EQ(image.width, 1200);
@@ -108,7 +103,7 @@ TEST(HeatMapTest, DiffRowPutsPanelsSideBySideWithSignedColours) {
 }
 
 TEST(HeatMapTest, InvalidSpecThrowsAndWritesNothing) {
-  const fs::path png = TempPng("invalid.png");
+  const fs::path png = test::OutputPath("invalid.png");
   fs::remove(png);
   HeatMapSpec spec = SpecOf(TwoBumps(), 640, 480);
   spec.background.values(3, 4) = NAN;

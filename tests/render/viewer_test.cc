@@ -4,7 +4,6 @@
 #include "render/viewer.h"
 
 #include <gtest/gtest.h>
-#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -14,6 +13,7 @@
 
 #include "render/heat_map.h"
 #include "render/slice_figure.h"
+#include "tests/render/output_dir.h"
 #include "tests/render/png_pixels.h"
 
 namespace dgmm {
@@ -22,7 +22,7 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path TempDir() {
-  fs::path dir = fs::temp_directory_path() / ("dgmm-viewer-test-" + std::to_string(::getpid()));
+  const fs::path dir = test::OutputPath("viewer");
   fs::create_directories(dir);
   return dir;
 }
