@@ -41,6 +41,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim2real/quadratic_peak.h"
 #include "sim2real/refine.h"
 #include "sim2real/refine_search.h"
 #include "sim2real/sentence_format.h"
@@ -85,26 +86,6 @@ bool Inside(const std::vector<PayloadPoint>& grid, const PayloadPoint& p) {
     ulo = std::min(ulo, q.u), uhi = std::max(uhi, q.u), vlo = std::min(vlo, q.v), vhi = std::max(vhi, q.v);
   }
   return ulo < p.u && p.u < uhi && vlo < p.v && p.v < vhi;
-}
-
-// The maximum of ll = a + b u + c v + d u^2 + e v^2 + g u v fitted to the points (u, v, ll), within
-// |u| <= u_max, |v| <= v_max; false when the fit is not concave.
-bool QuadraticMaximum(const std::vector<Eigen::Vector3d>& pts, double u_max, double v_max, double* u, double* v) {
-  Eigen::MatrixXd a(pts.size(), 6);
-  Eigen::VectorXd y(pts.size());
-  for (size_t i = 0; i < pts.size(); ++i) {
-    const double pu = pts[i](0), pv = pts[i](1);
-    a.row(i) << 1, pu, pv, pu * pu, pv * pv, pu * pv;
-    y(i) = pts[i](2);
-  }
-  const Eigen::VectorXd q = a.colPivHouseholderQr().solve(y);
-  Eigen::Matrix2d h;
-  h << 2 * q(3), q(5), q(5), 2 * q(4);
-  if (!(h(0, 0) < 0 && h.determinant() > 0)) return false;
-  const Eigen::Vector2d s = -h.inverse() * Eigen::Vector2d(q(1), q(2));
-  *u = std::clamp(s(0), -u_max, u_max);
-  *v = std::clamp(s(1), -v_max, v_max);
-  return true;
 }
 
 // The search's frame: the probes' linear reading (added mass t0 (probe - nominal), offsets t1 / t0
@@ -330,19 +311,11 @@ void RecordHalfSteps(Search* s, Walk* w) {
   }
   s->RecordAndScore(&halves);
   w->grid.insert(w->grid.end(), halves.begin(), halves.end());
-  const std::vector<const PayloadPoint*> near = column();
-  if (near.size() < 3) return;
-  Eigen::MatrixXd a(near.size(), 3);
-  Eigen::VectorXd y(near.size());
-  for (size_t i = 0; i < near.size(); ++i) {
-    const double du = near[i]->u - best.u;
-    a.row(i) << 1, du, du * du;
-    y(i) = near[i]->score;
-  }
-  const Eigen::Vector3d q = a.colPivHouseholderQr().solve(y);
-  if (!(q(2) < 0)) return;
-  const double u = best.u + std::clamp(-q(1) / (2 * q(2)), -0.5, 0.5);
-  if (!unrecorded(u)) return;
+  std::vector<Eigen::Vector2d> near;
+  for (const PayloadPoint* p : column()) near.emplace_back(p->u - best.u, p->score);
+  double du = 0;
+  if (!QuadraticPeak(near, 0.5, &du) || !unrecorded(best.u + du)) return;
+  const double u = best.u + du;
   std::vector<PayloadPoint> peak = {at_offset(u)};
   s->RecordAndScore(&peak);
   w->grid.push_back(peak[0]);
