@@ -25,6 +25,10 @@ def load(path):
     return f["commands/values"][:], f["command"][:], f["x"][:]
 
 
+def text(attr):
+    return attr.decode() if isinstance(attr, bytes) else attr
+
+
 def pooled(a, b):
     """The samples of two recordings with the same command table."""
     return a[0], np.concatenate([a[1], b[1]]), np.concatenate([a[2], b[2]])
@@ -75,7 +79,7 @@ def main():
         for pattern in a.patterns.split(","):
             cfg = json.loads(json.dumps(base))
             cfg["slope_deg"] = slope
-            cfg["robot"]["gait"]["pattern"] = pattern
+            cfg["robot"].setdefault("gait", {})["pattern"] = pattern
             path = os.path.join(tmp, f"{pattern}_{slope:g}.json")
             json.dump(cfg, open(path, "w"))
             out = os.path.join(tmp, f"{pattern}_{slope:g}.h5")
@@ -86,12 +90,14 @@ def main():
                 json.dump(cfg, open(path, "w"))
                 record(dgmm, path, out, a.seed)
                 data = pooled(data, load(out))
-            # The leg reach the simulator derived from the model (set metadata).
-            reach_attr = h5py.File(out, "r")["metadata"].attrs["robot_leg_reach_m"]
-            reach = float(reach_attr.decode() if isinstance(reach_attr, bytes) else reach_attr)
-            g = cfg["robot"]["gait"]
-            stride = g.get("stride_m") or g["stride_reach"] * reach
-            cycles = cfg["command_duration_s"] / g["period_s"]
+            # The leg reach the simulator derived from the model and the gait as it ran, defaults
+            # filled in (set metadata): a config may leave out any gait length.
+            meta = h5py.File(out, "r")["metadata"].attrs
+            reach = float(text(meta["robot_leg_reach_m"]))
+            ran = json.loads(text(meta["sim_config"]))
+            g = ran["robot"]["gait"]
+            stride = g["stride_m"] or g["stride_reach"] * reach
+            cycles = ran["command_duration_s"] / g["period_s"]
             rows = rows_of(data, stride, g["turn_rad"], cycles)
             if header is None:
                 header = sorted(rows)

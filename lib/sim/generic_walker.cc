@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "sim/gait_reach.h"
 #include "sim/ground.h"
 #include "sim/simulator.h"
 #include "util/error.h"
@@ -170,9 +171,7 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   std::vector<Eigen::Vector3d> targets(n);
   for (std::size_t i = 0; i < n; ++i) {
     const LegChain& leg = robot_.legs[i];
-    const Eigen::Vector2d p = leg.stance_m.head<2>();
-    const Eigen::Vector2d d = duty * (robot_.stride_m * Eigen::Vector2d(c.x(), c.y()) +
-                                      config_.robot->gait.turn_rad * c.z() * Eigen::Vector2d(-p.y(), p.x()));
+    const Eigen::Vector2d d = FootTravel(robot_, leg, c, config_.robot->gait.turn_rad);
     targets[i] = robot_.robot_in_torso *
                  (leg.stance_m + lean - sway + envelope * FootOffset(u[i], duty, d, robot_.step_height_m));
   }

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "sim/actuation_line.h"
+#include "sim/gait_reach.h"
 #include "sim/generic_walker.h"
 #include "sim/ground.h"
 #include "sim/mujoco_model.h"
@@ -224,7 +225,12 @@ std::vector<Eigen::Vector3d> Simulator::FootPositions() const {
 
 std::vector<std::string> Simulator::ScaleWarnings() const {
   const SimConfig& c = impl_->config;
-  if (!c.terrain) return {};
+  std::vector<std::string> out;
+  if (impl_->walker && impl_->walker->robot().replay.empty()) {
+    const LeggedRobot& robot = impl_->walker->robot();
+    out = GaitReachWarnings(MeasureGaitMisses(impl_->walker->model(), robot, c.robot->gait.turn_rad), robot);
+  }
+  if (!c.terrain) return out;
   double stance = c.gait.stance_height_m, foot = 0;
   if (impl_->walker) {
     stance = impl_->walker->robot().stance_height_m;
@@ -232,7 +238,8 @@ std::vector<std::string> Simulator::ScaleWarnings() const {
   } else {
     for (const LegGeometry& leg : impl_->parts.legs) foot = std::max(foot, leg.foot_radius_m);
   }
-  std::vector<std::string> out = TerrainScaleWarnings(*c.terrain, stance, foot);
+  const std::vector<std::string> terrain = TerrainScaleWarnings(*c.terrain, stance, foot);
+  out.insert(out.end(), terrain.begin(), terrain.end());
   const double half = placement_half_width_m(), reach = leg_reach_m();
   if (half + 2 * reach > c.terrain->half_size_m) {
     char what[200];

@@ -86,8 +86,8 @@ class Simulator {
   const std::array<LegGeometry, kNumLegs>& legs() const;
   const SimConfig& config() const;
 
-  // Advice on the config against this robot's scale (terrain.h TerrainScaleWarnings); empty
-  // when nothing is far off.
+  // Advice on the config against this robot's scale (terrain.h TerrainScaleWarnings) and, for a
+  // robot block's gait, steps its legs cannot make (gait_reach.h); empty when nothing is far off.
   std::vector<std::string> ScaleWarnings() const;
 
   // Physics steps since construction in which the robot touched itself (two of its bodies in
