@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <set>
 
 #include "sim/replay.h"
@@ -222,7 +223,43 @@ void ChooseLengths(const RobotDescription& r, LeggedRobot* b, const std::string&
   b->step_height_m = g.step_height_m > 0 ? g.step_height_m : g.step_height_reach * b->reach_m;
 }
 
-// Every foot must reach its stance point: inverse kinematics from the rest pose.
+// Starts for the stance's inverse kinematics when the rest pose does not lead there (damped least
+// squares is local: it stops where a joint meets its limit or a leg is straight): the middle of
+// every joint's range, then draws within the ranges from a fixed seed (the stance is part of the
+// robot's description). Unlimited joints span +-pi/2 rad (slides +-reach) about the rest pose.
+std::vector<Eigen::VectorXd> StanceStarts(const mjModel* m, const LegChain& leg, int draws) {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Eigen::VectorXd> starts;
+  for (int s = 0; s <= draws; ++s) {
+    Eigen::VectorXd q = leg.stance_q;
+    for (int k = 0; k < q.size(); ++k) {
+      const int j = leg.joints[k];
+      const double span = m->jnt_type[j] == mjJNT_SLIDE ? leg.reach_m : M_PI / 2;
+      const double lo = m->jnt_limited[j] ? m->jnt_range[2 * j] : q[k] - span;
+      const double hi = m->jnt_limited[j] ? m->jnt_range[2 * j + 1] : q[k] + span;
+      q[k] = s == 0 ? 0.5 * (lo + hi) : lo + unit(rng) * (hi - lo);
+    }
+    starts.push_back(q);
+  }
+  return starts;
+}
+
+// The names of the leg's joints that sit at a limit of their range at q.
+std::string JointsAtLimits(const mjModel* m, const LegChain& leg, const Eigen::VectorXd& q) {
+  std::string names;
+  for (int k = 0; k < q.size(); ++k) {
+    const int j = leg.joints[k];
+    const double tol = 1e-6 * (1 + std::abs(q[k]));
+    if (!m->jnt_limited[j] || (q[k] > m->jnt_range[2 * j] + tol && q[k] < m->jnt_range[2 * j + 1] - tol)) continue;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    names += (names.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)");
+  }
+  return names;
+}
+
+// Every foot must reach its stance point: inverse kinematics from the rest pose, else from other
+// starts (StanceStarts); refused with the joints that end at their limits.
 void SolveStance(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* b) {
   MjDataPtr d(mj_makeData(m));
   if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
@@ -230,12 +267,23 @@ void SolveStance(const mjModel* m, const RobotDescription& r, const std::string&
   for (std::size_t i = 0; i < b->legs.size(); ++i) {
     LegChain& leg = b->legs[i];
     leg.stance_m.z() = -b->stance_height_m;
-    const double residual = SolveLegIk(m, d.get(), leg, b->robot_in_torso * leg.stance_m, &leg.stance_q, 200);
-    if (residual > 0.05 * leg.reach_m) {
+    const Eigen::Vector3d target = b->robot_in_torso * leg.stance_m;
+    const double tolerance = 0.05 * leg.reach_m;
+    double residual = SolveLegIk(m, d.get(), leg, target, &leg.stance_q, 200);
+    if (residual <= tolerance) continue;
+    for (Eigen::VectorXd q : StanceStarts(m, leg, 16)) {
+      const double from_here = SolveLegIk(m, d.get(), leg, target, &q, 200, true);
+      if (from_here < residual) residual = from_here, leg.stance_q = q;
+      if (residual <= tolerance) break;
+    }
+    if (residual > tolerance) {
+      const std::string limits = JointsAtLimits(m, leg, leg.stance_q);
       char what[160];
-      std::snprintf(what, sizeof what, "the foot cannot reach the ground %.3g m below the torso (off by %.3g m)",
+      std::snprintf(what, sizeof what, "the foot cannot reach the ground %.3g m below the torso (off by %.3g m",
                     b->stance_height_m, residual);
-      throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]), what);
+      throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]),
+                           what + (limits.empty() ? std::string(")") : "; at their range limits: " + limits + ")") +
+                               ": check the joint ranges, or give the model a keyframe with the legs as they stand");
     }
   }
 }
@@ -273,8 +321,35 @@ Eigen::Vector3d FootPoint(const mjModel* m, const mjData* d, const LegChain& leg
   return Vec(d->xpos + 3 * leg.foot_body) + Mat(d->xmat + 9 * leg.foot_body) * leg.foot_offset_m;
 }
 
+namespace {
+
+// dq = J' (J J' + lambda^2 I)^-1 e
+Eigen::VectorXd DampedStep(const Eigen::MatrixXd& j, const Eigen::Vector3d& e, double lambda) {
+  const Eigen::Matrix3d a = j * j.transpose() + lambda * lambda * Eigen::Matrix3d::Identity();
+  return j.transpose() * a.ldlt().solve(e);
+}
+
+// Zeroes the Jacobian's columns of joints at a limit that dq pushes further out (they cannot move,
+// and the others must not count on them); true when any was.
+bool PinLimited(const mjModel* m, const LegChain& leg, const Eigen::VectorXd& q, const Eigen::VectorXd& dq,
+                Eigen::MatrixXd* j) {
+  bool pinned = false;
+  for (int k = 0; k < q.size(); ++k) {
+    const int jn = leg.joints[k];
+    if (!m->jnt_limited[jn]) continue;
+    if ((q[k] <= m->jnt_range[2 * jn] && dq[k] < 0) || (q[k] >= m->jnt_range[2 * jn + 1] && dq[k] > 0)) {
+      j->col(k).setZero();
+      pinned = true;
+    }
+  }
+  return pinned;
+}
+
+}  // namespace
+
 double SolveLegsIk(const mjModel* m, mjData* d, const std::vector<LegChain>& legs,
-                   const std::vector<Eigen::Vector3d>& targets, std::vector<Eigen::VectorXd>* q, int iterations) {
+                   const std::vector<Eigen::Vector3d>& targets, std::vector<Eigen::VectorXd>* q, int iterations,
+                   bool limits_pin) {
   std::vector<mjtNum> jacp(3 * m->nv);
   std::vector<bool> done(legs.size(), false);
   double worst = 0;
@@ -301,8 +376,8 @@ double SolveLegsIk(const mjModel* m, mjData* d, const std::vector<LegChain>& leg
         for (int r = 0; r < 3; ++r) j(r, k) = jacp[r * m->nv + leg.dofs[k]];
       }
       const double lambda = 0.02 * std::max(leg.reach_m, 1e-3);
-      const Eigen::Matrix3d a = j * j.transpose() + lambda * lambda * Eigen::Matrix3d::Identity();
-      Eigen::VectorXd dq = j.transpose() * a.ldlt().solve(e);
+      Eigen::VectorXd dq = DampedStep(j, e, lambda);
+      if (limits_pin && PinLimited(m, leg, (*q)[l], dq, &j)) dq = DampedStep(j, e, lambda);
       const double max_step = 0.3;  // rad (or m for slides) per iteration
       if (dq.cwiseAbs().maxCoeff() > max_step) dq *= max_step / dq.cwiseAbs().maxCoeff();
       for (int k = 0; k < n; ++k) {
@@ -318,9 +393,9 @@ double SolveLegsIk(const mjModel* m, mjData* d, const std::vector<LegChain>& leg
 }
 
 double SolveLegIk(const mjModel* m, mjData* d, const LegChain& leg, const Eigen::Vector3d& target,
-                  Eigen::VectorXd* q, int iterations) {
+                  Eigen::VectorXd* q, int iterations, bool limits_pin) {
   std::vector<Eigen::VectorXd> qs = {*q};
-  const double residual = SolveLegsIk(m, d, {leg}, {target}, &qs, iterations);
+  const double residual = SolveLegsIk(m, d, {leg}, {target}, &qs, iterations, limits_pin);
   *q = qs[0];
   return residual;
 }

@@ -64,13 +64,17 @@ void AddPayload(mjModel* model, int torso, const Eigen::Vector3d& p_m, double ma
 // Damped least squares on the foot's Jacobian restricted to the leg's joints, joint ranges
 // respected: moves `q` (the leg's joint values) towards placing the foot at `target_m` (torso
 // frame) in `iterations` steps, using `scratch` (torso at the origin). Returns the residual (m).
+// With `limits_pin`, a step that would push a joint beyond its limit is solved again without that
+// joint (the others do not count on it; the stance's search from other starts). Without it a
+// joint is only clamped, as the gait has always done (its recordings stay bit-identical).
 double SolveLegIk(const mjModel* model, mjData* scratch, const LegChain& leg, const Eigen::Vector3d& target_m,
-                  Eigen::VectorXd* q, int iterations);
+                  Eigen::VectorXd* q, int iterations, bool limits_pin = false);
 
 // The same for every leg at once (one forward-kinematics pass per iteration: the legs' chains are
 // independent); returns the largest residual.
 double SolveLegsIk(const mjModel* model, mjData* scratch, const std::vector<LegChain>& legs,
-                   const std::vector<Eigen::Vector3d>& targets_m, std::vector<Eigen::VectorXd>* q, int iterations);
+                   const std::vector<Eigen::Vector3d>& targets_m, std::vector<Eigen::VectorXd>* q, int iterations,
+                   bool limits_pin = false);
 
 // Foot point of a leg in the world frame of `data`.
 Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegChain& leg);

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <sstream>
 #include <unistd.h>
 
@@ -253,6 +254,48 @@ TEST(LeggedRobot, BadRobotsAreRefusedNamingThePart) {
          "robot.legs[2] (rear_left).foot.geom");
   // A gait for another number of legs.
   expect(ErrorOf("", "", [](RobotDescription* r) { r->gait.pattern = "trot"; }), "needs 4 legs");
+}
+
+// The planar quadruped (datasets/robots/planar_quadruped.json) with its knees' range `range`,
+// written to a temporary MJCF.
+SimConfig PlanarWithKneeRange(const std::string& range) {
+  std::string xml = ReadText(kRobots / "planar_quadruped.xml");
+  for (auto at = xml.find("range=\"-10 120\""); at != std::string::npos; at = xml.find("range=\"-10 120\"", at)) {
+    xml.replace(at, 15, "range=\"" + range + "\"");
+  }
+  const fs::path path = fs::temp_directory_path() / ("dgmm_planar_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  SimConfig c = LoadSimConfig((kRobots / "planar_quadruped.json").string());
+  c.mjcf_path = path.string();
+  return c;
+}
+
+// Knees that bend the other way (range -120 to 10 degrees): from the rest pose, straight legs,
+// damped least squares pushes each knee into its 10 degree limit and the hip to -60 (0.195 m off),
+// and the robot was refused as if its feet could not reach the ground. Other starts find the stance.
+TEST(LeggedRobot, TheStanceIsFoundWhenTheRestPoseLeadsAJointIntoItsLimit) {
+  const SimConfig c = PlanarWithKneeRange("-120 10");
+  std::unique_ptr<Simulator> sim;
+  ASSERT_NO_THROW(sim = std::make_unique<Simulator>(c));
+  fs::remove(c.mjcf_path);
+  ASSERT_EQ(sim->Place(0, 0, 0), RunOutcome::kCompleted);
+  for (const Eigen::Vector3d& foot : sim->FootPositions()) EXPECT_LT(foot.z(), 0.03);  // on the ground
+  EXPECT_GT(sim->TorsoPose().position_m.z(), 0.15);  // standing on them: the stance height is 0.2 m
+}
+
+// Knees that hardly bend (range -1 to 1 degree) cannot lift the feet to the stance height: refused,
+// and the message names the joint held at its limit.
+TEST(LeggedRobot, AFootThatCannotReachNamesTheJointsAtTheirLimits) {
+  const SimConfig c = PlanarWithKneeRange("-1 1");
+  std::string error;
+  try {
+    Simulator sim(c);
+  } catch (const std::exception& e) {
+    error = e.what();
+  }
+  fs::remove(c.mjcf_path);
+  EXPECT_NE(error.find("robot.legs[0] (fl): the foot cannot reach the ground"), std::string::npos) << error;
+  EXPECT_NE(error.find("at their range limits: fl_knee"), std::string::npos) << error;
 }
 
 TEST(LeggedRobot, TheSprawledQuadrupedTrotsOnItsPassiveAnkles) {
