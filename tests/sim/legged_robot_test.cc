@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <unistd.h>
 
@@ -82,6 +83,59 @@ TEST(LeggedRobot, TheHexapodWalksAsCommandedOnFlatGround) {
   const Eigen::Matrix3d turn = before.rotation.transpose() * sim.TorsoPose().rotation;
   const double yaw = std::atan2(turn(1, 0), turn(0, 0));
   EXPECT_NEAR(yaw / (-0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
+}
+
+// The hexapod modelled facing +y: every leg's mount turned 90 degrees about the torso's z (position
+// and yaw) and the torso box turned with it, robot.forward_axis [0, 1, 0]. Each (command, placement)
+// must do what it does on the hexapod facing +x: the same physics seen from a turned torso frame.
+SimConfig HexapodFacingY(const fs::path& path) {
+  std::string xml = ReadText(kRobots / "hexapod.xml");
+  const std::regex mount(R"re(_coxa" pos="([-0-9.]+) ([-0-9.]+) 0" euler="0 0 ([-0-9.]+)")re");
+  std::string turned;
+  auto from = xml.cbegin();
+  int legs = 0;
+  for (std::sregex_iterator it(xml.begin(), xml.end(), mount), end; it != end; ++it, ++legs) {
+    const std::smatch& m = *it;
+    turned.append(from, m[0].first);
+    char text[120];
+    std::snprintf(text, sizeof text, "_coxa\" pos=\"%g %g 0\" euler=\"0 0 %g\"", -std::stod(m[2]), std::stod(m[1]),
+                  std::stod(m[3]) + 90);
+    turned += text;
+    from = m[0].second;
+  }
+  turned.append(from, xml.cend());
+  EXPECT_EQ(legs, 6);
+  const std::string box = "size=\"0.15 0.075 0.025\"";
+  turned.replace(turned.find(box), box.size(), "size=\"0.075 0.15 0.025\"");
+  std::ofstream(path) << turned;
+  SimConfig c = Hexapod();
+  c.mjcf_path = path.string();
+  c.robot->forward_axis = Eigen::Vector3d::UnitY();
+  return c;
+}
+
+// Travel (robot frame: forward, left) and yaw of one command from a placement at the origin.
+Eigen::Vector3d Travel(Simulator& sim, const Eigen::Vector3d& command) {
+  EXPECT_EQ(sim.Place(0, 0, 0), RunOutcome::kCompleted);
+  const Pose start = sim.TorsoPose();
+  EXPECT_EQ(sim.RunCommand(command), RunOutcome::kCompleted);
+  const Eigen::Vector3d moved = start.rotation.transpose() * (sim.TorsoPose().position_m - start.position_m);
+  const Eigen::Matrix3d turn = start.rotation.transpose() * sim.TorsoPose().rotation;
+  return Eigen::Vector3d(moved.x(), moved.y(), std::atan2(turn(1, 0), turn(0, 0)));
+}
+
+TEST(LeggedRobot, TheForwardAxisTurnsTheRobotsFrame) {
+  const fs::path path = fs::temp_directory_path() / ("dgmm_facing_y_" + std::to_string(::getpid()) + ".xml");
+  Simulator facing_x(Hexapod()), facing_y(HexapodFacingY(path));
+  fs::remove(path);
+  EXPECT_NEAR(facing_y.leg_reach_m(), facing_x.leg_reach_m(), 1e-9);
+  for (const Eigen::Vector3d& command : {Eigen::Vector3d(0.5, 0, 0), Eigen::Vector3d(0, -0.5, 0),
+                                         Eigen::Vector3d(0, 0, 0.5)}) {
+    const Eigen::Vector3d x = Travel(facing_x, command), y = Travel(facing_y, command);
+    EXPECT_LT((y.head<2>() - x.head<2>()).norm(), 0.01) << "command " << command.transpose() << ": " << y.transpose()
+                                                         << " facing +y, " << x.transpose() << " facing +x";
+    EXPECT_NEAR(y.z(), x.z(), 0.02) << "command " << command.transpose();
+  }
 }
 
 TEST(LeggedRobot, TheModelsOwnPhysicsIsKeptExceptWhatTheExperimentSets) {
@@ -256,13 +310,14 @@ TEST(LeggedRobot, BadRobotsAreRefusedNamingThePart) {
   expect(ErrorOf("", "", [](RobotDescription* r) { r->gait.pattern = "trot"; }), "needs 4 legs");
 }
 
-// The planar quadruped (datasets/robots/planar_quadruped.json) with its knees' range `range`,
-// written to a temporary MJCF.
-SimConfig PlanarWithKneeRange(const std::string& range) {
+// The planar quadruped (datasets/robots/planar_quadruped.json) with its knees' range `range` and
+// `extra` before the model's end (e.g. a keyframe), written to a temporary MJCF.
+SimConfig PlanarWithKneeRange(const std::string& range, const std::string& extra = "") {
   std::string xml = ReadText(kRobots / "planar_quadruped.xml");
   for (auto at = xml.find("range=\"-10 120\""); at != std::string::npos; at = xml.find("range=\"-10 120\"", at)) {
     xml.replace(at, 15, "range=\"" + range + "\"");
   }
+  xml.insert(xml.rfind("</mujoco>"), extra);
   const fs::path path = fs::temp_directory_path() / ("dgmm_planar_" + std::to_string(::getpid()) + ".xml");
   std::ofstream(path) << xml;
   SimConfig c = LoadSimConfig((kRobots / "planar_quadruped.json").string());
@@ -281,6 +336,25 @@ TEST(LeggedRobot, TheStanceIsFoundWhenTheRestPoseLeadsAJointIntoItsLimit) {
   ASSERT_EQ(sim->Place(0, 0, 0), RunOutcome::kCompleted);
   for (const Eigen::Vector3d& foot : sim->FootPositions()) EXPECT_LT(foot.z(), 0.03);  // on the ground
   EXPECT_GT(sim->TorsoPose().position_m.z(), 0.15);  // standing on them: the stance height is 0.2 m
+}
+
+// A model whose joints at zero lie outside their ranges (knees from 20 to 120 degrees) and whose
+// standing pose is its first keyframe (knees at 60 degrees), as public quadruped models are
+// written: the rest pose, the stance height and the reach come from the keyframe. Standing on
+// straighter legs than the keyframe's would put the torso higher.
+TEST(LeggedRobot, TheFirstKeyframeIsTheRestPose) {
+  const std::string key = "<keyframe><key qpos='0 0 0.2 1 0 0 0 -0.5 1.05 -0.5 1.05 -0.5 1.05 -0.5 1.05'/></keyframe>";
+  const SimConfig with_key = PlanarWithKneeRange("20 120", key);
+  Simulator crouched(with_key);
+  fs::remove(with_key.mjcf_path);
+  const SimConfig without = PlanarWithKneeRange("20 120");
+  Simulator upright(without);
+  fs::remove(without.mjcf_path);
+  EXPECT_NEAR(crouched.leg_reach_m(), upright.leg_reach_m(), 1e-9);  // link by link: the same legs
+  ASSERT_EQ(crouched.Place(0, 0, 0), RunOutcome::kCompleted);
+  ASSERT_EQ(upright.Place(0, 0, 0), RunOutcome::kCompleted);
+  EXPECT_LT(crouched.TorsoPose().position_m.z(), upright.TorsoPose().position_m.z() - 0.02)
+      << crouched.TorsoPose().position_m.z() << " m with the keyframe";
 }
 
 // Knees that hardly bend (range -1 to 1 degree) cannot lift the feet to the stance height: refused,
