@@ -63,6 +63,19 @@ double ExtentBelow(const mjModel* m, const mjData* d, int g) {
   }
 }
 
+// How far the foot's contact reaches below its foot point: a geom foot's own extent; for a site or a
+// body foot, the lowest point of the colliding geoms on the foot's body and the bodies below it.
+double FootExtent(const mjModel* m, const mjData* d, const LegChain& leg, const Eigen::Vector3d& foot) {
+  if (leg.foot_geom >= 0) return ExtentBelow(m, d, leg.foot_geom);
+  double extent = 0;
+  for (int g = 0; g < m->ngeom; ++g) {
+    const int body = m->geom_bodyid[g];
+    if ((m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) || !IsDescendant(m, body, leg.foot_body)) continue;
+    extent = std::max(extent, foot.z() - (d->geom_xpos[3 * g + 2] - ExtentBelow(m, d, g)));
+  }
+  return extent;
+}
+
 void BindFoot(const mjModel* m, const FootDescription& foot, const std::string& part, const std::string& source,
               LegChain* leg) {
   if (!foot.site.empty()) {
@@ -187,7 +200,7 @@ void MeasureRest(const mjModel* m, const RobotDescription& r, const std::string&
     }
     const Eigen::Vector3d foot = FootPoint(m, d.get(), leg);
     leg.reach_m += (foot - last).norm();
-    leg.foot_extent_m = leg.foot_geom >= 0 ? ExtentBelow(m, d.get(), leg.foot_geom) : 0;
+    leg.foot_extent_m = FootExtent(m, d.get(), leg, foot);
     const Eigen::Vector3d in_robot = bound->robot_in_torso.transpose() * foot;
     const int side = in_robot.y() >= 0 ? 1 : -1;
     const std::string& declared = r.legs[i].side;

@@ -138,6 +138,43 @@ TEST(LeggedRobot, TheForwardAxisTurnsTheRobotsFrame) {
   }
 }
 
+// The torso's height at release (no settling) with every foot given as the hexapod's foot geoms,
+// as sites at those geoms' centres, or as the tibia bodies with the centres as offsets.
+double ReleaseHeight(const std::string& foot_kind) {
+  std::string xml = ReadText(kRobots / "hexapod.xml");
+  const std::string centre = "0.03 0 -0.16";  // every foot geom's centre in its tibia's frame
+  SimConfig c = Hexapod();
+  for (auto& leg : c.robot->legs) {
+    const std::string geom = leg.foot.geom, at = "<geom name=\"" + geom + "\"";
+    if (foot_kind == "site") {
+      xml.insert(xml.find(at), "<site name=\"" + leg.name + "_tip\" pos=\"" + centre + "\"/>");
+      leg.foot = {};
+      leg.foot.site = leg.name + "_tip";
+    } else if (foot_kind == "body") {
+      leg.foot = {};
+      leg.foot.body = leg.name + "_tibia";
+      leg.foot.offset_m = Eigen::Vector3d(0.03, 0, -0.16);
+    }
+  }
+  const fs::path path = fs::temp_directory_path() / ("dgmm_feet_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  c.mjcf_path = path.string();
+  c.settle_duration_s = 0;
+  Simulator sim(c);
+  fs::remove(path);
+  EXPECT_EQ(sim.Place(0, 0, 0), RunOutcome::kCompleted);
+  return sim.TorsoPose().position_m.z();
+}
+
+// A site or body foot has no shape of its own: its contact reach below the foot point is the
+// colliding geoms' on its body (the capsules and boxes 1 cm and 0.8 cm below the centres). Until
+// 2026-12-03 it was taken as 0 and such a robot was released with its feet 1 cm in the ground.
+TEST(LeggedRobot, SiteAndBodyFeetArePlacedAsTheirGeomsAre) {
+  const double geom = ReleaseHeight("geom");
+  EXPECT_NEAR(ReleaseHeight("site"), geom, 1e-9);
+  EXPECT_NEAR(ReleaseHeight("body"), geom, 1e-9);
+}
+
 TEST(LeggedRobot, TheModelsOwnPhysicsIsKeptExceptWhatTheExperimentSets) {
   const SimConfig c = Hexapod(10);
   MjModelPtr original = LoadRobotModel(c);
