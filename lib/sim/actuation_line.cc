@@ -11,6 +11,12 @@ ActuationLine::ActuationLine(const mjModel* m, std::vector<int> actuators, int l
     const bool servo = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0;
     const bool joint = m->actuator_trntype[a] == mjTRN_JOINT;
     backlash_qpos_.push_back(servo && joint ? m->jnt_qposadr[m->actuator_trnid[2 * a]] : -1);
+    // A servo at rest where gain ctrl + b0 + b1 gear q = 0: ctrl = -(b0 + b1 gear q) / gain.
+    const double gain = m->actuator_gainprm[mjNGAIN * a];
+    const bool mapped = servo && joint && m->actuator_gaintype[a] == mjGAIN_FIXED && gain != 0;
+    const double* b = m->actuator_biasprm + mjNBIAS * a;
+    ctrl_scale_.push_back(mapped ? -b[1] * m->actuator_gear[6 * a] / gain : 1.0);
+    ctrl_offset_.push_back(mapped ? -b[0] / gain : 0.0);
   }
   seen_ = Eigen::VectorXd::Zero(static_cast<int>(actuators_.size()));
 }
@@ -39,6 +45,7 @@ void ActuationLine::Write(mjData* d) const {
       const double e = u - q;
       u = q + std::copysign(std::max(0.0, std::abs(e) - half_backlash_), e);
     }
+    if (ctrl_scale_[i] != 1.0 || ctrl_offset_[i] != 0.0) u = ctrl_offset_[i] + ctrl_scale_[i] * u;
     d->ctrl[actuators_[i]] = u;
   }
 }

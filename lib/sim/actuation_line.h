@@ -1,8 +1,10 @@
 #pragma once
 // Internal to dgmm_sim (includes MuJoCo): actuator signals on their way to the actuators. A value
-// sent now reaches them latency_steps physics steps later; position targets of joint servos pass
-// the backlash dead band ctrl = q + sign(e) max(0, |e| - b/2), e = target - q (MuJoCo's position
-// actuator then applies kp (ctrl - q)). Used by the generic gait and the replay controller.
+// sent now reaches them latency_steps physics steps later; position targets of joint servos are
+// joint values (rad or m) that pass the backlash dead band q' = q + sign(e) max(0, |e| - b/2),
+// e = target - q, and reach the servo as the ctrl at which it holds the joint at q': for MuJoCo's
+// position actuator ctrl = gear q' (it applies kp (ctrl - gear q)), for any affine servo
+// ctrl = -(b0 + b1 gear q') / gain. Used by the generic gait and the replay controller.
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Core>
@@ -27,6 +29,7 @@ class ActuationLine {
  private:
   std::vector<int> actuators_;
   std::vector<int> backlash_qpos_;  // per signal: the joint's qpos address, or -1 (no dead band)
+  std::vector<double> ctrl_scale_, ctrl_offset_;  // per signal: ctrl = offset + scale x target
   std::vector<Eigen::VectorXd> pending_;  // ring; pending_[head_] is the oldest
   int head_ = 0;
   Eigen::VectorXd seen_;

@@ -1,6 +1,6 @@
 // A robot driven by replayed actuator signals (robot.controller type replay: lib/sim/replay.h,
-// generic_walker.h) and the actuation line both controllers share (actuation_line.h), on the
-// project's mammal-shaped quadruped (datasets/robots/mammal_quadruped) and small variants.
+// generic_walker.h; the actuation line both controllers share is tested in actuation_line_test.cc),
+// on the project's mammal-shaped quadruped (datasets/robots/mammal_quadruped) and small variants.
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
@@ -10,7 +10,6 @@
 #include <sstream>
 #include <unistd.h>
 
-#include "sim/actuation_line.h"
 #include "sim/generic_walker.h"
 #include "sim/ground.h"
 #include "sim/protocol.h"
@@ -198,28 +197,6 @@ TEST(Replay, TorquesGoToMotorsThroughTheLatency) {
   EXPECT_EQ(ctrl[3], 0.0);  // still what the stand sent
   EXPECT_NEAR(ctrl[10], 2 * (10 - 5 + 1) * dt, 1e-9);
   EXPECT_NEAR(ctrl[20], 2 * (20 - 5 + 1) * dt, 1e-9);
-}
-
-TEST(ActuationLine, DelaysBySteppingAndAppliesTheDeadBandToJointServos) {
-  const char* xml = R"(<mujoco><worldbody><body><joint name="j" type="hinge"/><geom size="0.1"/></body></worldbody>
-                       <actuator><position name="servo" joint="j" kp="10"/><motor name="motor" joint="j"/></actuator></mujoco>)";
-  Scratch s;
-  char error[200] = "";
-  MjModelPtr model(mj_loadXML(s.Write("line.xml", xml).c_str(), nullptr, error, sizeof error));
-  ASSERT_TRUE(model) << error;
-  MjDataPtr data(mj_makeData(model.get()));
-  ActuationLine line(model.get(), {0, 1}, 2, 0.2);
-  line.Reset(Eigen::Vector2d(0.0, 0.0));
-  line.Send(Eigen::Vector2d(1.0, 5.0));
-  line.Write(data.get());
-  EXPECT_DOUBLE_EQ(data->ctrl[1], 0.0);  // two steps of latency: not yet
-  line.Send(Eigen::Vector2d(1.0, 5.0));
-  line.Write(data.get());
-  EXPECT_DOUBLE_EQ(data->ctrl[1], 0.0);
-  line.Send(Eigen::Vector2d(1.0, 5.0));
-  line.Write(data.get());
-  EXPECT_DOUBLE_EQ(data->ctrl[1], 5.0);  // the motor's torque passes unchanged
-  EXPECT_DOUBLE_EQ(data->ctrl[0], 0.9);  // the servo's target, q = 0, less half the backlash
 }
 
 }  // namespace
