@@ -17,9 +17,11 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v6";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v7";
 // v6: a recording runs in chunks of this many placements, each with its own random stream, so
-// one recording can use several threads (sim::ProtocolOptions::chunk_placements).
+// one recording can use several threads (sim::ProtocolOptions::chunk_placements). v7: a servo
+// gets the ctrl that holds its joint at the target (through its gear), and a site or body foot
+// is placed by its body's geoms (recordings of geared servos or such feet changed; others not).
 constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {
