@@ -59,7 +59,17 @@ double ExtentBelow(const mjModel* m, const mjData* d, int g) {
     case mjGEOM_CYLINDER: return s[0] * std::sqrt(std::max(0.0, 1 - z.z() * z.z())) + s[1] * std::abs(z.z());
     case mjGEOM_BOX: return s[0] * std::abs(z.x()) + s[1] * std::abs(z.y()) + s[2] * std::abs(z.z());
     case mjGEOM_ELLIPSOID: return Eigen::Vector3d(s[0] * z.x(), s[1] * z.y(), s[2] * z.z()).norm();
-    default: return m->geom_rbound[g];  // meshes and the rest: the bounding sphere
+    case mjGEOM_MESH: {  // its lowest vertex (vertices in the geom's frame)
+      const int mesh = m->geom_dataid[g];
+      if (mesh < 0 || m->mesh_vertnum[mesh] == 0) return m->geom_rbound[g];
+      double below = -INFINITY;
+      for (int v = 0; v < m->mesh_vertnum[mesh]; ++v) {
+        const float* p = m->mesh_vert + 3 * (m->mesh_vertadr[mesh] + v);
+        below = std::max(below, -(z.x() * p[0] + z.y() * p[1] + z.z() * p[2]));
+      }
+      return below;
+    }
+    default: return m->geom_rbound[g];  // height fields, planes: the bounding sphere
   }
 }
 

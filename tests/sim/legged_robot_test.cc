@@ -310,6 +310,34 @@ TEST(LeggedRobot, FootExtentForCapsuleAndBoxFeet) {
   EXPECT_NEAR(bound.reach_m, 0.297, 0.01);
 }
 
+// A mesh foot reaches below its centre as far as its lowest vertex, not its bounding sphere: the
+// hexapod's middle box feet (0.032 x 0.032 x 0.016 m) given as meshes of the same box reach 0.008 m
+// (the bounding sphere's 0.024 m was used until 2026-12-03: the robot was released 1.6 cm high).
+TEST(LeggedRobot, AMeshFootReachesAsFarAsItsLowestVertex) {
+  std::string xml = ReadText(kRobots / "hexapod.xml");
+  const std::string box = R"(type="box" pos="0.03 0 -0.16" size="0.016 0.016 0.008")";
+  for (auto at = xml.find(box); at != std::string::npos; at = xml.find(box, at)) {
+    xml.replace(at, box.size(), R"(type="mesh" mesh="pad" pos="0.03 0 -0.16")");
+  }
+  const auto head = xml.find("<worldbody>");
+  xml.insert(head, R"(<asset><mesh name="pad" vertex="-0.016 -0.016 -0.008  0.016 -0.016 -0.008  0.016 0.016 -0.008
+    -0.016 0.016 -0.008  -0.016 -0.016 0.008  0.016 -0.016 0.008  0.016 0.016 0.008  -0.016 0.016 0.008"/></asset>)");
+  const fs::path path = fs::temp_directory_path() / ("dgmm_mesh_feet_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  SimConfig c = Hexapod();
+  c.mjcf_path = path.string();
+  MjModelPtr m = LoadRobotModel(c);
+  fs::remove(path);
+  const LeggedRobot bound = BindRobot(m.get(), *c.robot, "hexapod with mesh feet");
+  int meshes = 0;
+  for (const auto& leg : bound.legs) {
+    if (m->geom_type[leg.foot_geom] != mjGEOM_MESH) continue;
+    ++meshes;
+    EXPECT_NEAR(leg.foot_extent_m, 0.008, 1e-6) << leg.name;
+  }
+  EXPECT_EQ(meshes, 2);
+}
+
 TEST(LeggedRobot, BadRobotsAreRefusedNamingThePart) {
   auto expect = [](const std::string& error, const std::string& part) {
     EXPECT_NE(error.find(part), std::string::npos) << "expected \"" << part << "\" in: " << error;
