@@ -73,15 +73,27 @@ double ExtentBelow(const mjModel* m, const mjData* d, int g) {
   }
 }
 
-// How far the foot's contact reaches below its foot point: a geom foot's own extent; for a site or a
-// body foot, the lowest point of the colliding geoms on the foot's body and the bodies below it.
-double FootExtent(const mjModel* m, const mjData* d, const LegChain& leg, const Eigen::Vector3d& foot) {
-  if (leg.foot_geom >= 0) return ExtentBelow(m, d, leg.foot_geom);
-  double extent = 0;
+// Can geom g touch geom f? MuJoCo's filter (either's contype meets the other's conaffinity) or an
+// explicit <pair> of the two.
+bool CanTouch(const mjModel* m, int g, int f) {
+  if ((m->geom_contype[g] & m->geom_conaffinity[f]) || (m->geom_contype[f] & m->geom_conaffinity[g])) return true;
+  for (int p = 0; p < m->npair; ++p) {
+    if ((m->pair_geom1[p] == g && m->pair_geom2[p] == f) || (m->pair_geom1[p] == f && m->pair_geom2[p] == g)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+// How far the foot's contact reaches below its foot point: a geom foot's own extent when it can
+// touch the floor; else (a site, a body, a visual geom) the lowest point of the geoms on the foot's
+// body and the bodies below it that can. -1 when none can.
+double FootExtent(const mjModel* m, const mjData* d, const LegChain& leg, const Eigen::Vector3d& foot, int floor) {
+  if (leg.foot_geom >= 0 && CanTouch(m, leg.foot_geom, floor)) return ExtentBelow(m, d, leg.foot_geom);
+  double extent = -1;
   for (int g = 0; g < m->ngeom; ++g) {
-    const int body = m->geom_bodyid[g];
-    if ((m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0) || !IsDescendant(m, body, leg.foot_body)) continue;
-    extent = std::max(extent, foot.z() - (d->geom_xpos[3 * g + 2] - ExtentBelow(m, d, g)));
+    if (!IsDescendant(m, m->geom_bodyid[g], leg.foot_body) || !CanTouch(m, g, floor)) continue;
+    extent = std::max({extent, 0.0, foot.z() - (d->geom_xpos[3 * g + 2] - ExtentBelow(m, d, g))});
   }
   return extent;
 }
@@ -210,7 +222,14 @@ void MeasureRest(const mjModel* m, const RobotDescription& r, const std::string&
     }
     const Eigen::Vector3d foot = FootPoint(m, d.get(), leg);
     leg.reach_m += (foot - last).norm();
-    leg.foot_extent_m = FootExtent(m, d.get(), leg, foot);
+    leg.foot_extent_m = FootExtent(m, d.get(), leg, foot, bound->floor_geom);
+    if (leg.foot_extent_m < 0) {
+      const char* body = mj_id2name(m, mjOBJ_BODY, leg.foot_body);
+      throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]) + ".foot",
+                           std::string("no geom of body \"") + (body ? body : "(unnamed)") +
+                               "\" or below it can touch the floor (their contype/conaffinity and the floor's "
+                               "do not meet, and no <pair> joins them)");
+    }
     const Eigen::Vector3d in_robot = bound->robot_in_torso.transpose() * foot;
     const int side = in_robot.y() >= 0 ? 1 : -1;
     const std::string& declared = r.legs[i].side;

@@ -371,6 +371,12 @@ TEST(LeggedRobot, BadRobotsAreRefusedNamingThePart) {
   // A missing foot.
   expect(ErrorOf("", "", [](RobotDescription* r) { r->legs[2].foot.geom = "no_such_foot"; }),
          "robot.legs[2] (rear_left).foot.geom");
+  // A foot whose body has no geom that can touch the floor (visual geoms only).
+  expect(ErrorOf(R"(<geom type="capsule" fromto="0 0 0 0.03 0 -0.15" size="0.01" mass="0.05" rgba="0.5 0.5 0.55 1"/>
+            <geom name="front_left_foot" type="capsule")",
+                 R"(<geom type="capsule" fromto="0 0 0 0.03 0 -0.15" size="0.01" mass="0.05" contype="0" conaffinity="0"/>
+            <geom name="front_left_foot" contype="0" conaffinity="0" type="capsule")"),
+         "robot.legs[0] (front_left).foot: no geom of body \"front_left_tibia\" or below it can touch the floor");
   // A gait for another number of legs.
   expect(ErrorOf("", "", [](RobotDescription* r) { r->gait.pattern = "trot"; }), "needs 4 legs");
 }
