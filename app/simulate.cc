@@ -57,11 +57,11 @@ void RunSimulate(const SimulateArgs& args) {
       config, options,
       [](long long done, long long total) { ReportProgress("simulate: placement", done, total); },
       &summary);
+  for (const std::string& w : summary.warnings) Warn(args.config_path + ": " + w);  // they may say why
   if (set.size() == 0) {
     throw MakeInputError(args.config_path, "", "every placement fell; nothing to write (" +
                                                    summary.BriefReport() + ")");
   }
-  for (const std::string& w : summary.warnings) Warn(args.config_path + ": " + w);
   WriteSampleSet(set, args.output);
   if (args.json) {
     nlohmann::json j = {{"output", args.output},

@@ -8,6 +8,7 @@
 
 #include "sim/actuation_line.h"
 #include "sim/gait_reach.h"
+#include "sim/stance_load.h"
 #include "sim/generic_walker.h"
 #include "sim/ground.h"
 #include "sim/mujoco_model.h"
@@ -229,6 +230,12 @@ std::vector<std::string> Simulator::ScaleWarnings() const {
   if (impl_->walker && impl_->walker->robot().replay.empty()) {
     const LeggedRobot& robot = impl_->walker->robot();
     out = GaitReachWarnings(MeasureGaitMisses(impl_->walker->model(), robot, c.robot->gait.turn_rad), robot);
+  }
+  if (impl_->walker) {
+    const LeggedRobot& robot = impl_->walker->robot();
+    const mjModel* m = impl_->walker->model();
+    const std::vector<std::string> load = StanceLoadWarnings(MeasureStanceLoad(m, robot), m, robot);
+    out.insert(out.end(), load.begin(), load.end());
   }
   if (!c.terrain) return out;
   double stance = c.gait.stance_height_m, foot = 0;

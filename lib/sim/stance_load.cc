@@ -1,0 +1,67 @@
+#include "sim/stance_load.h"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace dgmm::sim {
+namespace {
+
+// The largest force or torque actuator a can put on its joint: its force range times its gear
+// (0: not limited).
+double ActuatorLimit(const mjModel* m, int a) {
+  if (!m->actuator_forcelimited[a]) return 0;
+  const double range = std::max(std::abs(m->actuator_forcerange[2 * a]), std::abs(m->actuator_forcerange[2 * a + 1]));
+  return range * std::abs(m->actuator_gear[6 * a]);
+}
+
+}  // namespace
+
+StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
+  MjDataPtr d(mj_makeData(m));
+  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
+  for (int k = 0; k < 7; ++k) d->qpos[robot.torso_qpos + k] = k == 3 ? 1 : 0;
+  for (const LegChain& leg : robot.legs) {
+    for (std::size_t k = 0; k < leg.qpos.size(); ++k) d->qpos[leg.qpos[k]] = leg.stance_q[k];
+  }
+  mj_kinematics(m, d.get());
+  mj_comPos(m, d.get());
+  double mass = 0;
+  for (int b = 1; b < m->nbody; ++b) mass += m->body_mass[b];
+  StanceLoad worst;
+  worst.feet = std::max(1.0, robot.legs.size() * robot.timing.duty);
+  const double g = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]).norm();
+  const Eigen::Vector3d force(0, 0, mass * g / worst.feet);  // the ground's push on each foot
+  std::vector<mjtNum> jacp(3 * m->nv);
+  for (std::size_t i = 0; i < robot.legs.size(); ++i) {
+    const LegChain& leg = robot.legs[i];
+    const Eigen::Vector3d foot = FootPoint(m, d.get(), leg);
+    mj_jac(m, d.get(), jacp.data(), nullptr, foot.data(), leg.foot_body);
+    for (std::size_t k = 0; k < leg.joints.size() && k < leg.actuators.size(); ++k) {
+      const double limit = ActuatorLimit(m, leg.actuators[k]);
+      if (!(limit > 0)) continue;
+      double tau = 0;
+      for (int r = 0; r < 3; ++r) tau += jacp[r * m->nv + leg.dofs[k]] * force[r];
+      if (worst.joint < 0 || std::abs(tau) / limit > worst.needed / worst.limit) {
+        worst.leg = static_cast<int>(i), worst.joint = leg.joints[k], worst.needed = std::abs(tau), worst.limit = limit;
+      }
+    }
+  }
+  return worst;
+}
+
+std::vector<std::string> StanceLoadWarnings(const StanceLoad& load, const mjModel* m, const LeggedRobot& robot) {
+  if (load.joint < 0 || load.needed <= load.limit) return {};
+  const char* joint = mj_id2name(m, mjOBJ_JOINT, load.joint);
+  char what[400];
+  std::snprintf(what, sizeof what,
+                "robot: its actuators cannot carry it: with its weight on %.3g feet (the gait's duty factor) joint "
+                "\"%s\" of leg %s needs %.3g at the stance, and its actuator gives at most %.3g (force range x gear); "
+                "expect it to sink or fall. Raise the actuators' force range, or stand lower or wider "
+                "(robot.gait.stance_height_m)",
+                load.feet, joint ? joint : "(unnamed)", robot.legs[load.leg].name.c_str(), load.needed, load.limit);
+  return {what};
+}
+
+}  // namespace dgmm::sim
