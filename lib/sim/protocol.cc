@@ -278,7 +278,7 @@ struct PlanRun {
   std::map<int, long long> self_contact_by_command;  // steps in contact per command
   std::string self_contact_pair;
   double simulated_seconds = 0;
-  std::vector<std::string> scale_warnings;  // of the robot as simulated
+  std::vector<std::string> robot_warnings;  // of the robot as simulated
   double total_mass_kg = 0, leg_reach_m = 0;
 };
 
@@ -343,7 +343,7 @@ void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOption
   }
   out->simulated_seconds = sim.time_s();
   out->self_contact_pair = sim.SelfContactPair();
-  out->scale_warnings = sim.ScaleWarnings();
+  out->robot_warnings = sim.RobotWarnings();
   out->total_mass_kg = sim.total_mass_kg();
   out->leg_reach_m = sim.leg_reach_m();
 }
@@ -367,7 +367,7 @@ void Append(PlanRun&& part, PlanRun* all) {
     all->self_contact_pair = part.self_contact_pair;  // the first run with contacts names the pair
   }
   all->simulated_seconds += part.simulated_seconds;
-  all->scale_warnings = part.scale_warnings;
+  all->robot_warnings = part.robot_warnings;
   all->total_mass_kg = part.total_mass_kg;
   all->leg_reach_m = part.leg_reach_m;
 }
@@ -420,7 +420,7 @@ void FinishRecording(const SimConfig& config, const ProtocolOptions& options, in
   FillSamples(run.rec, sensed, set);
   *sum = run.sum;
   sum->samples = set->size();
-  sum->warnings = run.scale_warnings;
+  sum->warnings = run.robot_warnings;
   if (sum->self_contact_executions > 0) {
     const auto worst =
         std::max_element(run.self_contact_by_command.begin(), run.self_contact_by_command.end(),

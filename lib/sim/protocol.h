@@ -65,7 +65,7 @@ struct SimSummary {
   double cpu_seconds = 0;  // process CPU time while simulating (wall time suffers on a busy machine)
   int executions = 0;               // commands run (fallen ones included)
   int self_contact_executions = 0;  // of which the robot touched itself (Simulator::SelfContactSteps)
-  // The config against the robot's scale (Simulator::ScaleWarnings) and the robot touching itself.
+  // The config against the robot (Simulator::RobotWarnings) and the robot touching itself.
   std::vector<std::string> warnings;
 
   double SimulatedPerWallSecond() const;

@@ -224,7 +224,7 @@ std::vector<Eigen::Vector3d> Simulator::FootPositions() const {
   return impl_->walker ? impl_->walker->FootPoints() : impl_->FootSites();
 }
 
-std::vector<std::string> Simulator::ScaleWarnings() const {
+std::vector<std::string> Simulator::RobotWarnings() const {
   const SimConfig& c = impl_->config;
   std::vector<std::string> out;
   if (impl_->walker && impl_->walker->robot().replay.empty()) {

@@ -86,9 +86,10 @@ class Simulator {
   const std::array<LegGeometry, kNumLegs>& legs() const;
   const SimConfig& config() const;
 
-  // Advice on the config against this robot's scale (terrain.h TerrainScaleWarnings) and, for a
-  // robot block's gait, steps its legs cannot make (gait_reach.h); empty when nothing is far off.
-  std::vector<std::string> ScaleWarnings() const;
+  // Advice on the config against this robot: the ground against its scale (terrain.h
+  // TerrainScaleWarnings) and, for a robot block's robot, steps its legs cannot make (gait_reach.h)
+  // and actuators too weak to carry it (stance_load.h); empty when nothing is far off.
+  std::vector<std::string> RobotWarnings() const;
 
   // Physics steps since construction in which the robot touched itself (two of its bodies in
   // contact: a leg striking another leg or the body; self_contact.h), and the pair met most often

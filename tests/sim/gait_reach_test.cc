@@ -60,7 +60,7 @@ TEST(GaitReach, LegsMovingInOnePlaneMissTheirSidewaysAndTurningSteps) {
 
 TEST(GaitReach, TheSimulatorWarnsBeforeAnythingIsRecorded) {
   const Simulator sim(PlanarQuadruped());
-  const std::vector<std::string> warnings = sim.ScaleWarnings();
+  const std::vector<std::string> warnings = sim.RobotWarnings();
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_EQ(warnings[0].rfind("robot.gait: ", 0), 0u) << warnings[0];
 }

@@ -146,12 +146,12 @@ TEST(GroundScaleTest, TheSimulatorWarnsOfGroundOffItsRobotsScale) {
   t.resolution_m = 0.04;
   t.stones = {0.04, 0.08, 1};
   c.terrain = t;
-  EXPECT_TRUE(Simulator(c).ScaleWarnings().empty());
+  EXPECT_TRUE(Simulator(c).RobotWarnings().empty());
   c.terrain->steps = {0.12, 0.5};  // most of the octopod's 0.14 m stance
-  const auto warnings = Simulator(c).ScaleWarnings();
+  const auto warnings = Simulator(c).RobotWarnings();
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("stance height of 0.14"), std::string::npos) << warnings[0];
-  EXPECT_TRUE(Simulator(SimConfig{}).ScaleWarnings().empty());
+  EXPECT_TRUE(Simulator(SimConfig{}).RobotWarnings().empty());
 }
 
 }  // namespace

@@ -286,10 +286,10 @@ TEST(LeggedRobot, PlacementsSpanTheRobotsReach) {
   c.terrain = TerrainDescription{};
   c.terrain->half_size_m = 0.9;
   bool warned = false;
-  for (const std::string& w : Simulator(c).ScaleWarnings()) warned |= w.find("placement_half_width_m") != std::string::npos;
+  for (const std::string& w : Simulator(c).RobotWarnings()) warned |= w.find("placement_half_width_m") != std::string::npos;
   EXPECT_TRUE(warned);
   c.terrain->half_size_m = 1.2;
-  for (const std::string& w : Simulator(c).ScaleWarnings()) EXPECT_EQ(w.find("placement_half_width_m"), std::string::npos) << w;
+  for (const std::string& w : Simulator(c).RobotWarnings()) EXPECT_EQ(w.find("placement_half_width_m"), std::string::npos) << w;
   SimConfig builtin;
   EXPECT_DOUBLE_EQ(Simulator(builtin).placement_half_width_m(), 1.0);
   builtin.placement_half_width_m = -1;

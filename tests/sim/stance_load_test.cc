@@ -59,7 +59,7 @@ TEST(StanceLoad, ServosTooWeakToCarryTheRobotAreNamedAndItSinks) {
   EXPECT_GT(load.needed, 2 * load.limit);
   Simulator sim(c);
   fs::remove(path);
-  const std::vector<std::string> warnings = sim.ScaleWarnings();
+  const std::vector<std::string> warnings = sim.RobotWarnings();
   ASSERT_EQ(warnings.size(), 1u);
   EXPECT_NE(warnings[0].find("robot: its actuators cannot carry it"), std::string::npos) << warnings[0];
   Simulator strong(LoadSimConfig((kRobots / "hexapod.json").string()));
