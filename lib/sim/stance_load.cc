@@ -8,12 +8,17 @@
 namespace dgmm::sim {
 namespace {
 
-// The largest force or torque actuator a can put on its joint: its force range times its gear
-// (0: not limited).
-double ActuatorLimit(const mjModel* m, int a) {
-  if (!m->actuator_forcelimited[a]) return 0;
-  const double range = std::max(std::abs(m->actuator_forcerange[2 * a]), std::abs(m->actuator_forcerange[2 * a + 1]));
-  return range * std::abs(m->actuator_gear[6 * a]);
+// The largest force or torque the actuators on `joint` can put on it: their force ranges times
+// their gears, summed (0: none, or one not limited).
+double JointLimit(const mjModel* m, int joint) {
+  double limit = 0;
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_trnid[2 * a] != joint) continue;
+    if (!m->actuator_forcelimited[a]) return 0;
+    const double range = std::max(std::abs(m->actuator_forcerange[2 * a]), std::abs(m->actuator_forcerange[2 * a + 1]));
+    limit += range * std::abs(m->actuator_gear[6 * a]);
+  }
+  return limit;
 }
 
 }  // namespace
@@ -38,8 +43,8 @@ StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
     const LegChain& leg = robot.legs[i];
     const Eigen::Vector3d foot = FootPoint(m, d.get(), leg);
     mj_jac(m, d.get(), jacp.data(), nullptr, foot.data(), leg.foot_body);
-    for (std::size_t k = 0; k < leg.joints.size() && k < leg.actuators.size(); ++k) {
-      const double limit = ActuatorLimit(m, leg.actuators[k]);
+    for (std::size_t k = 0; k < leg.joints.size(); ++k) {
+      const double limit = JointLimit(m, leg.joints[k]);
       if (!(limit > 0)) continue;
       double tau = 0;
       for (int r = 0; r < 3; ++r) tau += jacp[r * m->nv + leg.dofs[k]] * force[r];

@@ -17,7 +17,7 @@ namespace dgmm::sim {
 struct StanceLoad {
   int leg = -1, joint = -1;  // the worst joint (model id) and its leg; -1: no actuator is limited
   double needed = 0;         // torque (N m) or force (N) at the joint to carry the weight
-  double limit = 0;          // what its actuator can give there: force range x gear
+  double limit = 0;          // what its actuators can give there: force range x gear
   double feet = 0;           // feet on the ground the weight is shared by
 };
 StanceLoad MeasureStanceLoad(const mjModel* model, const LeggedRobot& robot);
