@@ -269,12 +269,13 @@ void ChooseLengths(const RobotDescription& r, LeggedRobot* b, const std::string&
 // squares is local: it stops where a joint meets its limit or a leg is straight): the middle of
 // every joint's range, then draws within the ranges from a fixed seed (the stance is part of the
 // robot's description). Unlimited joints span +-pi/2 rad (slides +-reach) about the rest pose.
-std::vector<Eigen::VectorXd> StanceStarts(const mjModel* m, const LegChain& leg, int draws) {
+std::vector<Eigen::VectorXd> StanceStarts(const mjModel* m, const LegChain& leg, const Eigen::VectorXd& rest,
+                                          int draws) {
   std::mt19937_64 rng(1);
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::vector<Eigen::VectorXd> starts;
   for (int s = 0; s <= draws; ++s) {
-    Eigen::VectorXd q = leg.stance_q;
+    Eigen::VectorXd q = rest;
     for (int k = 0; k < q.size(); ++k) {
       const int j = leg.joints[k];
       const double span = m->jnt_type[j] == mjJNT_SLIDE ? leg.reach_m : M_PI / 2;
@@ -311,9 +312,10 @@ void SolveStance(const mjModel* m, const RobotDescription& r, const std::string&
     leg.stance_m.z() = -b->stance_height_m;
     const Eigen::Vector3d target = b->robot_in_torso * leg.stance_m;
     const double tolerance = 0.05 * leg.reach_m;
+    const Eigen::VectorXd rest = leg.stance_q;
     double residual = SolveLegIk(m, d.get(), leg, target, &leg.stance_q, 200);
     if (residual <= tolerance) continue;
-    for (Eigen::VectorXd q : StanceStarts(m, leg, 16)) {
+    for (Eigen::VectorXd q : StanceStarts(m, leg, rest, 16)) {
       const double from_here = SolveLegIk(m, d.get(), leg, target, &q, 200, true);
       if (from_here < residual) residual = from_here, leg.stance_q = q;
       if (residual <= tolerance) break;
