@@ -20,9 +20,10 @@ namespace {
 constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v7";
 // v6: a recording runs in chunks of this many placements, each with its own random stream, so
 // one recording can use several threads (sim::ProtocolOptions::chunk_placements). v7: a servo
-// gets the ctrl that holds its joint at the target (through its gear), a site, body or visual-geom
-// foot is placed by its body's colliding geoms and a mesh foot by its lowest vertex (recordings
-// of robots with geared servos or such feet changed; others not).
+// gets the ctrl that holds its joint at the target (through its gear) and the gait keeps within
+// its ctrlrange, a site, body or visual-geom foot is placed by its body's colliding geoms and a
+// mesh foot by its lowest vertex (recordings of robots with geared or ctrl-limited servos or such
+// feet changed; others not).
 constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {

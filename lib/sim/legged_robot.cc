@@ -112,6 +112,20 @@ void BindFoot(const mjModel* m, const FootDescription& foot, const std::string& 
   }
 }
 
+// The values joint j may be asked for: its range (if limited) within the joint values at which its
+// servo a (if any, and if its ctrl is limited) holds it: ctrl = -(b0 + b1 gear q) / gain.
+Eigen::Vector2d TargetRange(const mjModel* m, int j, int a) {
+  Eigen::Vector2d r(-INFINITY, INFINITY);
+  if (m->jnt_limited[j]) r = Eigen::Vector2d(m->jnt_range[2 * j], m->jnt_range[2 * j + 1]);
+  if (a < 0 || !m->actuator_ctrllimited[a] || !IsPositionServo(m, a)) return r;
+  const double gain = m->actuator_gainprm[mjNGAIN * a], b0 = m->actuator_biasprm[mjNBIAS * a];
+  const double scale = -m->actuator_biasprm[mjNBIAS * a + 1] * m->actuator_gear[6 * a] / gain;
+  if (!(std::abs(scale) > 0) || !std::isfinite(scale)) return r;
+  const double q0 = (m->actuator_ctrlrange[2 * a] + b0 / gain) / scale;
+  const double q1 = (m->actuator_ctrlrange[2 * a + 1] + b0 / gain) / scale;
+  return Eigen::Vector2d(std::max(r[0], std::min(q0, q1)), std::min(r[1], std::max(q0, q1)));
+}
+
 // The actuator driving joint k (`j`) of a leg: the one named in the description or the one on
 // the joint. The generic gait needs a position servo on every leg joint; a replay does not (-1:
 // the joint is driven otherwise, e.g. through a tendon).
@@ -166,6 +180,9 @@ LegChain BindChain(const mjModel* m, const RobotDescription& r, int i, int torso
     leg.dofs.push_back(m->jnt_dofadr[j]);
     const int a = LegActuator(m, r, desc, k, j, part, source);
     if (a >= 0) leg.actuators.push_back(a);
+    const Eigen::Vector2d range = TargetRange(m, j, a);
+    leg.q_lo.conservativeResize(static_cast<int>(k) + 1), leg.q_hi.conservativeResize(static_cast<int>(k) + 1);
+    leg.q_lo[k] = range[0], leg.q_hi[k] = range[1];
   }
   return leg;
 }
@@ -279,8 +296,8 @@ std::vector<Eigen::VectorXd> StanceStarts(const mjModel* m, const LegChain& leg,
     for (int k = 0; k < q.size(); ++k) {
       const int j = leg.joints[k];
       const double span = m->jnt_type[j] == mjJNT_SLIDE ? leg.reach_m : M_PI / 2;
-      const double lo = m->jnt_limited[j] ? m->jnt_range[2 * j] : q[k] - span;
-      const double hi = m->jnt_limited[j] ? m->jnt_range[2 * j + 1] : q[k] + span;
+      const double lo = std::isfinite(leg.q_lo[k]) ? leg.q_lo[k] : q[k] - span;
+      const double hi = std::isfinite(leg.q_hi[k]) ? leg.q_hi[k] : q[k] + span;
       q[k] = s == 0 ? 0.5 * (lo + hi) : lo + unit(rng) * (hi - lo);
     }
     starts.push_back(q);
@@ -294,7 +311,7 @@ std::string JointsAtLimits(const mjModel* m, const LegChain& leg, const Eigen::V
   for (int k = 0; k < q.size(); ++k) {
     const int j = leg.joints[k];
     const double tol = 1e-6 * (1 + std::abs(q[k]));
-    if (!m->jnt_limited[j] || (q[k] > m->jnt_range[2 * j] + tol && q[k] < m->jnt_range[2 * j + 1] - tol)) continue;
+    if (q[k] > leg.q_lo[k] + tol && q[k] < leg.q_hi[k] - tol) continue;
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
     names += (names.empty() ? "" : ", ") + std::string(name ? name : "(unnamed)");
   }
@@ -375,13 +392,10 @@ Eigen::VectorXd DampedStep(const Eigen::MatrixXd& j, const Eigen::Vector3d& e, d
 
 // Zeroes the Jacobian's columns of joints at a limit that dq pushes further out (they cannot move,
 // and the others must not count on them); true when any was.
-bool PinLimited(const mjModel* m, const LegChain& leg, const Eigen::VectorXd& q, const Eigen::VectorXd& dq,
-                Eigen::MatrixXd* j) {
+bool PinLimited(const LegChain& leg, const Eigen::VectorXd& q, const Eigen::VectorXd& dq, Eigen::MatrixXd* j) {
   bool pinned = false;
   for (int k = 0; k < q.size(); ++k) {
-    const int jn = leg.joints[k];
-    if (!m->jnt_limited[jn]) continue;
-    if ((q[k] <= m->jnt_range[2 * jn] && dq[k] < 0) || (q[k] >= m->jnt_range[2 * jn + 1] && dq[k] > 0)) {
+    if ((q[k] <= leg.q_lo[k] && dq[k] < 0) || (q[k] >= leg.q_hi[k] && dq[k] > 0)) {
       j->col(k).setZero();
       pinned = true;
     }
@@ -421,13 +435,12 @@ double SolveLegsIk(const mjModel* m, mjData* d, const std::vector<LegChain>& leg
       }
       const double lambda = 0.02 * std::max(leg.reach_m, 1e-3);
       Eigen::VectorXd dq = DampedStep(j, e, lambda);
-      if (limits_pin && PinLimited(m, leg, (*q)[l], dq, &j)) dq = DampedStep(j, e, lambda);
+      if (limits_pin && PinLimited(leg, (*q)[l], dq, &j)) dq = DampedStep(j, e, lambda);
       const double max_step = 0.3;  // rad (or m for slides) per iteration
       if (dq.cwiseAbs().maxCoeff() > max_step) dq *= max_step / dq.cwiseAbs().maxCoeff();
       for (int k = 0; k < n; ++k) {
         double v = (*q)[l][k] + dq[k];
-        const int jn = leg.joints[k];
-        if (m->jnt_limited[jn]) v = std::clamp(v, m->jnt_range[2 * jn], m->jnt_range[2 * jn + 1]);
+        v = std::clamp(v, leg.q_lo[k], leg.q_hi[k]);
         (*q)[l][k] = v;
       }
     }

@@ -26,6 +26,9 @@ struct LegChain {
   double foot_extent_m = 0;        // lowest contact point below the foot point
   Eigen::Vector3d stance_m = Eigen::Vector3d::Zero();  // standing foot position, robot frame
   Eigen::VectorXd stance_q;        // the leg's joint values there
+  // Per joint, the values the gait may ask for: its range (if limited) within what its servo can be
+  // commanded to (its ctrlrange, if limited, through ctrl = offset + scale q); -inf/+inf when free.
+  Eigen::VectorXd q_lo, q_hi;
 };
 
 struct LeggedRobot {

@@ -7,6 +7,9 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <unistd.h>
 
 #include "sim/legged_robot.h"
 #include "sim/mujoco_model.h"
@@ -73,6 +76,39 @@ TEST(GaitReach, TheProjectsRobotsFollowEveryStepOfTheirGaits) {
     for (int axis = 0; axis < 3; ++axis) EXPECT_LT(WorstShare(misses, axis), 0.05) << name << " axis " << axis;
     EXPECT_TRUE(GaitReachWarnings(misses, b.robot).empty()) << name;
   }
+}
+
+// The hexapod whose hip-yaw servos can be commanded to +-0.05 rad only (ctrlrange): its feet swing
+// fore and aft through the hip yaw, so forward steps and turns cannot be made, and the gait asks for
+// no more than the servos can be told (until 2026-12-03 MuJoCo clipped the gait's targets silently).
+TEST(GaitReach, AServosCtrlRangeBoundsTheGaitsTargets) {
+  std::string xml;
+  {
+    std::ifstream in(kRobots / "hexapod.xml");
+    xml.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  int narrowed = 0;
+  for (auto at = xml.find("_hip_yaw\" joint="); at != std::string::npos; at = xml.find("_hip_yaw\" joint=", at + 1)) {
+    const auto end = xml.find("/>", at);
+    xml.insert(end, " ctrllimited=\"true\" ctrlrange=\"-0.05 0.05\"");
+    ++narrowed;
+  }
+  ASSERT_EQ(narrowed, 6);
+  const fs::path path = fs::temp_directory_path() / ("dgmm_yaw_range_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  SimConfig c = LoadSimConfig((kRobots / "hexapod.json").string());
+  c.mjcf_path = path.string();
+  const Bound b = Bind(c);
+  fs::remove(path);
+  for (const LegChain& leg : b.robot.legs) {
+    EXPECT_NEAR(leg.q_hi[0], 0.05, 1e-12) << leg.name;  // the hip yaw: its servo's range, not the joint's
+    EXPECT_NEAR(leg.q_lo[0], -0.05, 1e-12) << leg.name;
+  }
+  const std::vector<GaitMiss> misses = MeasureGaitMisses(b.model.get(), b.robot, c.robot->gait.turn_rad);
+  EXPECT_GT(WorstShare(misses, 0), 0.25);
+  const std::vector<std::string> warnings = GaitReachWarnings(misses, b.robot);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("forward +"), std::string::npos) << warnings[0];
 }
 
 TEST(GaitReachWarnings, OnlyMissesOverTheShareOfTheTravelCount) {
