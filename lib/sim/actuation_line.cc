@@ -5,18 +5,25 @@
 
 namespace dgmm::sim {
 
+std::optional<ServoMap> JointServoMap(const mjModel* m, int a) {
+  const double gain = m->actuator_gainprm[mjNGAIN * a];
+  const double* b = m->actuator_biasprm + mjNBIAS * a;
+  if (m->actuator_trntype[a] != mjTRN_JOINT || m->actuator_gaintype[a] != mjGAIN_FIXED ||
+      m->actuator_biastype[a] != mjBIAS_AFFINE || !(b[1] < 0) || gain == 0) {
+    return std::nullopt;
+  }
+  return ServoMap{-b[1] * m->actuator_gear[6 * a] / gain, -b[0] / gain};
+}
+
 ActuationLine::ActuationLine(const mjModel* m, std::vector<int> actuators, int latency_steps, double backlash_rad)
     : actuators_(std::move(actuators)), pending_(std::max(0, latency_steps)), half_backlash_(0.5 * backlash_rad) {
   for (int a : actuators_) {
     const bool servo = m->actuator_biastype[a] == mjBIAS_AFFINE && m->actuator_biasprm[mjNBIAS * a + 1] < 0;
     const bool joint = m->actuator_trntype[a] == mjTRN_JOINT;
     backlash_qpos_.push_back(servo && joint ? m->jnt_qposadr[m->actuator_trnid[2 * a]] : -1);
-    // A servo at rest where gain ctrl + b0 + b1 gear q = 0: ctrl = -(b0 + b1 gear q) / gain.
-    const double gain = m->actuator_gainprm[mjNGAIN * a];
-    const bool mapped = servo && joint && m->actuator_gaintype[a] == mjGAIN_FIXED && gain != 0;
-    const double* b = m->actuator_biasprm + mjNBIAS * a;
-    ctrl_scale_.push_back(mapped ? -b[1] * m->actuator_gear[6 * a] / gain : 1.0);
-    ctrl_offset_.push_back(mapped ? -b[0] / gain : 0.0);
+    const ServoMap map = JointServoMap(m, a).value_or(ServoMap{});
+    ctrl_scale_.push_back(map.scale);
+    ctrl_offset_.push_back(map.offset);
   }
   seen_ = Eigen::VectorXd::Zero(static_cast<int>(actuators_.size()));
 }

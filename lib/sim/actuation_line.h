@@ -8,9 +8,17 @@
 #include <mujoco/mujoco.h>
 
 #include <Eigen/Core>
+#include <optional>
 #include <vector>
 
 namespace dgmm::sim {
+
+// A servo's ctrl for joint value q: ctrl = offset + scale q, where gain ctrl + b0 + b1 gear q = 0.
+struct ServoMap {
+  double scale = 1, offset = 0;
+};
+// For actuator a when it is a fixed-gain, affine-bias servo (b1 < 0, gain != 0) on a joint.
+std::optional<ServoMap> JointServoMap(const mjModel* model, int a);
 
 class ActuationLine {
  public:

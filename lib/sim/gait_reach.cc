@@ -25,11 +25,12 @@ std::vector<GaitMiss> MeasureGaitMisses(const mjModel* m, const LeggedRobot& rob
       c[axis] = sign;
       for (std::size_t i = 0; i < robot.legs.size(); ++i) {
         const LegChain& leg = robot.legs[i];
-        GaitMiss miss{c, static_cast<int>(i), 0, FootTravel(robot, leg, c, turn_rad).norm()};
+        const Eigen::Vector2d travel = FootTravel(robot, leg, c, turn_rad);
+        GaitMiss miss{c, static_cast<int>(i), 0, travel.norm()};
         Eigen::VectorXd q = leg.stance_q;
         for (int s = 0; s < phases; ++s) {
-          const Eigen::Vector3d offset = FootOffset(static_cast<double>(s) / phases, robot.timing.duty,
-                                                    FootTravel(robot, leg, c, turn_rad), robot.step_height_m);
+          const Eigen::Vector3d offset =
+              FootOffset(static_cast<double>(s) / phases, robot.timing.duty, travel, robot.step_height_m);
           const Eigen::Vector3d target = robot.robot_in_torso * (leg.stance_m + offset);
           miss.residual_m = std::max(miss.residual_m, SolveLegIk(m, d.get(), leg, target, &q, 100));
         }

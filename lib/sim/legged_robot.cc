@@ -7,6 +7,7 @@
 #include <random>
 #include <set>
 
+#include "sim/actuation_line.h"
 #include "sim/replay.h"
 #include "util/error.h"
 
@@ -117,12 +118,11 @@ void BindFoot(const mjModel* m, const FootDescription& foot, const std::string& 
 Eigen::Vector2d TargetRange(const mjModel* m, int j, int a) {
   Eigen::Vector2d r(-INFINITY, INFINITY);
   if (m->jnt_limited[j]) r = Eigen::Vector2d(m->jnt_range[2 * j], m->jnt_range[2 * j + 1]);
-  if (a < 0 || !m->actuator_ctrllimited[a] || !IsPositionServo(m, a)) return r;
-  const double gain = m->actuator_gainprm[mjNGAIN * a], b0 = m->actuator_biasprm[mjNBIAS * a];
-  const double scale = -m->actuator_biasprm[mjNBIAS * a + 1] * m->actuator_gear[6 * a] / gain;
-  if (!(std::abs(scale) > 0) || !std::isfinite(scale)) return r;
-  const double q0 = (m->actuator_ctrlrange[2 * a] + b0 / gain) / scale;
-  const double q1 = (m->actuator_ctrlrange[2 * a + 1] + b0 / gain) / scale;
+  if (a < 0 || !m->actuator_ctrllimited[a]) return r;
+  const std::optional<ServoMap> map = JointServoMap(m, a);  // the actuation line's map
+  if (!map || !(std::abs(map->scale) > 0) || !std::isfinite(map->scale)) return r;
+  const double q0 = (m->actuator_ctrlrange[2 * a] - map->offset) / map->scale;
+  const double q1 = (m->actuator_ctrlrange[2 * a + 1] - map->offset) / map->scale;
   return Eigen::Vector2d(std::max(r[0], std::min(q0, q1)), std::min(r[1], std::max(q0, q1)));
 }
 

@@ -278,7 +278,7 @@ struct PlanRun {
   std::map<int, long long> self_contact_by_command;  // steps in contact per command
   std::string self_contact_pair;
   double simulated_seconds = 0;
-  std::vector<std::string> robot_warnings;  // of the robot as simulated
+  std::vector<std::string> robot_warnings;  // of the robot as simulated (the first run of placements only)
   double total_mass_kg = 0, leg_reach_m = 0;
 };
 
@@ -343,7 +343,7 @@ void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOption
   }
   out->simulated_seconds = sim.time_s();
   out->self_contact_pair = sim.SelfContactPair();
-  out->robot_warnings = sim.RobotWarnings();
+  if (first == 0) out->robot_warnings = sim.RobotWarnings();  // one config, one robot: once per recording
   out->total_mass_kg = sim.total_mass_kg();
   out->leg_reach_m = sim.leg_reach_m();
 }
@@ -367,7 +367,7 @@ void Append(PlanRun&& part, PlanRun* all) {
     all->self_contact_pair = part.self_contact_pair;  // the first run with contacts names the pair
   }
   all->simulated_seconds += part.simulated_seconds;
-  all->robot_warnings = part.robot_warnings;
+  all->robot_warnings.insert(all->robot_warnings.end(), part.robot_warnings.begin(), part.robot_warnings.end());
   all->total_mass_kg = part.total_mass_kg;
   all->leg_reach_m = part.leg_reach_m;
 }
