@@ -15,9 +15,7 @@ Eigen::Vector2d FootTravel(const LeggedRobot& robot, const LegChain& leg, const 
 }
 
 std::vector<GaitMiss> MeasureGaitMisses(const mjModel* m, const LeggedRobot& robot, double turn_rad, int phases) {
-  MjDataPtr d(mj_makeData(m));
-  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
-  for (int k = 0; k < 7; ++k) d->qpos[robot.torso_qpos + k] = k == 3 ? 1 : 0;  // torso frame = world
+  MjDataPtr d = RestPoseData(m, robot.torso_qpos);
   std::vector<GaitMiss> out;
   for (int axis = 0; axis < 3; ++axis) {
     for (double sign : {1.0, -1.0}) {

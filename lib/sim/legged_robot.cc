@@ -225,9 +225,7 @@ Eigen::Matrix3d RobotFrame(const Eigen::Vector3d& forward) {
 
 // Rest-pose geometry of every leg: reach, side (checked against the declared one), foot extent.
 void MeasureRest(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* bound) {
-  MjDataPtr d(mj_makeData(m));
-  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
-  for (int k = 0; k < 7; ++k) d->qpos[bound->torso_qpos + k] = k == 3 ? 1 : 0;
+  MjDataPtr d = RestPoseData(m, bound->torso_qpos);
   mj_kinematics(m, d.get());
   for (std::size_t i = 0; i < bound->legs.size(); ++i) {
     LegChain& leg = bound->legs[i];
@@ -321,9 +319,7 @@ std::string JointsAtLimits(const mjModel* m, const LegChain& leg, const Eigen::V
 // Every foot must reach its stance point: inverse kinematics from the rest pose, else from other
 // starts (StanceStarts); refused with the joints that end at their limits.
 void SolveStance(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* b) {
-  MjDataPtr d(mj_makeData(m));
-  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
-  for (int k = 0; k < 7; ++k) d->qpos[b->torso_qpos + k] = k == 3 ? 1 : 0;
+  MjDataPtr d = RestPoseData(m, b->torso_qpos);
   for (std::size_t i = 0; i < b->legs.size(); ++i) {
     LegChain& leg = b->legs[i];
     leg.stance_m.z() = -b->stance_height_m;
@@ -375,6 +371,13 @@ void BindReplay(const mjModel* m, const RobotDescription& r, const std::string& 
 }
 
 }  // namespace
+
+MjDataPtr RestPoseData(const mjModel* m, int torso_qpos) {
+  MjDataPtr d(mj_makeData(m));
+  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
+  for (int k = 0; k < 7; ++k) d->qpos[torso_qpos + k] = k == 3 ? 1 : 0;
+  return d;
+}
 
 Eigen::Vector3d FootPoint(const mjModel* m, const mjData* d, const LegChain& leg) {
   if (leg.foot_site >= 0) return Vec(d->site_xpos + 3 * leg.foot_site);

@@ -79,6 +79,10 @@ double SolveLegsIk(const mjModel* model, mjData* scratch, const std::vector<LegC
                    const std::vector<Eigen::Vector3d>& targets_m, std::vector<Eigen::VectorXd>* q, int iterations,
                    bool limits_pin = false);
 
+// Data at the model's first keyframe (qpos0 without one) with the torso's free joint at the world's
+// origin, unrotated: the frame every rest-pose measurement (reach, stance, gait reach, load) is made in.
+MjDataPtr RestPoseData(const mjModel* model, int torso_qpos);
+
 // Foot point of a leg in the world frame of `data`.
 Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegChain& leg);
 

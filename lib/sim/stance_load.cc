@@ -24,9 +24,7 @@ double JointLimit(const mjModel* m, int joint) {
 }  // namespace
 
 StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
-  MjDataPtr d(mj_makeData(m));
-  if (m->nkey > 0) mju_copy(d->qpos, m->key_qpos, m->nq);
-  for (int k = 0; k < 7; ++k) d->qpos[robot.torso_qpos + k] = k == 3 ? 1 : 0;
+  MjDataPtr d = RestPoseData(m, robot.torso_qpos);
   for (const LegChain& leg : robot.legs) {
     for (std::size_t k = 0; k < leg.qpos.size(); ++k) d->qpos[leg.qpos[k]] = leg.stance_q[k];
   }
