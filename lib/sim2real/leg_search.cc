@@ -423,8 +423,11 @@ void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>
   s->z_vs_named = PairedZ(s->best_rows, floored, in.real.episode);
   if (!s->named || s->z_vs_named >= options.z) return;
   s->named = false;
-  s->why = "its best point (" + s->leg + Fmt(" at gain %.3g) fits the real samples no better than the named knobs' ", s->value) +
-           Fmt("correction (%.3g against %.3g nats per sample, z %.2f)", s->best_rows.mean(), floored.mean(), s->z_vs_named);
+  s->rivals_named = s->z_vs_named > 0;
+  const std::string than = s->rivals_named ? Fmt(" better than the named knobs' correction, but by under %.3g SE", options.z)
+                                           : " no better than the named knobs' correction";
+  s->why = "its best point (" + s->leg + Fmt(" at gain %.3g) fits the real samples", s->value) + than +
+           Fmt(" (%.3g against %.3g nats per sample, z %.2f)", s->best_rows.mean(), floored.mean(), s->z_vs_named);
 }
 
 Correction LegSearchCorrection(const LegSearch& search) {

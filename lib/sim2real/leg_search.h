@@ -123,6 +123,9 @@ struct LegSearch {
   // point's score against their floored correction's held-out one, in SEs (LegSearchChallenge).
   std::vector<std::string> challenged;
   double z_vs_named = NAN;
+  // The best point fits better than the named knobs' correction, but by under options.z SE: the
+  // data do not tell the leg from the named knobs (a doubt of the verdict, AddLegSearch).
+  bool rivals_named = false;
 };
 
 // The best point's mean score per real sample under the search's own score (its recording's own
@@ -149,7 +152,7 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
 // the correction given the same floor as that score (the sag reference's broad component, share e):
 //   l'_i = log((1 - e) exp(l_corrected,i) + e N(x_i - ref(c_i, z_i); 0, k^2 S)),
 //   z = sum_i (score_best,i - l'_i) / SE;
-// else the search names nothing and says so in `why`.
+// else the search names nothing and says so in `why` (with `rivals_named` when z is above 0).
 void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named, const Eigen::VectorXd& corrected,
                         const LegSearchOptions& options, LegSearch* search);
 

@@ -23,6 +23,16 @@ VerdictNamed NamedLeg(const LegSearch& s) {
   return n;
 }
 
+// A weak leg that fits the real samples at least as well as the named knobs: the data do not tell
+// them apart, so the named knobs are not the only reading.
+void AddRivalDoubt(const LegSearch& s, Verdict* v) {
+  v->doubts.push_back("a weak " + s.leg + Fmt(" leg (gain %.3g)", s.value) +
+                      Fmt(" fits the real samples as well as the named knobs (better by z %.2f, under the search's bar):",
+                          s.z_vs_named) +
+                      " these data do not tell the two apart");
+  if (v->status == "explained") v->status = "partly_explained";
+}
+
 }  // namespace
 
 VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const std::string& unit) {
@@ -73,6 +83,7 @@ void AddLegSearch(const LegSearch& s, Verdict* v) {
     v->sentence += Fmt(" A search of every leg's gain (%.0f recordings, each scored by a model of its own) names no leg: ",
                        static_cast<double>(s.points.size())) +
                    s.why + ".";
+    if (s.rivals_named) AddRivalDoubt(s, v);
     return;
   }
   ReplaceNamed(s, NamedLeg(s), v);

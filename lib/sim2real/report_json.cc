@@ -187,7 +187,8 @@ json LegSearchJson(const LegSearch& l) {
           {"misfit_against", l.misfit_elsewhere ? "other_places" : "own_executions"},
           {"best_plain_score", JsonNumber(l.best_plain)}, {"z_vs_nominal", JsonNumber(l.z_vs_nominal)},
           {"gap_closed", JsonNumber(l.gap_closed)}, {"challenged", l.challenged},
-          {"z_vs_named", JsonNumber(l.z_vs_named)}, {"legs_as_well", l.legs_as_well}, {"fits_as_well", SearchSpanJson(l.as_well)}, {"points", points},
+          {"z_vs_named", JsonNumber(l.z_vs_named)}, {"rivals_named", l.rivals_named}, {"legs_as_well", l.legs_as_well},
+          {"fits_as_well", SearchSpanJson(l.as_well)}, {"points", points},
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 
@@ -198,7 +199,7 @@ json RunoffJson(const Runoff& r) {
   if (!r.ran) return {{"ran", false}, {"why_not", r.why_not}};
   const LegSearch& s = r.search;
   json out = LegSearchJson(s);
-  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named"}) out.erase(leg_only);
+  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named", "rivals_named"}) out.erase(leg_only);
   const auto leg_of = [](const LegSearchPoint& p) { return p.leg == p.knob ? json(nullptr) : json(p.leg); };
   json knobs_as_well = json::array();
   for (size_t j = 0; j < s.points.size(); ++j) {

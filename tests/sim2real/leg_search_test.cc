@@ -143,6 +143,41 @@ TEST(LegSearch, AChallengedNameGivesWayOnlyToALegThatFitsBetter) {
   EXPECT_NE(kept.sentence.find("names no leg: " + good.why), std::string::npos) << kept.sentence;
 }
 
+// A challenged name that the leg's recording beats, but by under the search's bar: the name stays,
+// and the verdict says the data do not tell the weak leg from it.
+TEST(LegSearch, ALegThatFitsBetterButNotByTheBarIsADoubtOfTheNamedKnobs) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  const std::vector<std::string> before = {"payload.mass_kg"};
+  const LegSearch found = Search(s);
+  ASSERT_TRUE(found.named) << found.why;
+  // Corrections that fit some placements better and others worse than the leg's recording, by `t`
+  // nats per sample: the wider the spread, the nearer 0 the leg's z over them.
+  LegSearch rival;
+  for (double t : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {
+    Eigen::VectorXd corrected = found.best_rows;
+    for (int i = 0; i < corrected.size(); ++i) corrected(i) += (s.in.real.episode[i] % 2 ? t : -t);
+    rival = found;
+    LegSearchChallenge(s.in, before, corrected, Options(s), &rival);
+    if (rival.z_vs_named > 0 && rival.z_vs_named < Options(s).z) break;
+  }
+  ASSERT_GT(rival.z_vs_named, 0);
+  ASSERT_LT(rival.z_vs_named, Options(s).z);
+  EXPECT_FALSE(rival.named);
+  EXPECT_TRUE(rival.rivals_named);
+  EXPECT_NE(rival.why.find("better than the named knobs' correction, but by under 2 SE"), std::string::npos) << rival.why;
+  Verdict v;
+  v.status = "explained";
+  v.named.resize(1);
+  v.named[0].knob = "payload.mass_kg";
+  AddLegSearch(rival, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "payload.mass_kg");
+  EXPECT_EQ(v.status, "partly_explained") << "a rival reading is a doubt";
+  ASSERT_FALSE(v.doubts.empty());
+  EXPECT_NE(v.doubts.back().find("a weak leg1 leg"), std::string::npos) << v.doubts.back();
+  EXPECT_NE(v.doubts.back().find("do not tell the two apart"), std::string::npos) << v.doubts.back();
+}
+
 // The other score (a broad component instead of the default sag mode) on the same fake: a planted
 // weak leg is named with its gain, a nominal robot names none, and the answer does not depend on
 // the thread count.

@@ -157,7 +157,7 @@ TEST(Report, TheRunoffsJsonNamesKnobsNotLegs) {
   EXPECT_TRUE(j["points"][0]["leg"].is_null());
   EXPECT_EQ(j["points"][1]["leg"], "leg1");
   EXPECT_EQ(j["knobs_as_well"], nlohmann::json::array({"actuators.leg1.gain"}));
-  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named"}) EXPECT_FALSE(j.contains(leg_only)) << leg_only;
+  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named", "rivals_named"}) EXPECT_FALSE(j.contains(leg_only)) << leg_only;
   EXPECT_EQ(j["contenders"].size(), 2u);
 }
 
