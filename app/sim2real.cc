@@ -55,6 +55,7 @@ struct Sim2RealArgs {
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
+  double challenge_inclusion = sim2real::LegSearchOptions{}.challenge_inclusion;
   std::string null_source = "auto";
   int null_recordings = sim2real::RecordedNullOptions{}.draws;
   bool locate_only = false;
@@ -164,6 +165,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.legs.only_with_tails = args.leg_search_on == "tails";
   o.legs.challenge_named = args.leg_search_on == "remaining";
   o.legs.challenge_gap_closed = args.challenge_gap_closed;
+  o.legs.challenge_inclusion = args.challenge_inclusion;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -388,6 +390,10 @@ void Setup(CLI::App& root) {
   cmd->add_option("--challenge-gap-closed", args->challenge_gap_closed,
                   "... and also when the named knobs' correction closed less than this share of the gap between "
                   "the sim model and the ceiling")
+      ->capture_default_str()->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--challenge-inclusion", args->challenge_inclusion,
+                  "... and also when a named family's bootstrap inclusion is under this (0: never; experimental, "
+                  "docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "

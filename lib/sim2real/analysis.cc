@@ -36,10 +36,15 @@ std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement
 
 // A challenge of named knobs (LegSearchOptions::challenge_named): on a plane (on uneven ground the
 // runoff scores contenders by their own models), knobs named, none of them a leg's, and the
-// corrected model still below the real-trained ceiling or closing little of the gap.
+// corrected model still below the real-trained ceiling, closing little of the gap, or named with
+// little agreement between the resamples.
 bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
   if (!options.challenge_named || a.baseline.permute_placements) return false;
-  const bool short_of_it = a.adequacy.below_ceiling || a.adequacy.gap_closed < options.challenge_gap_closed;
+  const bool unsure = std::any_of(a.verdict.named.begin(), a.verdict.named.end(), [&](const VerdictNamed& n) {
+    return n.inclusion >= 0 && n.inclusion < options.challenge_inclusion;
+  });
+  const bool short_of_it =
+      a.adequacy.below_ceiling || a.adequacy.gap_closed < options.challenge_gap_closed || unsure;
   if (a.verdict.status == "explained" || !short_of_it) return false;
   return std::none_of(a.naming.named.begin(), a.naming.named.end(),
                       [&](int c) { return !a.candidates.candidates[c].leg.empty(); });

@@ -341,9 +341,9 @@ bool LegSearchOptions::IsValid(std::string* error) const {
     return false;
   }
   if (refine_steps < 0 || executions_per_placement < 0 || !(z > 0) || !(min_gap_closed >= 0 && min_gap_closed <= 1) ||
-      !(challenge_gap_closed >= 0 && challenge_gap_closed <= 1)) {
-    *error = "leg search: refine_steps >= 0, executions_per_placement >= 0, z > 0, min_gap_closed and "
-             "challenge_gap_closed in [0, 1] expected";
+      !(challenge_gap_closed >= 0 && challenge_gap_closed <= 1) || !(challenge_inclusion >= 0 && challenge_inclusion <= 1)) {
+    *error = "leg search: refine_steps >= 0, executions_per_placement >= 0, z > 0, min_gap_closed, "
+             "challenge_gap_closed and challenge_inclusion in [0, 1] expected";
     return false;
   }
   if (!(sag.broad_share > 0 && sag.broad_share < 0.5) || !(sag.broad_scale > 1) || !(sag.floor >= 0)) {

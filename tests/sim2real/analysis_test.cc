@@ -145,6 +145,31 @@ TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
   EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
 }
 
+// With challenge_inclusion a name the resamples seldom agree on is challenged even at the ceiling
+// (sprawled quadruped 54202: a weak front leg read as soft servos, inclusion 75%, and a tracker
+// offset, 60%); off by default.
+TEST(Analysis, TheLegSearchCanChallengeANameOfLowInclusion) {
+  Analysis a;
+  a.candidates.candidates.resize(1);
+  a.naming.named = {0};
+  a.verdict.status = "partly_explained";
+  a.verdict.named.resize(2);
+  a.verdict.named[0].inclusion = 0.75, a.verdict.named[1].inclusion = 0.6;
+  a.adequacy.gap_closed = 1.02;
+  LegSearchOptions options;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "off by default";
+  options.challenge_inclusion = 0.8;
+  EXPECT_TRUE(WantLegSearch(a, options));
+  a.verdict.named[0].inclusion = 0.8, a.verdict.named[1].inclusion = 1.0;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "every named family at 80% or more";
+  a.verdict.named[1].inclusion = -1;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "no bootstrap: no inclusion to go by";
+  options.challenge_inclusion = 1.5;
+  std::string error;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("challenge_inclusion"), std::string::npos) << error;
+}
+
 // On uneven ground a mismatch left after the mean shifts gets a runoff of the first step's
 // contenders, on a plane never; what it names is the verdict's and the correction's one story.
 TEST(Analysis, TheRunoffRunsOnUnevenGroundWhenAMismatchIsLeft) {
