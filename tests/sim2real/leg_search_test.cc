@@ -23,6 +23,15 @@ LegSearch Search(const Stages& s, int threads = 1) {
   return SearchLegGains(SharedFake(), s.in, s.set, recording, Options(s));
 }
 
+// A verdict that named one knob, with `status`.
+Verdict OneNamed(const std::string& status, const std::string& knob) {
+  Verdict v;
+  v.status = status;
+  v.named.resize(1);
+  v.named[0].knob = knob;
+  return v;
+}
+
 TEST(LegSearch, FindsOnlyThePerLegGainKnobs) {
   const std::vector<int> legs = LegGainKnobs(SharedFake());
   EXPECT_EQ(legs, (std::vector<int>{kLeg0Gain, kLeg1Gain, kLeg2Gain, kLeg3Gain}));
@@ -133,11 +142,10 @@ TEST(LegSearch, AChallengedNameGivesWayOnlyToALegThatFitsBetter) {
   EXPECT_FALSE(good.named);
   EXPECT_LT(good.z_vs_named, 0);
   EXPECT_NE(good.why.find("no better than the named knobs' correction"), std::string::npos) << good.why;
-  Verdict kept;
-  kept.status = "partly_explained";
-  kept.named.resize(1);
-  kept.named[0].knob = "tracker.yaw_drift";
+  EXPECT_FALSE(good.rivals_named);
+  Verdict kept = OneNamed("partly_explained", "tracker.yaw_drift");
   AddLegSearch(good, &kept);
+  EXPECT_TRUE(kept.doubts.empty()) << "a leg that fits worse is no rival";
   ASSERT_EQ(kept.named.size(), 1u);
   EXPECT_EQ(kept.named[0].knob, "tracker.yaw_drift");
   EXPECT_NE(kept.sentence.find("names no leg: " + good.why), std::string::npos) << kept.sentence;
@@ -165,10 +173,7 @@ TEST(LegSearch, ALegThatFitsBetterButNotByTheBarIsADoubtOfTheNamedKnobs) {
   EXPECT_FALSE(rival.named);
   EXPECT_TRUE(rival.rivals_named);
   EXPECT_NE(rival.why.find("better than the named knobs' correction, but by under 2 SE"), std::string::npos) << rival.why;
-  Verdict v;
-  v.status = "explained";
-  v.named.resize(1);
-  v.named[0].knob = "payload.mass_kg";
+  Verdict v = OneNamed("explained", "payload.mass_kg");
   AddLegSearch(rival, &v);
   ASSERT_EQ(v.named.size(), 1u);
   EXPECT_EQ(v.named[0].knob, "payload.mass_kg");
