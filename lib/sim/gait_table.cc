@@ -43,20 +43,54 @@ GaitTiming FromTable(const PhaseTable& table, double duty, const std::vector<Leg
   return t;
 }
 
+// The wave on any number of legs: one foot in the air at a time, each side's legs from back to
+// front, the left side first; the j-th leg of that sequence at phase j / N, duty (N - 1) / N.
+GaitTiming Wave(const std::vector<LegPlace>& legs, const std::string& source) {
+  if (legs.size() < 3) throw MakeInputError(source, "robot.gait.pattern", "wave needs at least 3 legs");
+  std::vector<int> order = SideFrontToBack(legs, 1), right = SideFrontToBack(legs, -1);
+  std::reverse(order.begin(), order.end());
+  order.insert(order.end(), right.rbegin(), right.rend());
+  const double n = static_cast<double>(legs.size());
+  GaitTiming t;
+  t.duty = (n - 1) / n;
+  t.phase.assign(legs.size(), 0);
+  for (std::size_t j = 0; j < order.size(); ++j) t.phase[order[j]] = static_cast<double>(j) / n;
+  t.side_sequential = true;
+  return t;
+}
+
+// Neighbours along a side and across in opposite halves of the cycle (trot, tripod and the
+// alternating tetrapod for 2, 3 and 4 legs a side): any equal number of legs a side, 2 or more.
+GaitTiming Alternating(const std::vector<LegPlace>& legs, const std::string& source) {
+  const std::size_t left = SideFrontToBack(legs, 1).size(), right = legs.size() - left;
+  if (left != right || left < 2) {
+    throw MakeInputError(source, "robot.gait.pattern",
+                         "alternating needs the same number of legs on each side, at least 2; the robot has " +
+                             std::to_string(left) + " left and " + std::to_string(right) + " right");
+  }
+  PhaseTable table(2, std::vector<double>(left));
+  for (std::size_t k = 0; k < left; ++k) table[0][k] = 0.5 * (k % 2), table[1][k] = 0.5 * ((k + 1) % 2);
+  return FromTable(table, 0.5, legs, "alternating", source);
+}
+
+// The pattern `auto` stands for: the alternating pattern on equal sides (trot, tripod, the
+// alternating tetrapod by name for 4, 6 and 8 legs), else the wave from 4 legs on.
+std::string AutoPattern(const std::vector<LegPlace>& legs, const std::string& source) {
+  const std::size_t left = SideFrontToBack(legs, 1).size(), right = legs.size() - left;
+  if (left == right && left >= 2) {
+    static const char* kNamed[] = {"trot", "tripod", "alternating_tetrapod"};
+    return left <= 4 ? kNamed[left - 2] : "alternating";
+  }
+  if (legs.size() >= 4) return "wave";
+  throw MakeInputError(source, "robot.gait.pattern",
+                       "no default gait for " + std::to_string(legs.size()) +
+                           " legs: give pattern custom with one phase per leg, or a replay controller");
+}
+
 }  // namespace
 
 GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>& legs, const std::string& source) {
-  std::string pattern = gait.pattern;
-  if (pattern == "auto") {
-    if (legs.size() == 4) pattern = "trot";
-    else if (legs.size() == 6) pattern = "tripod";
-    else if (legs.size() == 8) pattern = "alternating_tetrapod";
-    else {
-      throw MakeInputError(source, "robot.gait.pattern",
-                           "no default gait for " + std::to_string(legs.size()) +
-                               " legs: give pattern custom with one phase per leg");
-    }
-  }
+  const std::string pattern = gait.pattern == "auto" ? AutoPattern(legs, source) : gait.pattern;
   GaitTiming t;
   if (pattern == "custom") {
     if (gait.phases.size() != legs.size()) {
@@ -73,9 +107,10 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
     t = FromTable({{0.0, 0.5, 0.0}, {0.5, 0.0, 0.5}}, 0.5, legs, pattern, source);
   } else if (pattern == "tetrapod") {  // three pairs, one swinging at a time, back to front
     t = FromTable({{0.0, 2.0 / 3, 1.0 / 3}, {1.0 / 3, 0.0, 2.0 / 3}}, 2.0 / 3, legs, pattern, source);
-  } else if (pattern == "wave") {  // back to front, left side then right
-    t = FromTable({{2.0 / 6, 1.0 / 6, 0.0}, {5.0 / 6, 4.0 / 6, 3.0 / 6}}, 5.0 / 6, legs, pattern, source);
-    t.side_sequential = true;
+  } else if (pattern == "wave") {
+    t = Wave(legs, source);
+  } else if (pattern == "alternating") {
+    t = Alternating(legs, source);
   } else {  // alternating_tetrapod
     t = FromTable({{0.0, 0.5, 0.0, 0.5}, {0.5, 0.0, 0.5, 0.0}}, 0.5, legs, pattern, source);
   }

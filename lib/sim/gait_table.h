@@ -36,11 +36,14 @@ struct GaitTiming {
 double LateralShift(const GaitTiming& timing, const std::vector<double>& phase, const std::vector<int>& sides,
                     double lateral);
 
-// The pattern's timing for these legs: trot / crawl need 4 legs, tripod / tetrapod / wave 6,
-// alternating_tetrapod 8, each half on either side; auto picks trot, tripod or the alternating
-// tetrapod by the leg count; custom takes gait.phases (one per leg). The tetrapod and the wave
-// swing each side's legs from back to front when walking forwards. Throws InputError
-// "<source>: robot.gait.pattern: ..." when the pattern needs another number of legs.
+// The pattern's timing for these legs: trot / crawl need 4 legs, tripod / tetrapod 6,
+// alternating_tetrapod 8, each half on either side; alternating any equal number a side from 2
+// (trot, tripod and the alternating tetrapod are its cases); wave any number from 3, one foot in
+// the air at a time. auto picks the alternating pattern on equal sides (by its name for 4, 6 and 8
+// legs) and the wave otherwise (a robot that lost a leg); custom takes gait.phases (one per leg).
+// The tetrapod and the wave swing each side's legs from back to front when walking forwards.
+// Throws InputError "<source>: robot.gait.pattern: ..." when the pattern needs another number of
+// legs.
 GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>& legs, const std::string& source);
 
 // A foot's offset from its stance position at fraction u in [0, 1) of its own cycle (u = 0:

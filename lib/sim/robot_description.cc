@@ -73,10 +73,12 @@ GaitDescription ReadGait(const json& j, const std::string& source) {
   f.Number("lean", &g.lean, 0, 1.5);
   f.Number("sway", &g.sway, -1, 1);
   f.Done();
-  static const std::set<std::string> kPatterns = {"auto", "trot", "crawl", "tripod", "tetrapod", "wave",
-                                                  "alternating_tetrapod", "custom"};
+  static const std::set<std::string> kPatterns = {"auto", "trot",        "crawl",
+                                                  "tripod", "tetrapod", "wave",
+                                                  "alternating", "alternating_tetrapod", "custom"};
   if (!kPatterns.count(g.pattern)) {
-    f.Fail("robot.gait.pattern", "expected auto, trot, crawl, tripod, tetrapod, wave, alternating_tetrapod or custom");
+    f.Fail("robot.gait.pattern",
+           "expected auto, trot, crawl, tripod, tetrapod, wave, alternating, alternating_tetrapod or custom");
   }
   if ((g.pattern == "custom") != !g.phases.empty()) f.Fail("robot.gait.phases", "expected exactly with pattern custom");
   return g;

@@ -29,7 +29,8 @@ struct LegDescription {
 // of the cycle a foot is on the ground). Named tables exist for 4, 6 and 8 legs
 // (gait_table.h); "custom" takes `phases`.
 struct GaitDescription {
-  std::string pattern = "auto";  // auto | trot | crawl | tripod | tetrapod | wave | alternating_tetrapod | custom
+  // auto | trot | crawl | tripod | tetrapod | wave | alternating | alternating_tetrapod | custom
+  std::string pattern = "auto";
   std::vector<double> phases;    // custom: one per leg, in the order of `legs`
   double duty_factor = 0;        // (0, 1); 0: the pattern's own
   double period_s = 0.6;         // one full cycle

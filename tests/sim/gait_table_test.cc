@@ -115,7 +115,58 @@ TEST(GaitTable, APatternForAnotherLegCountIsRefusedNamingIt) {
   EXPECT_THROW(ResolveGait(g, Hexapod(), "robot.json"), std::exception);
   g.pattern = "auto";
   g.phases.clear();
-  EXPECT_THROW(ResolveGait(g, {{1, 0}, {-1, 0}, {1, 0.1}, {-1, 0.1}, {1, 0.2}}, "robot.json"), std::exception);
+  EXPECT_THROW(ResolveGait(g, {{1, 0}, {-1, 0}, {1, 0.1}}, "robot.json"), std::exception);  // three legs
+  g.pattern = "alternating";
+  try {
+    ResolveGait(g, {{1, 0}, {-1, 0}, {1, 0.1}, {-1, 0.1}, {1, 0.2}}, "robot.json");
+    FAIL();
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("3 left and 2 right"), std::string::npos) << e.what();
+  }
+}
+
+// A hexapod that lost its rear right leg: the wave on five legs, one foot in the air at a time.
+TEST(GaitTable, TheWaveTakesAnyNumberOfLegsOneFootInTheAirAtATime) {
+  std::vector<LegPlace> five = Hexapod();
+  five.pop_back();
+  GaitDescription g;  // auto: the sides differ, so the wave
+  const GaitTiming t = ResolveGait(g, five, "test");
+  EXPECT_TRUE(t.side_sequential);
+  EXPECT_DOUBLE_EQ(t.duty, 0.8);
+  // Left rear (2), middle (1), front (0), then right middle (4), front (3).
+  EXPECT_EQ(SwingOrder(t.phase, t.duty, {2, 1, 0, 4, 3}), (std::vector<int>{3, 2, 1, 0, 4}));
+  for (int i = 0; i < 100; ++i) {  // swings never overlap: at most one foot in the air
+    const double u = 0.005 + 0.01 * i;  // between the swings' ends at multiples of 0.2
+    int up = 0;
+    for (double p : t.phase) up += (u - p - std::floor(u - p)) >= t.duty;
+    EXPECT_LE(up, 1) << "at " << u;
+  }
+  g.pattern = "wave";  // on six legs, the table it has always had
+  EXPECT_EQ(ResolveGait(g, Hexapod(), "test").phase,
+            (std::vector<double>{2.0 / 6, 1.0 / 6, 0.0, 5.0 / 6, 4.0 / 6, 3.0 / 6}));
+  EXPECT_EQ(ResolveGait(g, Hexapod(), "test").duty, 5.0 / 6);
+}
+
+// Ten legs, five a side: auto alternates neighbours along a side and across; on 4, 6 and 8 legs
+// the alternating pattern is the trot, the tripod and the alternating tetrapod.
+TEST(GaitTable, TheAlternatingPatternTakesAnyEqualNumberOfLegsASide) {
+  std::vector<LegPlace> ten;
+  for (int k = 0; k < 5; ++k) ten.push_back({1, 0.1 * k}), ten.push_back({-1, 0.1 * k});
+  const GaitTiming t = ResolveGait(GaitDescription{}, ten, "test");
+  EXPECT_DOUBLE_EQ(t.duty, 0.5);
+  for (int k = 0; k < 5; ++k) {
+    EXPECT_NE(t.phase[2 * k], t.phase[2 * k + 1]) << "across, pair " << k;
+    if (k > 0) EXPECT_NE(t.phase[2 * k], t.phase[2 * k - 2]) << "along the left side, leg " << k;
+  }
+  for (const auto& [pattern, legs] : {std::pair<std::string, std::vector<LegPlace>>{"tripod", Hexapod()},
+                                      {"trot", {{1, 0.2}, {-1, 0.2}, {1, -0.2}, {-1, -0.2}}},
+                                      {"alternating_tetrapod", {{1, 3}, {1, 2}, {1, 1}, {1, 0}, {-1, 3}, {-1, 2},
+                                                                {-1, 1}, {-1, 0}}}}) {
+    GaitDescription named, alternating;
+    named.pattern = pattern;
+    alternating.pattern = "alternating";
+    EXPECT_EQ(ResolveGait(alternating, legs, "test").phase, ResolveGait(named, legs, "test").phase) << pattern;
+  }
 }
 
 TEST(GaitTable, FootOffsetIsContinuousAndOnTheGroundInStance) {

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -489,6 +490,54 @@ TEST(LeggedRobot, TheSprawledQuadrupedCrawlsWhenItSwaysItsBody) {
       EXPECT_GT(worst_tilt, 4.0);
     }
   }
+}
+
+// The hexapod's MJCF without one leg's body (and all below it) and its actuators, written to `path`;
+// the config without the leg and with the gait left to auto (as scripts/drop_leg.py makes them).
+SimConfig HexapodWithout(const std::string& leg, const fs::path& path) {
+  std::string xml = ReadText(kRobots / "hexapod.xml");
+  const std::size_t begin = xml.find("<body name=\"" + leg + "_coxa\"");
+  std::size_t end = begin;
+  for (int depth = 0; end != std::string::npos;) {  // to the body's own closing tag
+    const std::size_t open = xml.find("<body", end + 1), close = xml.find("</body>", end + 1);
+    if (open < close) {
+      ++depth, end = open;
+    } else if (depth-- > 0) {
+      end = close;
+    } else {
+      end = close + std::strlen("</body>");
+      break;
+    }
+  }
+  EXPECT_NE(begin, std::string::npos);
+  xml.erase(begin, end - begin);
+  xml = std::regex_replace(xml, std::regex("<position [^>]*joint=\"" + leg + "_[a-z_]+\"/>"), "");
+  std::ofstream(path) << xml;
+  SimConfig c = Hexapod();
+  c.mjcf_path = path.string();
+  auto& legs = c.robot->legs;
+  legs.erase(std::remove_if(legs.begin(), legs.end(), [&](const LegDescription& l) { return l.name == leg; }),
+             legs.end());
+  c.robot->gait.pattern = "auto";
+  return c;
+}
+
+// A hexapod that lost its rear right leg walks in the wave (one foot in the air at a time, the
+// pattern auto picks for five legs) as commanded: forward within 25% and straight, turning the
+// commanded way within 30%.
+TEST(LeggedRobot, AHexapodThatLostALegWalksInTheWave) {
+  const fs::path path = fs::temp_directory_path() / ("dgmm_five_legs_" + std::to_string(::getpid()) + ".xml");
+  Simulator sim(HexapodWithout("rear_right", path));
+  fs::remove(path);
+  const RobotDescription& r = *sim.config().robot;
+  ASSERT_EQ(sim.leg_count(), 5);
+  const double cycles = sim.config().command_duration_s / r.gait.period_s;
+  const double stride = r.gait.stride_reach * sim.leg_reach_m() * cycles;
+  const Eigen::Vector3d forward = Travel(sim, Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_NEAR(forward.x() / (0.5 * stride), 1.0, 0.25);
+  EXPECT_LT(std::abs(forward.y()) / (0.5 * stride), 0.15);
+  const Eigen::Vector3d turn = Travel(sim, Eigen::Vector3d(0, 0, -0.5));
+  EXPECT_NEAR(turn.z() / (-0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
 }
 
 }  // namespace
