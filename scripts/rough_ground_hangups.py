@@ -48,14 +48,14 @@ def load(path):
         return f["x"][:], [labels[c] for c in f["command"][:]], f["episode"][:]
 
 
-def median_travel(path):
-    x, cmd, _ = load(path)
+def median_travel(data):
+    x, cmd, _ = data
     travel = np.hypot(x[:, 0], x[:, 1])
     return {c: float(np.median(travel[[i for i, ci in enumerate(cmd) if ci == c]])) for c in set(cmd)}
 
 
-def per_placement_hangups(path, reach):
-    x, cmd, ep = load(path)
+def per_placement_hangups(data, reach):
+    x, cmd, ep = data
     r = np.array([reach.get(c, 0.0) for c in cmd])
     moving = r > 0.25 * max(reach.values())
     hung = (np.hypot(x[:, 0], x[:, 1]) < 0.5 * r)[moving]
@@ -78,7 +78,7 @@ def main():
         base = json.load(f)
     if "stones" not in base.get("terrain", {}):
         raise SystemExit(f"{a.config}: terrain.stones expected (the boulders whose height is scaled)")
-    sim = record(a.build, base, 1.0, a.sim_seed, a.placements, a.out)
+    sim = load(record(a.build, base, 1.0, a.sim_seed, a.placements, a.out))
     reach = median_travel(sim)
     s = per_placement_hangups(sim, reach)
     print(f"sim set: nominal boulders, seed {a.sim_seed}, {a.placements} placements: "
@@ -88,7 +88,7 @@ def main():
     for item in a.real.split(","):
         factor, seed = item.split(":")
         path = record(a.build, base, float(factor), int(seed), a.real_placements, a.out)
-        r = per_placement_hangups(path, reach)
+        r = per_placement_hangups(load(path), reach)
         se_r = r.std(ddof=1) / np.sqrt(len(r))
         se = np.sqrt(se_r ** 2 + s.var(ddof=1) / len(s))
         d = r.mean() - s.mean()

@@ -35,12 +35,6 @@ bool IsDescendant(const mjModel* m, int body, int ancestor) {
   return ancestor == 0;
 }
 
-// A position servo: force = gain * ctrl - gain * q (MuJoCo's <position>).
-bool IsPositionServo(const mjModel* m, int a) {
-  return m->actuator_gaintype[a] == mjGAIN_FIXED && m->actuator_biastype[a] == mjBIAS_AFFINE &&
-         m->actuator_biasprm[mjNBIAS * a + 1] < 0;
-}
-
 // The actuator driving `joint`, or -1.
 int ActuatorOf(const mjModel* m, int joint) {
   for (int a = 0; a < m->nu; ++a) {
@@ -550,6 +544,11 @@ void ApplyExperiment(const SimConfig& config, const LeggedRobot& b, mjModel* m, 
       m->geom_friction[3 * i + 2] = config.friction.rolling;
     }
   }
+}
+
+bool IsPositionServo(const mjModel* m, int a) {
+  return m->actuator_gaintype[a] == mjGAIN_FIXED && m->actuator_biastype[a] == mjBIAS_AFFINE &&
+         m->actuator_biasprm[mjNBIAS * a + 1] < 0;
 }
 
 }  // namespace dgmm::sim

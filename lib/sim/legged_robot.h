@@ -86,4 +86,7 @@ MjDataPtr RestPoseData(const mjModel* model, int torso_qpos);
 // Foot point of a leg in the world frame of `data`.
 Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegChain& leg);
 
+// Actuator `a` is a position servo: force = gain * ctrl - gain * q (MuJoCo's <position>).
+bool IsPositionServo(const mjModel* model, int a);
+
 }  // namespace dgmm::sim

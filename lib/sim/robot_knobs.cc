@@ -42,8 +42,7 @@ void AddActuationKnobs(const SimConfig& config, const mjModel* m, std::vector<Kn
   knobs->push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, 0.2, {probe}));
   bool servos = false;
   for (int a = 0; a < m->nu; ++a) {
-    servos |= m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_biastype[a] == mjBIAS_AFFINE &&
-              m->actuator_biasprm[mjNBIAS * a + 1] < 0;
+    servos |= m->actuator_trntype[a] == mjTRN_JOINT && IsPositionServo(m, a);
   }
   if (!servos) return;
   const double bl = config.actuators.backlash_rad;

@@ -424,6 +424,7 @@ void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>
   if (!s->named || s->z_vs_named >= options.z) return;
   s->named = false;
   s->rivals_named = s->z_vs_named > 0;
+  s->bar_z = options.z;
   const std::string than = s->rivals_named ? Fmt(" better than the named knobs' correction, but by under %.3g SE", options.z)
                                            : " no better than the named knobs' correction";
   s->why = "its best point (" + s->leg + Fmt(" at gain %.3g) fits the real samples", s->value) + than +

@@ -131,6 +131,7 @@ struct LegSearch {
   // The best point fits better than the named knobs' correction, but by under options.z SE: the
   // data do not tell the leg from the named knobs (a doubt of the verdict, AddLegSearch).
   bool rivals_named = false;
+  double bar_z = NAN;  // the z it would have needed to replace them (LegSearchOptions::z)
 };
 
 // The best point's mean score per real sample under the search's own score (its recording's own

@@ -181,6 +181,7 @@ TEST(LegSearch, ALegThatFitsBetterButNotByTheBarIsADoubtOfTheNamedKnobs) {
   ASSERT_FALSE(v.doubts.empty());
   EXPECT_NE(v.doubts.back().find("a weak leg1 leg"), std::string::npos) << v.doubts.back();
   EXPECT_NE(v.doubts.back().find("do not tell the two apart"), std::string::npos) << v.doubts.back();
+  EXPECT_NE(v.doubts.back().find("under the search's bar of 2)"), std::string::npos) << v.doubts.back();
 }
 
 // The other score (a broad component instead of the default sag mode) on the same fake: a planted
