@@ -290,26 +290,29 @@ void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, 
                                      state.Ref(), &out->best_misfit_se);
 }
 
+// The gate at other places: the real samples fit the best point's model no worse than its own
+// recording there, within z SE; else the point is not named.
+void GateElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
+                   const SearchState& state, const LegSearchOptions& options, const Knob& knob, LegSearch* out) {
+  MisfitsElsewhere(simulator, in, recording, state, options, out);
+  out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
+  if (out->best_misfit <= options.z * out->best_misfit_se) return;
+  out->named = false;
+  out->why = "the real samples fit the model of the best point (" + PointName(knob, out->value) +
+             Fmt(") worse than its own recording at other places does (by %.3g nats per sample, ", out->best_misfit) +
+             Fmt("%.1f SE)", out->best_misfit / out->best_misfit_se) +
+             (knob.leg.empty() ? ": the mismatch is not this knob alone" : ": the mismatch is not a weak leg alone");
+}
+
 // Does the best point remove enough of the nominal's misfit? Else the leg is not named.
 void CheckMisfit(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
                  const SearchState& state, const LegSearchOptions& options, const Knob& knob, LegSearch* out) {
-  if (options.misfit_elsewhere) {
-    MisfitsElsewhere(simulator, in, recording, state, options, out);
-  } else {
-    out->nominal_misfit = Misfit(state.nominal.samples, in, options, state.Ref());
-    out->best_misfit = Misfit(state.scored[out->best].samples, in, options, state.Ref());
-  }
+  if (options.misfit_elsewhere) return GateElsewhere(simulator, in, recording, state, options, knob, out);
+  out->nominal_misfit = Misfit(state.nominal.samples, in, options, state.Ref());
+  out->best_misfit = Misfit(state.scored[out->best].samples, in, options, state.Ref());
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
-  if (options.misfit_elsewhere) {
-    if (out->best_misfit <= options.z * out->best_misfit_se) return;
-    out->named = false;
-    out->why = "the real samples fit the model of the best point (" + PointName(knob, out->value) +
-               Fmt(") worse than its own recording at other places does (by %.3g nats per sample, ", out->best_misfit) +
-               Fmt("%.1f SE)", out->best_misfit / out->best_misfit_se) +
-               (knob.leg.empty() ? ": the mismatch is not this knob alone" : ": the mismatch is not a weak leg alone");
-    return;
-  }
   if (out->gap_closed >= options.min_gap_closed) return;
+  if (options.second_look_elsewhere) return GateElsewhere(simulator, in, recording, state, options, knob, out);
   out->named = false;
   out->why = "the best point (" + PointName(knob, out->value) +
              Fmt(") removes only %.0f%% of the nominal's misfit (the real samples' deficit against the recording's own "

@@ -74,6 +74,31 @@ TEST(LegSearch, PhysicsOfAnotherKindNamesNoLeg) {
   EXPECT_FALSE(r.named) << "named " << r.leg << " at " << r.value;
 }
 
+// A point the same-place gate refuses gets a second look at other places (second_look_elsewhere):
+// a planted weak leg is named after it, checked against a recording of the point elsewhere;
+// physics of another kind still names no leg.
+TEST(LegSearch, ASecondLookAtOtherPlacesNamesALegTheSamePlaceGateRefused) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  LegSearchOptions o = Options(s);
+  o.min_gap_closed = 1;  // a share of the nominal's misfit no point removes here
+  const LegSearch refused = SearchLegGains(SharedFake(), s.in, s.set, s.options.candidates, o);
+  ASSERT_FALSE(refused.named) << "gap closed " << refused.gap_closed;
+  EXPECT_FALSE(refused.misfit_elsewhere);
+  EXPECT_NE(refused.why.find("of the nominal's misfit"), std::string::npos) << refused.why;
+  o.second_look_elsewhere = true;
+  const LegSearch second = SearchLegGains(SharedFake(), s.in, s.set, s.options.candidates, o);
+  ASSERT_TRUE(second.named) << second.why;
+  EXPECT_EQ(second.leg, "leg1");
+  EXPECT_NEAR(second.value, 0.38, 0.25 * 0.38);
+  EXPECT_TRUE(second.misfit_elsewhere);
+  EXPECT_LE(second.best_misfit, o.z * second.best_misfit_se);
+  FakeExtras extras;
+  extras.geometry = 0.04;  // no knob describes it
+  const Stages g = RunStages({}, 3, extras);
+  const LegSearch other = SearchLegGains(SharedFake(), g.in, g.set, g.options.candidates, o);
+  EXPECT_FALSE(other.named) << "named " << other.leg << " at " << other.value;
+}
+
 TEST(LegSearch, TheAnswerDoesNotDependOnTheThreadCount) {
   const Stages s = RunStages({{kLeg2Gain, 0.4}}, 3);
   const LegSearch one = Search(s, 1), two = Search(s, 2);
