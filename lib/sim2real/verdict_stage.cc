@@ -84,8 +84,9 @@ VerdictDrifting Drifting(const CandidateSet& set, const Refinement& r, const Con
 }  // namespace
 
 bool VerdictOptions::IsValid(std::string* error) const {
-  if (!(min_inclusion >= 0 && min_inclusion <= 1) || !(noise_structure_p > 0 && noise_structure_p < 1)) {
-    if (error) *error = "0 <= min_inclusion <= 1 and 0 < noise_structure_p < 1";
+  if (!(min_inclusion >= 0 && min_inclusion <= 1) || !(sure_inclusion >= min_inclusion && sure_inclusion <= 1) ||
+      !(noise_structure_p > 0 && noise_structure_p < 1)) {
+    if (error) *error = "0 <= min_inclusion <= sure_inclusion <= 1 and 0 < noise_structure_p < 1";
     return false;
   }
   return true;
@@ -151,6 +152,11 @@ Verdict ComposeVerdict(const Baseline& base, const CandidateSet& set, const Refi
                       confidence.family_inclusion.at(set.candidates[k].family)});
   }
   for (const auto& d : adequacy.doubts) v.doubts.push_back(d);
+  for (const VerdictNamed& n : v.named) {
+    if (n.inclusion < 0 || n.inclusion >= options.sure_inclusion) continue;
+    v.doubts.push_back(n.family + " (" + n.knob + Fmt(") held in %.0f%% of the resamples, under ", 100 * n.inclusion) +
+                       Fmt("%.0f%%: these data are often read otherwise", 100 * options.sure_inclusion));
+  }
   v.structured_in = adequacy.residual.structured_in;
   const bool session_drift = adequacy.total_drift.drifting, step_varies = adequacy.total_step_variation.drifting;
   if (session_drift) AddUnique(&v.structured_in, "session order");
