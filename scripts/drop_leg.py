@@ -20,7 +20,7 @@ def fail(message):
 
 
 def without_leg(mjcf_path, first_joint):
-    """The model's element tree without the body carrying `first_joint`, and that body's names."""
+    """The model's element tree without the body carrying `first_joint` and what names its contents."""
     try:
         tree = ET.parse(mjcf_path)
     except (OSError, ET.ParseError) as e:

@@ -1,7 +1,6 @@
 #!/usr/bin/env python3
 """Unit tests of scripts/drop_leg.py (no dgmm needed; ctest drop_leg_test): the leg's body, its
 joints, actuators and config entry go and nothing else does; bad input exits with one line."""
-import importlib.util
 import json
 import os
 import subprocess

@@ -59,8 +59,15 @@ GaitTiming Wave(const std::vector<LegPlace>& legs, const std::string& source) {
   return t;
 }
 
-// Neighbours along a side and across in opposite halves of the cycle (trot, tripod and the
-// alternating tetrapod for 2, 3 and 4 legs a side): any equal number of legs a side, 2 or more.
+// Neighbours along a side and across in opposite halves of the cycle, per_side legs a side: the
+// trot, tripod and alternating tetrapod for 2, 3 and 4.
+PhaseTable AlternatingTable(std::size_t per_side) {
+  PhaseTable table(2, std::vector<double>(per_side));
+  for (std::size_t k = 0; k < per_side; ++k) table[0][k] = 0.5 * (k % 2), table[1][k] = 0.5 * ((k + 1) % 2);
+  return table;
+}
+
+// The alternating pattern on any equal number of legs a side, 2 or more.
 GaitTiming Alternating(const std::vector<LegPlace>& legs, const std::string& source) {
   const std::size_t left = SideFrontToBack(legs, 1).size(), right = legs.size() - left;
   if (left != right || left < 2) {
@@ -68,19 +75,14 @@ GaitTiming Alternating(const std::vector<LegPlace>& legs, const std::string& sou
                          "alternating needs the same number of legs on each side, at least 2; the robot has " +
                              std::to_string(left) + " left and " + std::to_string(right) + " right");
   }
-  PhaseTable table(2, std::vector<double>(left));
-  for (std::size_t k = 0; k < left; ++k) table[0][k] = 0.5 * (k % 2), table[1][k] = 0.5 * ((k + 1) % 2);
-  return FromTable(table, 0.5, legs, "alternating", source);
+  return FromTable(AlternatingTable(left), 0.5, legs, "alternating", source);
 }
 
-// The pattern `auto` stands for: the alternating pattern on equal sides (trot, tripod, the
-// alternating tetrapod by name for 4, 6 and 8 legs), else the wave from 4 legs on.
+// The pattern `auto` stands for: the alternating pattern on equal sides (the trot, tripod and
+// alternating tetrapod on 4, 6 and 8 legs), else the wave from 4 legs on.
 std::string AutoPattern(const std::vector<LegPlace>& legs, const std::string& source) {
   const std::size_t left = SideFrontToBack(legs, 1).size(), right = legs.size() - left;
-  if (left == right && left >= 2) {
-    static const char* kNamed[] = {"trot", "tripod", "alternating_tetrapod"};
-    return left <= 4 ? kNamed[left - 2] : "alternating";
-  }
+  if (left == right && left >= 2) return "alternating";
   if (legs.size() >= 4) return "wave";
   throw MakeInputError(source, "robot.gait.pattern",
                        "no default gait for " + std::to_string(legs.size()) +
@@ -100,11 +102,11 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
     t.phase = gait.phases;
     t.duty = 0.5;
   } else if (pattern == "trot") {
-    t = FromTable({{0.0, 0.5}, {0.5, 0.0}}, 0.5, legs, pattern, source);
+    t = FromTable(AlternatingTable(2), 0.5, legs, pattern, source);
   } else if (pattern == "crawl") {  // hind left, front left, hind right, front right
     t = FromTable({{0.25, 0.0}, {0.75, 0.5}}, 0.75, legs, pattern, source);
   } else if (pattern == "tripod") {
-    t = FromTable({{0.0, 0.5, 0.0}, {0.5, 0.0, 0.5}}, 0.5, legs, pattern, source);
+    t = FromTable(AlternatingTable(3), 0.5, legs, pattern, source);
   } else if (pattern == "tetrapod") {  // three pairs, one swinging at a time, back to front
     t = FromTable({{0.0, 2.0 / 3, 1.0 / 3}, {1.0 / 3, 0.0, 2.0 / 3}}, 2.0 / 3, legs, pattern, source);
   } else if (pattern == "wave") {
@@ -112,7 +114,7 @@ GaitTiming ResolveGait(const GaitDescription& gait, const std::vector<LegPlace>&
   } else if (pattern == "alternating") {
     t = Alternating(legs, source);
   } else {  // alternating_tetrapod
-    t = FromTable({{0.0, 0.5, 0.0, 0.5}, {0.5, 0.0, 0.5, 0.0}}, 0.5, legs, pattern, source);
+    t = FromTable(AlternatingTable(4), 0.5, legs, pattern, source);
   }
   if (gait.duty_factor > 0) t.duty = gait.duty_factor;
   t.phase_backward = t.phase;

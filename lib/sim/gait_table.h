@@ -39,8 +39,9 @@ double LateralShift(const GaitTiming& timing, const std::vector<double>& phase, 
 // The pattern's timing for these legs: trot / crawl need 4 legs, tripod / tetrapod 6,
 // alternating_tetrapod 8, each half on either side; alternating any equal number a side from 2
 // (trot, tripod and the alternating tetrapod are its cases); wave any number from 3, one foot in
-// the air at a time. auto picks the alternating pattern on equal sides (by its name for 4, 6 and 8
-// legs) and the wave otherwise (a robot that lost a leg); custom takes gait.phases (one per leg).
+// the air at a time. auto picks the alternating pattern on equal sides (the trot, tripod and
+// alternating tetrapod on 4, 6 and 8 legs) and the wave otherwise (a robot that lost a leg); custom
+// takes gait.phases (one per leg).
 // The tetrapod and the wave swing each side's legs from back to front when walking forwards.
 // Throws InputError "<source>: robot.gait.pattern: ..." when the pattern needs another number of
 // legs.

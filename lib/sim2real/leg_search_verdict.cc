@@ -27,9 +27,9 @@ VerdictNamed NamedLeg(const LegSearch& s) {
 // them apart, so the named knobs are not the only reading.
 void AddRivalDoubt(const LegSearch& s, Verdict* v) {
   v->doubts.push_back("a weak " + s.leg + Fmt(" leg (gain %.3g)", s.value) +
-                      Fmt(" fits the real samples as well as the named knobs (better by z %.2f, under the search's bar of",
-                          s.z_vs_named) +
-                      Fmt(" %.3g):", s.bar_z) +
+                      Fmt(" fits the real samples as well as the named knobs (better by z %.2f, under the search's bar of "
+                          "%.3g):",
+                          s.z_vs_named, s.bar_z) +
                       " these data do not tell the two apart");
   if (v->status == "explained") v->status = "partly_explained";
 }
