@@ -45,6 +45,14 @@ void SetBodyMass(mjModel* m, int body, double mass_kg) {
   m->body_mass[body] = mass_kg;
 }
 
+// MuJoCo's compile error on one line (its XML errors span several: "XML parse error 3:\nError=...").
+std::string OneLine(const char* error) {
+  std::string line = error[0] ? error : "MuJoCo cannot load it";
+  while (!line.empty() && (line.back() == '\n' || line.back() == ' ')) line.pop_back();
+  for (char& c : line) c = c == '\n' ? ' ' : c;
+  return line;
+}
+
 }  // namespace
 
 MjModelPtr LoadWithFiles(const std::vector<std::pair<std::string, std::string>>& files,
@@ -59,7 +67,7 @@ MjModelPtr LoadWithFiles(const std::vector<std::pair<std::string, std::string>>&
   }
   char error[1000] = "";
   MjModelPtr model(mj_loadXML(load_path.c_str(), vfs.get(), error, sizeof(error)));
-  if (!model) throw MakeInputError(source_name, "MJCF", error[0] ? error : "MuJoCo cannot load it");
+  if (!model) throw MakeInputError(source_name, "MJCF", OneLine(error));
   return model;
 }
 
@@ -71,9 +79,7 @@ MjModelPtr LoadRobotModel(const SimConfig& config) {
   if (config.mjcf_path.empty()) return LoadMjcfString(kBuiltinRobotMjcf, "built-in robot");
   char error[1000] = "";
   MjModelPtr model(mj_loadXML(config.mjcf_path.c_str(), nullptr, error, sizeof(error)));
-  if (!model) {
-    throw MakeInputError(config.mjcf_path, "MJCF", error[0] ? error : "MuJoCo cannot load it");
-  }
+  if (!model) throw MakeInputError(config.mjcf_path, "MJCF", OneLine(error));
   return model;
 }
 

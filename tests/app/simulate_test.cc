@@ -54,6 +54,29 @@ TEST(SimulateAppTest, UsesTheConfigFile) {
   fs::remove_all(dir);
 }
 
+// A user's first steps with their own MJCF: draft a config (robot-draft), then record with it.
+TEST(SimulateAppTest, ADraftedConfigRecordsAsWritten) {
+  const fs::path dir = MakeTempDir("simulate_draft");
+  const std::string config = (dir / "hexapod_draft.json").string();
+  const RunResult draft = RunDgmm({"robot-draft", SourcePath("datasets/robots/hexapod.xml").string(), "-o", config});
+  ASSERT_EQ(draft.exit_code, 0) << draft.err;
+  EXPECT_NE(draft.err.find("6 legs, torso torso, floor floor"), std::string::npos) << draft.err;
+  EXPECT_NE(draft.err.find("the draft binds"), std::string::npos) << draft.err;
+  auto args = Quick(dir / "draft.h5", "1");
+  args.insert(args.end(), {"--config", config});
+  const RunResult r = RunDgmm(args);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(ReadSampleSet((dir / "draft.h5").string()).size(), 6);
+  // No model, no draft: one line naming the file, nothing written.
+  const std::string missing = (dir / "missing.xml").string();
+  const RunResult bad = RunDgmm({"robot-draft", missing, "-o", (dir / "bad.json").string()});
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find(missing), std::string::npos) << bad.err;
+  EXPECT_EQ(CountLines(bad.err), 1) << bad.err;
+  EXPECT_FALSE(fs::exists(dir / "bad.json"));
+  fs::remove_all(dir);
+}
+
 TEST(SimulateAppTest, FailsCleanlyOnBadInput) {
   const fs::path dir = MakeTempDir("simulate_bad");
   std::ofstream(dir / "bad.json") << R"({"slope_deg": 18, "frictoin": {}})";

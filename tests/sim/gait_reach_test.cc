@@ -15,13 +15,14 @@
 #include "sim/mujoco_model.h"
 #include "sim/sim_config.h"
 #include "sim/simulator.h"
+#include "robot_files.h"
 
 namespace dgmm::sim {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kRobots = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots";
+using test::kRobots;
 
 struct Bound {
   MjModelPtr model;

@@ -17,20 +17,15 @@
 #include "sim/legged_robot.h"
 #include "sim/sim_config.h"
 #include "sim/simulator.h"
+#include "robot_files.h"
 
 namespace dgmm::sim {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kRobots = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots";
-
-std::string ReadText(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using test::kRobots;
+using test::ReadText;
 
 SimConfig Hexapod(double slope_deg = 0) {
   SimConfig c = LoadSimConfig((kRobots / "hexapod.json").string());

@@ -10,12 +10,13 @@
 
 #include "sim/protocol.h"
 #include "sim/simulator.h"
+#include "robot_files.h"
 
 namespace dgmm::sim {
 namespace {
 
 namespace fs = std::filesystem;
-const fs::path kRobots = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots";
+using test::kRobots;
 
 // The hexapod on its 10-degree slope; `self_colliding`: its MJCF with every geom colliding with
 // every other (default conaffinity 1), written next to the original so the config's path holds.

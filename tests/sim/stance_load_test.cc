@@ -12,13 +12,14 @@
 #include "sim/mujoco_model.h"
 #include "sim/sim_config.h"
 #include "sim/simulator.h"
+#include "robot_files.h"
 
 namespace dgmm::sim {
 namespace {
 
 namespace fs = std::filesystem;
 
-const fs::path kRobots = fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots";
+using test::kRobots;
 
 // The hexapod with every servo's force range set to +-`limit` N m, written to `path`.
 SimConfig HexapodWithForceRange(const std::string& limit, const fs::path& path) {

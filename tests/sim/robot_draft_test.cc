@@ -1,0 +1,150 @@
+// Tests of lib/sim/robot_draft.h: the project's robots are drafted as their shipped configs
+// describe them, and models that cannot be drafted are refused naming the part.
+#include "sim/robot_draft.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+#include "sim/sim_config.h"
+#include "util/error.h"
+#include "robot_files.h"
+
+namespace dgmm::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+using test::kRobots;
+using test::ReadText;
+
+// `xml` written to a temporary file for the duration of a test.
+class TempModel {
+ public:
+  explicit TempModel(const std::string& xml)
+      : path_(fs::temp_directory_path() / ("dgmm_draft_" + std::to_string(::getpid()) + ".xml")) {
+    std::ofstream(path_) << xml;
+  }
+  ~TempModel() { fs::remove(path_); }
+  std::string path() const { return path_.string(); }
+
+ private:
+  fs::path path_;
+};
+
+// The hexapod's MJCF with `from` replaced by `to`.
+std::string EditedHexapod(const std::string& from, const std::string& to) {
+  std::string xml = ReadText(kRobots / "hexapod.xml");
+  const auto at = xml.find(from);
+  if (at != std::string::npos) xml.replace(at, from.size(), to);
+  return at == std::string::npos ? "" : xml;
+}
+
+std::string ErrorOf(const std::string& xml) {
+  TempModel model(xml);
+  try {
+    DraftRobot(model.path());
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(RobotDraft, TheProjectsRobotsAreDraftedAsTheirConfigsDescribeThem) {
+  for (const char* name : {"hexapod.json", "sprawled_quadruped.json", "planar_quadruped.json",
+                           "mammal_quadruped/mammal_quadruped.json", "scorpion_generic.json"}) {
+    SCOPED_TRACE(name);
+    const SimConfig shipped = LoadSimConfig((kRobots / name).string());
+    const RobotDescription& want = *shipped.robot;
+    const RobotDraft draft = DraftRobot(shipped.mjcf_path);
+    const RobotDescription& got = draft.robot;
+    EXPECT_EQ(got.torso_body, want.torso_body);
+    EXPECT_EQ(got.floor_geom, want.floor_geom);
+    ASSERT_EQ(got.legs.size(), want.legs.size());
+    std::map<std::string, const LegDescription*> by_name;
+    for (const auto& leg : got.legs) by_name[leg.name] = &leg;
+    for (const auto& leg : want.legs) {
+      SCOPED_TRACE(leg.name);
+      ASSERT_EQ(by_name.count(leg.name), 1u);
+      const LegDescription& drafted = *by_name[leg.name];
+      EXPECT_EQ(drafted.joints, leg.joints);
+      EXPECT_EQ(drafted.foot.geom, leg.foot.geom);
+      if (!leg.side.empty()) EXPECT_EQ(drafted.side, leg.side);
+    }
+    EXPECT_EQ(got.passive_joints, want.passive_joints);
+    // Each draft binds as dgmm simulate binds a robot block (with the generic gait: the mammal's
+    // shipped config replays its own controller instead, which a draft cannot guess).
+    EXPECT_EQ(draft.bind_error, "");
+  }
+}
+
+TEST(RobotDraft, ABranchAboveTheFeetIsNotALegAndItsJointsArePassive) {
+  // A tail: an undriven hinge on the torso's back, well above the ground.
+  const std::string xml = EditedHexapod(
+      "<freejoint name=\"root\"/>",
+      "<freejoint name=\"root\"/><body name=\"tail\" pos=\"-0.16 0 0.02\"><joint name=\"tail_wag\" type=\"hinge\" "
+      "axis=\"0 0 1\" range=\"-30 30\"/><geom type=\"capsule\" fromto=\"0 0 0 -0.1 0 0.03\" size=\"0.01\" "
+      "mass=\"0.02\"/></body>");
+  ASSERT_NE(xml, "");
+  TempModel model(xml);
+  const RobotDraft draft = DraftRobot(model.path());
+  EXPECT_EQ(draft.robot.legs.size(), 6u);
+  EXPECT_EQ(draft.robot.passive_joints, std::vector<std::string>{"tail_wag"});
+  EXPECT_EQ(draft.bind_error, "");
+  ASSERT_FALSE(draft.notes.empty());
+  EXPECT_NE(draft.notes[0].find("\"tail\" does not reach the ground"), std::string::npos) << draft.notes[0];
+}
+
+TEST(RobotDraft, AnUnnamedFootIsItsBodyWithTheGeomsOffset) {
+  const std::string xml = EditedHexapod("name=\"front_left_foot\" ", "");
+  ASSERT_NE(xml, "");
+  TempModel model(xml);
+  const RobotDraft draft = DraftRobot(model.path());
+  const auto& leg = draft.robot.legs[0];
+  EXPECT_EQ(leg.name, "front_left");
+  EXPECT_EQ(leg.foot.geom, "");
+  EXPECT_EQ(leg.foot.body, "front_left_tibia");
+  EXPECT_NEAR(leg.foot.offset_m.x(), 0.03, 1e-9);  // the capsule's centre in its body's frame
+  EXPECT_NEAR(leg.foot.offset_m.z(), -0.16, 1e-9);
+  EXPECT_EQ(draft.bind_error, "");
+}
+
+TEST(RobotDraft, ATorsoLongerAcrossTheForwardAxisIsNoted) {
+  const SimConfig hexapod = LoadSimConfig((kRobots / "hexapod.json").string());
+  RobotDraftOptions sideways;
+  sideways.forward_axis = Eigen::Vector3d::UnitY();
+  const RobotDraft draft = DraftRobot(hexapod.mjcf_path, sideways);
+  ASSERT_EQ(draft.notes.size(), 1u);
+  EXPECT_NE(draft.notes[0].find("the torso is longest along 1,0,0"), std::string::npos) << draft.notes[0];
+  EXPECT_TRUE(DraftRobot(hexapod.mjcf_path).notes.empty());
+  int left = 0;
+  for (const auto& leg : draft.robot.legs) left += leg.side == "left";
+  EXPECT_EQ(left, 2);  // the front legs are on the left of +y
+}
+
+TEST(RobotDraft, ModelsThatCannotBeDraftedAreRefusedNamingThePart) {
+  EXPECT_NE(ErrorOf(EditedHexapod("<freejoint name=\"root\"/>", "")).find("one body with a free joint"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf(EditedHexapod("type=\"plane\"", "type=\"box\"")).find("no named plane geom"), std::string::npos);
+  EXPECT_NE(ErrorOf("<mujoco><worldbody><geom name=\"floor\" type=\"plane\" size=\"1 1 0.1\"/><body name=\"b\" "
+                    "pos=\"0 0 1\"><freejoint/><geom type=\"sphere\" size=\"0.1\"/></body></worldbody></mujoco>")
+                .find("no jointed branch below the torso reaches the ground"),
+            std::string::npos);
+  const std::string missing = (fs::temp_directory_path() / "dgmm_no_such_model.xml").string();
+  try {
+    DraftRobot(missing);
+    ADD_FAILURE() << "a missing file was drafted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(missing), std::string::npos) << e.what();
+  }
+  RobotDraftOptions vertical;
+  vertical.forward_axis = Eigen::Vector3d::UnitZ();
+  EXPECT_THROW(DraftRobot((kRobots / "hexapod.xml").string(), vertical), InputError);
+}
+
+}  // namespace
+}  // namespace dgmm::sim
