@@ -12,6 +12,7 @@
 #include "sim/robot_draft.h"
 #include "util/atomic_file.h"
 #include "util/error.h"
+#include "util/output_guard.h"
 
 namespace dgmm::app {
 namespace {
@@ -41,7 +42,10 @@ std::string ConfigText(const RobotDraftArgs& args, const sim::RobotDraft& draft)
 
 void Run(const RobotDraftArgs& args) {
   if (args.forward_axis.size() != 3) throw MakeInputError("", "--forward-axis", "three numbers x,y,z expected");
-  if (!args.output.empty()) { AtomicFile probe(args.output); }  // fail before the work when unwritable
+  if (!args.output.empty()) {
+    RefuseOutputThatIsAnInput(args.output, {args.mjcf});
+    AtomicFile probe(args.output);  // fail before the work when unwritable
+  }
   sim::RobotDraftOptions options;
   options.forward_axis = Eigen::Vector3d(args.forward_axis[0], args.forward_axis[1], args.forward_axis[2]);
   options.foot_band = args.foot_band;

@@ -396,6 +396,10 @@ def make_inputs(dgmm, w, seed):
     inp["real"] = os.path.join(ROOT, "datasets", "sim2real", "slip", "real.h5")
     shutil.copyfile(inp["sim"], P("sim_copy.h5"))
     inp["sim_copy.h5"] = P("sim_copy.h5")
+    shutil.copyfile(os.path.join(ROOT, "datasets", "robots", "hexapod.xml"), P("robot.xml"))
+    inp["robot.xml"] = P("robot.xml")
+    write(P("robot_bad.xml"), "<mujoco><worldbody><body name=\"b\">")
+    inp["robot_bad.xml"] = P("robot_bad.xml")
     return inp
 
 
@@ -688,6 +692,8 @@ def cases(inp, seed):
     same("simulate --config c.json -o c.json",
          ["simulate", "--config", I["cfg_good.json"], "-o", I["cfg_good.json"]],
          I["cfg_good.json"])
+    same("robot-draft robot.xml -o robot.xml", ["robot-draft", I["robot.xml"], "-o", I["robot.xml"]],
+         I["robot.xml"])
     same("upgrade set_v1.h5 -o set_v1.h5", ["upgrade", I["set_v1.h5"], "-o", I["set_v1.h5"]],
          I["set_v1.h5"])
     same("render m.h5 -o m.h5", ["render", I["m.h5"], "-o", I["m.h5"], "--command", "0"],
@@ -713,6 +719,14 @@ def cases(inp, seed):
                                  ("--protocol bogus", ["--protocol", "bogus"], "--protocol")]:
         add("simulate", f"simulate {label}", ["simulate", "-o", O] + extra, [], out=O,
             kind="h5_set", needles=[needle])
+
+    # --- robot-draft: models it cannot read or draft, flags it cannot take ---
+    for name, extra, needle in [("robot_bad.xml", [], "robot_bad.xml"), ("missing.json", [], "missing.json"),
+                                ("robot.xml", ["--forward-axis", "0,0,1"], "forward_axis"),
+                                ("robot.xml", ["--forward-axis", "1,0"], "--forward-axis"),
+                                ("robot.xml", ["--foot-band", "2"], "foot_band")]:
+        add("robot-draft", f"robot-draft {name} {' '.join(extra)}".strip(),
+            ["robot-draft", I[name], "-o", O] + extra, [I[name]], out=O, kind="json", needles=[needle])
 
     # --- sim2real ---
     def s2r(sim, real, *extra):

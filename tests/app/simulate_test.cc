@@ -74,6 +74,12 @@ TEST(SimulateAppTest, ADraftedConfigRecordsAsWritten) {
   EXPECT_NE(bad.err.find(missing), std::string::npos) << bad.err;
   EXPECT_EQ(CountLines(bad.err), 1) << bad.err;
   EXPECT_FALSE(fs::exists(dir / "bad.json"));
+  // The draft never overwrites the model it reads.
+  fs::copy_file(SourcePath("datasets/robots/hexapod.xml"), dir / "robot.xml");
+  const RunResult same = RunDgmm({"robot-draft", (dir / "robot.xml").string(), "-o", (dir / "robot.xml").string()});
+  EXPECT_NE(same.exit_code, 0);
+  EXPECT_EQ(CountLines(same.err), 1) << same.err;
+  EXPECT_NE(std::ifstream(dir / "robot.xml").get(), '{');
   fs::remove_all(dir);
 }
 
