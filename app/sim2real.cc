@@ -394,7 +394,7 @@ void Setup(CLI::App& root) {
                   "the sim model and the ceiling")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd->add_option("--challenge-inclusion", args->challenge_inclusion,
-                  "... and also when a named family's bootstrap inclusion is under this (0: never; experimental, "
+                  "... and also when a named family's bootstrap inclusion is under this (0: never; "
                   "docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
   cmd->add_flag("--leg-second-look", args->leg_second_look,

@@ -147,7 +147,7 @@ TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
 
 // With challenge_inclusion a name the resamples seldom agree on is challenged even at the ceiling
 // (sprawled quadruped 54202: a weak front leg read as soft servos, inclusion 75%, and a tracker
-// offset, 60%); off by default.
+// offset, 60%); at 80% by default, 0 turns it off.
 TEST(Analysis, TheLegSearchCanChallengeANameOfLowInclusion) {
   Analysis a;
   a.candidates.candidates.resize(1);
@@ -157,9 +157,10 @@ TEST(Analysis, TheLegSearchCanChallengeANameOfLowInclusion) {
   a.verdict.named[0].inclusion = 0.75, a.verdict.named[1].inclusion = 0.6;
   a.adequacy.gap_closed = 1.02;
   LegSearchOptions options;
-  EXPECT_FALSE(WantLegSearch(a, options)) << "off by default";
+  EXPECT_TRUE(WantLegSearch(a, options)) << "on by default";
+  options.challenge_inclusion = 0;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "turned off";
   options.challenge_inclusion = 0.8;
-  EXPECT_TRUE(WantLegSearch(a, options));
   a.verdict.named[0].inclusion = 0.8, a.verdict.named[1].inclusion = 1.0;
   EXPECT_FALSE(WantLegSearch(a, options)) << "every named family at 80% or more";
   a.verdict.named[1].inclusion = -1;
