@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 
 #include "sim/contact_extent.h"
@@ -61,8 +62,10 @@ int FindFloor(const mjModel* m, const std::string& source, std::vector<std::stri
   if (planes.empty()) {
     throw MakeInputError(source, "worldbody", "no named plane geom on the world body (the floor) found");
   }
-  if (planes.size() > 1) notes->push_back("floor: several named planes; the first, \"" + Name(m, mjOBJ_GEOM, planes[0]) +
-                                          "\", taken (robot.floor_geom)");
+  if (planes.size() > 1) {
+    notes->push_back("floor: several named planes; the first, \"" + Name(m, mjOBJ_GEOM, planes[0]) +
+                     "\", taken (robot.floor_geom)");
+  }
   return planes[0];
 }
 
@@ -108,10 +111,12 @@ bool Driven(const mjModel* m, int j) {
 }
 
 // The leg of a branch: driven hinge and slide joints from the torso to the foot geom's body; the
-// undriven ones go to `passive`. Empty name: the branch cannot be described (a note says why).
-LegDescription DescribeLeg(const mjModel* m, const Branch& branch, std::vector<std::string>* passive,
-                           std::vector<std::string>* notes) {
+// undriven ones go to `passive`. Nothing (and a note) when the branch cannot be described; the
+// name may be empty (MakeNamesUnique gives it one).
+std::optional<LegDescription> DescribeLeg(const mjModel* m, const Branch& branch, std::vector<std::string>* passive,
+                                          std::vector<std::string>* notes) {
   LegDescription leg;
+  std::vector<std::string> undriven;
   const std::string root = Name(m, mjOBJ_BODY, branch.root);
   std::vector<int> path;
   for (int b = m->geom_bodyid[branch.foot_geom]; b != m->body_parentid[branch.root]; b = m->body_parentid[b]) {
@@ -124,26 +129,41 @@ LegDescription DescribeLeg(const mjModel* m, const Branch& branch, std::vector<s
         notes->push_back("branch at body \"" + root + "\": joint " + std::to_string(j) +
                          (name.empty() ? " has no name" : " (\"" + name + "\") is neither hinge nor slide") +
                          ", so the branch is not drafted as a leg");
-        return {};
+        return std::nullopt;
       }
-      (Driven(m, j) ? leg.joints : *passive).push_back(name);
+      (Driven(m, j) ? leg.joints : undriven).push_back(name);
     }
   }
   leg.name = LegName(leg.joints, root);
   const std::string geom = Name(m, mjOBJ_GEOM, branch.foot_geom);
+  const int body = m->geom_bodyid[branch.foot_geom];
   if (!geom.empty()) {
     leg.foot.geom = geom;
-  } else {
-    const int body = m->geom_bodyid[branch.foot_geom];
+  } else if (!Name(m, mjOBJ_BODY, body).empty()) {
     leg.foot.body = Name(m, mjOBJ_BODY, body);
-    leg.foot.offset_m = Eigen::Vector3d(m->geom_pos[3 * branch.foot_geom], m->geom_pos[3 * branch.foot_geom + 1],
-                                        m->geom_pos[3 * branch.foot_geom + 2]);
-    if (leg.foot.body.empty()) {
-      notes->push_back("leg " + leg.name + ": its lowest geom and that geom's body have no name; not drafted");
-      return {};
+    const mjtNum* p = m->geom_pos + 3 * branch.foot_geom;
+    leg.foot.offset_m = Eigen::Vector3d(p[0], p[1], p[2]);
+  } else {
+    notes->push_back("branch at body \"" + root + "\": its lowest geom and that geom's body have no name, so the "
+                     "branch is not drafted as a leg");
+    return std::nullopt;
+  }
+  passive->insert(passive->end(), undriven.begin(), undriven.end());
+  return leg;
+}
+
+// A branch that is not a leg: its named joints are passive (a note says so).
+void NotALeg(const mjModel* m, const Branch& branch, std::vector<std::string>* passive,
+             std::vector<std::string>* notes) {
+  const std::string root = Name(m, mjOBJ_BODY, branch.root);
+  notes->push_back("branch at body \"" + (root.empty() ? std::to_string(branch.root) : root) +
+                   "\" does not reach the ground at rest: not a leg, its joints passive");
+  for (int j = 0; j < m->njnt; ++j) {
+    const int b = m->jnt_bodyid[j];
+    if ((b == branch.root || Below(m, b, branch.root)) && !Name(m, mjOBJ_JOINT, j).empty()) {
+      passive->push_back(Name(m, mjOBJ_JOINT, j));
     }
   }
-  return leg;
 }
 
 // Joints of a branch off its foot chain: undriven ones are passive; driven ones are noted.
@@ -155,7 +175,9 @@ void OffChainJoints(const mjModel* m, const Branch& branch, const LegDescription
     const int b = m->jnt_bodyid[j];
     const std::string name = Name(m, mjOBJ_JOINT, j);
     if ((b != branch.root && !Below(m, b, branch.root)) || on.count(name)) continue;
-    if (!Driven(m, j)) {
+    if (name.empty()) {
+      notes->push_back("joint " + std::to_string(j) + " below leg " + leg.name + " has no name: name it to list it");
+    } else if (!Driven(m, j)) {
       passive->push_back(name);
     } else {
       notes->push_back("joint \"" + name + "\" is driven but off the way from the torso to the foot of leg " + leg.name +
@@ -240,19 +262,13 @@ RobotDraft DraftRobot(const std::string& mjcf_path, const RobotDraftOptions& opt
   std::vector<Branch> legs;
   for (const auto& b : branches) {
     if (b.foot_geom < 0 || b.low_z > (1 - options.foot_band) * lowest) {
-      const std::string root = Name(m, mjOBJ_BODY, b.root);
-      draft.notes.push_back("branch at body \"" + (root.empty() ? std::to_string(b.root) : root) +
-                            "\" does not reach the ground at rest: not a leg, its joints passive");
-      for (int j = 0; j < m->njnt; ++j) {
-        const int jb = m->jnt_bodyid[j];
-        if (jb == b.root || Below(m, jb, b.root)) r.passive_joints.push_back(Name(m, mjOBJ_JOINT, j));
-      }
+      NotALeg(m, b, &r.passive_joints, &draft.notes);
       continue;
     }
-    LegDescription leg = DescribeLeg(m, b, &r.passive_joints, &draft.notes);
-    if (leg.name.empty()) continue;
-    OffChainJoints(m, b, leg, &r.passive_joints, &draft.notes);
-    r.legs.push_back(leg), legs.push_back(b);
+    const std::optional<LegDescription> leg = DescribeLeg(m, b, &r.passive_joints, &draft.notes);
+    if (!leg) continue;
+    OffChainJoints(m, b, *leg, &r.passive_joints, &draft.notes);
+    r.legs.push_back(*leg), legs.push_back(b);
   }
   MakeNamesUnique(&r.legs);
   Sides(d.get(), options, legs, &r);

@@ -26,13 +26,15 @@ using test::ReadText;
 class TempModel {
  public:
   explicit TempModel(const std::string& xml)
-      : path_(fs::temp_directory_path() / ("dgmm_draft_" + std::to_string(::getpid()) + ".xml")) {
+      : path_(fs::temp_directory_path() /
+              ("dgmm_draft_" + std::to_string(::getpid()) + "_" + std::to_string(count_++) + ".xml")) {
     std::ofstream(path_) << xml;
   }
   ~TempModel() { fs::remove(path_); }
   std::string path() const { return path_.string(); }
 
  private:
+  static inline int count_ = 0;
   fs::path path_;
 };
 
@@ -111,6 +113,20 @@ TEST(RobotDraft, AnUnnamedFootIsItsBodyWithTheGeomsOffset) {
   EXPECT_NEAR(leg.foot.offset_m.x(), 0.03, 1e-9);  // the capsule's centre in its body's frame
   EXPECT_NEAR(leg.foot.offset_m.z(), -0.16, 1e-9);
   EXPECT_EQ(draft.bind_error, "");
+  // Without a name on the foot's body either, the leg is left out with a note, and the binding
+  // says its joints belong to no leg.
+  std::string nameless = EditedHexapod("<body name=\"front_left_tibia\"", "<body");
+  const std::string foot = "name=\"front_left_foot\" ";
+  ASSERT_NE(nameless.find(foot), std::string::npos);
+  nameless.replace(nameless.find(foot), foot.size(), "");
+  TempModel unnamed(nameless);
+  const RobotDraft partial = DraftRobot(unnamed.path());
+  EXPECT_EQ(partial.robot.legs.size(), 5u);
+  ASSERT_EQ(partial.notes.size(), 1u);
+  EXPECT_NE(partial.notes[0].find("\"front_left_coxa\": its lowest geom and that geom's body have no name"),
+            std::string::npos)
+      << partial.notes[0];
+  EXPECT_NE(partial.bind_error.find("front_left_hip_yaw\" belongs to no leg"), std::string::npos) << partial.bind_error;
 }
 
 TEST(RobotDraft, ATorsoLongerAcrossTheForwardAxisIsNoted) {
