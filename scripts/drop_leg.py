@@ -109,14 +109,12 @@ def without_leg(mjcf_path, first_joint):
         fail(f"{mjcf_path}: no joint named {first_joint}")
     body = parents[hip]
     gone = {e.get("name") for e in body.iter() if e.get("name")}
-    actuators = {a for s in root.findall("actuator") for a in s if any(v in gone for v in a.attrib.values())}
-    edit_keyframes(root, parents, set(body.iter()) | actuators, mjcf_path)
+    naming = [(s, e) for section in ("actuator", "sensor", "contact", "equality", "tendon")
+              for s in root.findall(section) for e in s if any(v in gone for v in e.attrib.values())]
+    edit_keyframes(root, parents, set(body.iter()) | {e for s, e in naming if s.tag == "actuator"}, mjcf_path)
     parents[body].remove(body)
-    for section in ("actuator", "sensor", "contact", "equality", "tendon"):
-        for s in root.findall(section):
-            for e in list(s):
-                if any(v in gone for v in e.attrib.values()):
-                    s.remove(e)
+    for s, e in naming:
+        s.remove(e)
     compilers = root.findall("compiler") or [ET.SubElement(root, "compiler")]
     for key in ("meshdir", "texturedir"):  # MuJoCo 2.2 has no assetdir; a later compiler's overrides
         for compiler in [c for c in compilers if c.get(key) is not None] or compilers[:1]:

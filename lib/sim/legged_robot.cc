@@ -29,21 +29,6 @@ int Find(const mjModel* m, mjtObj type, const std::string& name, const std::stri
   return id;
 }
 
-bool IsDescendant(const mjModel* m, int body, int ancestor) {
-  for (int b = body; b > 0; b = m->body_parentid[b]) {
-    if (b == ancestor) return true;
-  }
-  return ancestor == 0;
-}
-
-// The actuator driving `joint`, or -1.
-int ActuatorOf(const mjModel* m, int joint) {
-  for (int a = 0; a < m->nu; ++a) {
-    if (m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_trnid[2 * a] == joint) return a;
-  }
-  return -1;
-}
-
 // How far the foot's contact reaches below its foot point: a geom foot's own extent when it can
 // touch the floor; else (a site, a body, a visual geom) the lowest point of the geoms on the foot's
 // body and the bodies below it that can. -1 when none can.
@@ -172,15 +157,6 @@ void CheckEverythingAccounted(const mjModel* m, const RobotDescription& r, const
   }
 }
 
-// Forward/left/up of the robot in the torso frame.
-Eigen::Matrix3d RobotFrame(const Eigen::Vector3d& forward) {
-  Eigen::Matrix3d r;
-  r.col(0) = forward.normalized();
-  r.col(2) = Eigen::Vector3d::UnitZ();
-  r.col(1) = r.col(2).cross(r.col(0));
-  return r;
-}
-
 // Rest-pose geometry of every leg: reach, side (checked against the declared one), foot extent.
 void MeasureRest(const mjModel* m, const RobotDescription& r, const std::string& source, LeggedRobot* bound) {
   MjDataPtr d = RestPoseData(m, bound->torso_qpos);
@@ -204,7 +180,7 @@ void MeasureRest(const mjModel* m, const RobotDescription& r, const std::string&
                                "do not meet, and no <pair> joins them)");
     }
     const Eigen::Vector3d in_robot = bound->robot_in_torso.transpose() * foot;
-    const int side = in_robot.y() >= 0 ? 1 : -1;
+    const int side = FootSide(bound->robot_in_torso, foot);
     const std::string& declared = r.legs[i].side;
     if (!declared.empty() && (declared == "left" ? 1 : -1) != side) {
       throw MakeInputError(source, LegPart(static_cast<int>(i), r.legs[i]) + ".side",
@@ -508,6 +484,32 @@ void ApplyExperiment(const SimConfig& config, const LeggedRobot& b, mjModel* m, 
       m->geom_friction[3 * i + 2] = config.friction.rolling;
     }
   }
+}
+
+bool IsDescendant(const mjModel* m, int body, int ancestor) {
+  for (int b = body; b > 0; b = m->body_parentid[b]) {
+    if (b == ancestor) return true;
+  }
+  return ancestor == 0;
+}
+
+int ActuatorOf(const mjModel* m, int joint) {
+  for (int a = 0; a < m->nu; ++a) {
+    if (m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_trnid[2 * a] == joint) return a;
+  }
+  return -1;
+}
+
+Eigen::Matrix3d RobotFrame(const Eigen::Vector3d& forward) {
+  Eigen::Matrix3d r;
+  r.col(0) = forward.normalized();
+  r.col(2) = Eigen::Vector3d::UnitZ();
+  r.col(1) = r.col(2).cross(r.col(0));
+  return r;
+}
+
+int FootSide(const Eigen::Matrix3d& robot_in_torso, const Eigen::Vector3d& foot) {
+  return (robot_in_torso.transpose() * foot).y() >= 0 ? 1 : -1;
 }
 
 bool IsPositionServo(const mjModel* m, int a) {

@@ -89,4 +89,17 @@ Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegCha
 // Actuator `a` is a position servo: force = gain * ctrl - gain * q (MuJoCo's <position>).
 bool IsPositionServo(const mjModel* model, int a);
 
+// Body `body` is `ancestor` or lies below it (every body lies below the world body, 0).
+bool IsDescendant(const mjModel* model, int body, int ancestor);
+
+// The actuator driving `joint` through a joint transmission, or -1.
+int ActuatorOf(const mjModel* model, int joint);
+
+// Forward, left and up of the robot (columns) in the torso frame, for a forward axis there.
+Eigen::Matrix3d RobotFrame(const Eigen::Vector3d& forward);
+
+// The side of a foot at `foot` (torso frame): +1 left of the forward axis (or on it), -1 right.
+// The one rule for a leg's side (the binding's check of a declared side, the draft's sides).
+int FootSide(const Eigen::Matrix3d& robot_in_torso, const Eigen::Vector3d& foot);
+
 }  // namespace dgmm::sim

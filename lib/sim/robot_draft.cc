@@ -30,13 +30,6 @@ std::string Name(const mjModel* m, mjtObj type, int id) {
   return name ? name : "";
 }
 
-bool Below(const mjModel* m, int body, int ancestor) {
-  for (int b = body; b > 0; b = m->body_parentid[b]) {
-    if (b == ancestor) return true;
-  }
-  return false;
-}
-
 int FindTorso(const mjModel* m, const std::string& source) {
   std::vector<int> free;
   for (int j = 0; j < m->njnt; ++j) {
@@ -74,14 +67,14 @@ int FindFloor(const mjModel* m, const std::string& source, std::vector<std::stri
 std::vector<Branch> FindBranches(const mjModel* m, const mjData* d, int torso, int floor) {
   std::vector<Branch> branches;
   for (int b = torso + 1; b < m->nbody; ++b) {
-    if (!Below(m, b, torso) || m->body_jntnum[b] == 0) continue;
+    if (!IsDescendant(m, b, torso) || m->body_jntnum[b] == 0) continue;
     bool first = true;
     for (int a = m->body_parentid[b]; a != torso; a = m->body_parentid[a]) first = first && m->body_jntnum[a] == 0;
     if (!first) continue;
     Branch branch{b};
     for (int g = 0; g < m->ngeom; ++g) {
       const int gb = m->geom_bodyid[g];
-      if ((gb != b && !Below(m, gb, b)) || !CanTouch(m, g, floor)) continue;
+      if (!IsDescendant(m, gb, b) || !CanTouch(m, g, floor)) continue;
       const double low = d->geom_xpos[3 * g + 2] - ExtentBelow(m, d, g);
       if (branch.foot_geom < 0 || low < branch.low_z) branch = {b, g, low};
     }
@@ -101,13 +94,6 @@ std::string LegName(const std::vector<std::string>& joints, const std::string& b
   }
   while (!prefix.empty() && std::string("_-. :/").find(prefix.back()) != std::string::npos) prefix.pop_back();
   return prefix.empty() ? body : prefix;
-}
-
-bool Driven(const mjModel* m, int j) {
-  for (int a = 0; a < m->nu; ++a) {
-    if (m->actuator_trntype[a] == mjTRN_JOINT && m->actuator_trnid[2 * a] == j) return true;
-  }
-  return false;
 }
 
 // The leg of a branch: driven hinge and slide joints from the torso to the foot geom's body; the
@@ -131,7 +117,7 @@ std::optional<LegDescription> DescribeLeg(const mjModel* m, const Branch& branch
                          ", so the branch is not drafted as a leg");
         return std::nullopt;
       }
-      (Driven(m, j) ? leg.joints : undriven).push_back(name);
+      (ActuatorOf(m, j) >= 0 ? leg.joints : undriven).push_back(name);
     }
   }
   leg.name = LegName(leg.joints, root);
@@ -159,8 +145,7 @@ void NotALeg(const mjModel* m, const Branch& branch, std::vector<std::string>* p
   notes->push_back("branch at body \"" + (root.empty() ? std::to_string(branch.root) : root) +
                    "\" does not reach the ground at rest: not a leg, its joints passive");
   for (int j = 0; j < m->njnt; ++j) {
-    const int b = m->jnt_bodyid[j];
-    if ((b == branch.root || Below(m, b, branch.root)) && !Name(m, mjOBJ_JOINT, j).empty()) {
+    if (IsDescendant(m, m->jnt_bodyid[j], branch.root) && !Name(m, mjOBJ_JOINT, j).empty()) {
       passive->push_back(Name(m, mjOBJ_JOINT, j));
     }
   }
@@ -172,12 +157,11 @@ void OffChainJoints(const mjModel* m, const Branch& branch, const LegDescription
   std::set<std::string> on(leg.joints.begin(), leg.joints.end());
   on.insert(passive->begin(), passive->end());
   for (int j = 0; j < m->njnt; ++j) {
-    const int b = m->jnt_bodyid[j];
     const std::string name = Name(m, mjOBJ_JOINT, j);
-    if ((b != branch.root && !Below(m, b, branch.root)) || on.count(name)) continue;
+    if (!IsDescendant(m, m->jnt_bodyid[j], branch.root) || on.count(name)) continue;
     if (name.empty()) {
       notes->push_back("joint " + std::to_string(j) + " below leg " + leg.name + " has no name: name it to list it");
-    } else if (!Driven(m, j)) {
+    } else if (ActuatorOf(m, j) < 0) {
       passive->push_back(name);
     } else {
       notes->push_back("joint \"" + name + "\" is driven but off the way from the torso to the foot of leg " + leg.name +
@@ -198,10 +182,10 @@ void MakeNamesUnique(std::vector<LegDescription>* legs) {
 // Each leg's side from the geometry: the foot's side of the forward axis at rest (the rule the
 // binding uses).
 void Sides(const mjData* d, const RobotDraftOptions& o, const std::vector<Branch>& legs, RobotDescription* robot) {
-  const Eigen::Vector3d forward = o.forward_axis.normalized(), left = Eigen::Vector3d::UnitZ().cross(forward);
+  const Eigen::Matrix3d frame = RobotFrame(o.forward_axis);
   for (std::size_t i = 0; i < legs.size(); ++i) {
     const mjtNum* p = d->geom_xpos + 3 * legs[i].foot_geom;
-    robot->legs[i].side = left.dot(Eigen::Vector3d(p[0], p[1], p[2])) >= 0 ? "left" : "right";
+    robot->legs[i].side = FootSide(frame, Eigen::Vector3d(p[0], p[1], p[2])) > 0 ? "left" : "right";
   }
 }
 
