@@ -19,6 +19,9 @@ GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Gr
   std::vector<Eigen::Vector2d> stance;
   for (const LegChain& leg : robot_.legs) stance.push_back(leg.stance_m.head<2>());
   sway_ = SwayTargets(stance, ResolveSway(config.robot->gait.sway, robot_.timing.duty));
+  if (config.robot->gait.servo_feedforward && robot_.replay.empty()) {
+    feedforward_ = ServoFeedforward(model_.get(), robot_, config.robot->gait.period_s);  // nominal: before the experiment
+  }
   ApplyExperiment(config, robot_, model_.get(), source);
   const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
   control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
@@ -76,15 +79,26 @@ void GenericWalker::HoldStance() {
   if (!robot_.replay.empty()) {
     u_ = robot_.replay[robot_.stand_recording].At(0);
   } else {
-    u_.resize(static_cast<int>(robot_.leg_actuators.size()));
-    int k = 0;
-    for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
-      q_[i] = robot_.legs[i].stance_q;
-      for (int j = 0; j < q_[i].size(); ++j) u_[k++] = q_[i][j];
-    }
+    StanceTargets();
   }
   line_.Reset(u_);
   line_.Write(data_.get());
+}
+
+void GenericWalker::StanceTargets() {
+  u_.resize(static_cast<int>(robot_.leg_actuators.size()));
+  int k = 0;
+  std::vector<Eigen::Vector3d> feet;
+  for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
+    q_[i] = robot_.legs[i].stance_q;
+    for (int j = 0; j < q_[i].size(); ++j) u_[k++] = q_[i][j];
+    feet.push_back(robot_.legs[i].stance_m);
+  }
+  if (!feedforward_.enabled()) return;
+  const double* w = data_->qpos + robot_.torso_qpos + 3;  // not xmat: it may predate a placement
+  const Eigen::Matrix3d torso = Eigen::Quaterniond(w[0], w[1], w[2], w[3]).toRotationMatrix();
+  const LegPlan plan{q_, {}, feet, Support(), GravityAtHeading(torso * robot_.robot_in_torso)};
+  u_ += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
 }
 
 const ReplayTrack& GenericWalker::Recording(const Eigen::Vector3d& c) const {
@@ -123,6 +137,7 @@ RunOutcome GenericWalker::Place(double x_m, double y_m, double heading_rad) {
   d->qpos[a + 4] = q.x();
   d->qpos[a + 5] = q.y();
   d->qpos[a + 6] = q.z();
+  support_.assign(robot_.legs.size(), 0.0);  // released in the air
   HoldStance();
   mj_forward(m, d);
   return Stand(config_.settle_duration_s);
@@ -134,6 +149,7 @@ RunOutcome GenericWalker::Stand(double seconds) {
   const int steps = static_cast<int>(std::lround(seconds / dt));
   for (int s = 0; s < steps; ++s) {
     if (!robot_.replay.empty()) u_ = robot_.replay[robot_.stand_recording].At((s + 1) * dt);
+    if (feedforward_.enabled() && s > 0 && s % control_every_ == 0) StanceTargets();  // s = 0: HoldStance's
     if (!Step()) return RunOutcome::kUnstable;
     if (Fallen()) return RunOutcome::kFell;
   }
@@ -147,7 +163,8 @@ RunOutcome GenericWalker::Stand(double seconds) {
 // sideways command with its trailing side, LateralShift); a ramp of a tenth of a cycle at
 // either end of the command starts and ends the pattern at the stance; the stance leans with
 // gravity (robot.gait.lean) and, in statically stable gaits, sways towards the centroid of the
-// feet that stay down while each leg swings (robot.gait.sway).
+// feet that stay down while each leg swings (robot.gait.sway); with robot.gait.servo_feedforward
+// the targets carry the loads the servos will meet (servo_feedforward.h).
 void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration) {
   const double period = config_.robot->gait.period_s;
   const double ramp = 0.1 * period;
@@ -157,9 +174,7 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   // plane), so that the support polygon stays under the centre of mass on a slope. From the
   // ground's tilt at the robot's heading, not the torso's own wobble (no feedback loop).
   Eigen::Vector3d lean = Eigen::Vector3d::Zero();
-  const Eigen::Matrix3d r = RobotPose().rotation;
-  const Eigen::Vector3d g = Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() *
-                            Eigen::Vector3d(model_->opt.gravity[0], model_->opt.gravity[1], model_->opt.gravity[2]).normalized();
+  const Eigen::Vector3d g = GravityAtHeading(RobotPose().rotation);
   if (g.z() < -0.5) lean.head<2>() = config_.robot->gait.lean * robot_.stance_height_m * g.head<2>() / -g.z();
   const std::vector<double>& phase = c.x() < 0 ? robot_.timing.phase_backward : robot_.timing.phase;
   const double shift = LateralShift(robot_.timing, phase, sides_, c.y());
@@ -175,11 +190,34 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
     targets[i] = robot_.robot_in_torso *
                  (leg.stance_m + lean - sway + envelope * FootOffset(u[i], duty, d, robot_.step_height_m));
   }
+  std::vector<Eigen::VectorXd> before;  // the last targets sent
+  if (feedforward_.enabled()) before = q_;
   SolveLegsIk(model_.get(), scratch_.get(), robot_.legs, targets, &q_, 3);
   int k = 0;
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
     for (int j = 0; j < q_[i].size(); ++j) u_[k++] = q_[i][j];
   }
+  if (!feedforward_.enabled()) return;
+  LegPlan plan{q_, {}, {}, Support(), g};
+  for (std::size_t i = 0; i < n; ++i) {
+    plan.q_velocity.push_back((q_[i] - before[i]) / (control_every_ * model_->opt.timestep));
+    plan.feet_robot_m.push_back(robot_.robot_in_torso.transpose() * targets[i]);
+  }
+  u_ += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
+}
+
+const std::vector<double>& GenericWalker::Support() {
+  const std::vector<double> on = feedforward_.OnGround(model_.get(), data_.get(), robot_.torso_body);
+  // A first-order filter over a twentieth of a cycle: contacts chatter, the load moves over smoothly.
+  const double rate = std::min(1.0, control_every_ * model_->opt.timestep / (0.05 * config_.robot->gait.period_s));
+  support_.resize(on.size(), 0.0);
+  for (std::size_t i = 0; i < on.size(); ++i) support_[i] += rate * (on[i] - support_[i]);
+  return support_;
+}
+
+Eigen::Vector3d GenericWalker::GravityAtHeading(const Eigen::Matrix3d& r) const {
+  return Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() *
+         Eigen::Vector3d(model_->opt.gravity[0], model_->opt.gravity[1], model_->opt.gravity[2]).normalized();
 }
 
 Eigen::Vector2d GenericWalker::Sway(const std::vector<double>& u) const {

@@ -10,6 +10,7 @@
 #include "sim/pose.h"
 #include "sim/self_contact.h"
 #include "sim/sim_config.h"
+#include "sim/servo_feedforward.h"
 
 namespace dgmm::sim {
 
@@ -49,6 +50,12 @@ class GenericWalker {
   // weighted by SwingWeight.
   Eigen::Vector2d Sway(const std::vector<double>& u) const;
   void HoldStance();
+  // u_ (and q_) for the standing pose, with the servo feedforward when enabled.
+  void StanceTargets();
+  // Each leg's share of the weight for the feedforward: its foot's contact with the ground, filtered.
+  const std::vector<double>& Support();
+  // Gravity's direction in the robot's heading frame (the ground's tilt at the heading).
+  Eigen::Vector3d GravityAtHeading(const Eigen::Matrix3d& robot_rotation) const;
   const ReplayTrack& Recording(const Eigen::Vector3d& command) const;
 
   SimConfig config_;
@@ -60,6 +67,8 @@ class GenericWalker {
   std::vector<Eigen::VectorXd> q_;  // each leg's joint targets
   Eigen::VectorXd u_;               // the signal sent now: leg targets (gait) or every actuator's (replay)
   ActuationLine line_;
+  ServoFeedforward feedforward_;   // enabled with robot.gait.servo_feedforward
+  std::vector<double> support_;     // its legs' filtered contact, 0 to 1
   const Ground* ground_;
   std::string source_;
   double time_s_ = 0;

@@ -72,6 +72,7 @@ GaitDescription ReadGait(const json& j, const std::string& source) {
   f.Number("turn_rad", &g.turn_rad, 0, 3.2);
   f.Number("lean", &g.lean, 0, 1.5);
   f.Number("sway", &g.sway, -1, 1);
+  f.Bool("servo_feedforward", &g.servo_feedforward);
   f.Done();
   static const std::set<std::string> kPatterns = {"auto", "trot",        "crawl",
                                                   "tripod", "tetrapod", "wave",
@@ -188,6 +189,7 @@ std::string RobotDescriptionToJson(const RobotDescription& r) {
                {"stance_height_m", g.stance_height_m}, {"turn_rad", g.turn_rad},
                {"lean", g.lean},               {"sway", g.sway}};
   if (!g.phases.empty()) gait["phases"] = g.phases;
+  if (g.servo_feedforward) gait["servo_feedforward"] = true;  // absent when off: older configs' text unchanged
   json j = {{"torso_body", r.torso_body},
             {"floor_geom", r.floor_geom},
             {"forward_axis", {r.forward_axis.x(), r.forward_axis.y(), r.forward_axis.z()}},

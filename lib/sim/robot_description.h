@@ -51,6 +51,9 @@ struct GaitDescription {
   // towards the centroid of the other legs' stance points (blended from one swing to the next).
   // Negative (-1): the default, 0.1 for a duty factor of 0.75 or more and 0 below (ResolveSway).
   double sway = -1;
+  // Stance legs' targets offset by the joint torques that carry the robot's weight over the
+  // servos' stiffness (servo_feedforward.h), so soft position servos do not sag and drift.
+  bool servo_feedforward = false;
 };
 
 // What drives the legs: the generic gait (foot placement through inverse kinematics), or a

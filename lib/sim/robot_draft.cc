@@ -13,6 +13,7 @@
 #include "sim/contact_extent.h"
 #include "sim/legged_robot.h"
 #include "sim/mujoco_model.h"
+#include "sim/stance_load.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -210,6 +211,26 @@ void ForwardAxisNote(const mjModel* m, int torso, const RobotDraftOptions& o, st
   }
 }
 
+// Servos that give under the robot's weight (stance_load.h) get the gait's feedforward, unless a
+// leg carries passive joints, whose give the feedforward cannot take out.
+void FeedforwardIfTheServosGive(const mjModel* m, const LeggedRobot& bound, RobotDescription* r,
+                                std::vector<std::string>* notes) {
+  const StanceLoad load = MeasureStanceLoad(m, bound);
+  if (!ServosGive(load, bound)) return;
+  bool passive = false;
+  for (const std::string& name : r->passive_joints) {
+    const int body = m->jnt_bodyid[mj_name2id(m, mjOBJ_JOINT, name.c_str())];
+    for (const LegChain& leg : bound.legs) passive |= IsDescendant(m, body, m->jnt_bodyid[leg.joints.front()]);
+  }
+  char what[300];
+  std::snprintf(what, sizeof what, "gait: leg %s's foot gives %.3g m (%.0f%% of the stride) under its share of the weight",
+                bound.legs[load.sag_leg].name.c_str(), load.sag_m, 100 * load.sag_m / bound.stride_m);
+  r->gait.servo_feedforward = !passive;
+  notes->push_back(std::string(what) + (passive ? "; the legs' passive joints give too, which the servo feedforward "
+                                                   "does not take out: left off (robot.gait.servo_feedforward)"
+                                                 : ": servo_feedforward on (targets that carry the weight)"));
+}
+
 }  // namespace
 
 bool RobotDraftOptions::IsValid(std::string* error) const {
@@ -258,7 +279,7 @@ RobotDraft DraftRobot(const std::string& mjcf_path, const RobotDraftOptions& opt
   Sides(d.get(), options, legs, &r);
   ForwardAxisNote(m, torso, options, &draft.notes);
   try {
-    BindRobot(m, r, mjcf_path);
+    FeedforwardIfTheServosGive(m, BindRobot(m, r, mjcf_path), &r, &draft.notes);
   } catch (const InputError& e) {
     draft.bind_error = e.what();
   }

@@ -234,7 +234,8 @@ std::vector<std::string> Simulator::RobotWarnings() const {
   if (impl_->walker) {
     const LeggedRobot& robot = impl_->walker->robot();
     const mjModel* m = impl_->walker->model();
-    const std::vector<std::string> load = StanceLoadWarnings(MeasureStanceLoad(m, robot), m, robot);
+    const std::vector<std::string> load =
+        StanceLoadWarnings(MeasureStanceLoad(m, robot), m, robot, c.robot->gait.servo_feedforward);
     out.insert(out.end(), load.begin(), load.end());
   }
   if (!c.terrain) return out;

@@ -21,6 +21,20 @@ double JointLimit(const mjModel* m, int joint) {
   return limit;
 }
 
+// How far a leg's foot gives under the push `force` (torso frame) through its servos' stiffness:
+// |J K^-1 J' F| (-1 when a joint is not held by a position servo). `jac`: the foot's Jacobian.
+double Sag(const mjModel* m, const LegChain& leg, const std::vector<mjtNum>& jac, const Eigen::Vector3d& force) {
+  Eigen::Vector3d give = Eigen::Vector3d::Zero();
+  for (std::size_t k = 0; k < leg.dofs.size(); ++k) {
+    const int a = leg.actuators[k];
+    if (a < 0 || !IsPositionServo(m, a)) return -1;
+    const double gear = m->actuator_gear[6 * a];
+    const Eigen::Vector3d column(jac[leg.dofs[k]], jac[m->nv + leg.dofs[k]], jac[2 * m->nv + leg.dofs[k]]);
+    give += column * column.dot(force) / (-m->actuator_biasprm[mjNBIAS * a + 1] * gear * gear);
+  }
+  return give.norm();
+}
+
 }  // namespace
 
 StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
@@ -41,6 +55,8 @@ StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
     const LegChain& leg = robot.legs[i];
     const Eigen::Vector3d foot = FootPoint(m, d.get(), leg);
     mj_jac(m, d.get(), jacp.data(), nullptr, foot.data(), leg.foot_body);
+    const double sag = Sag(m, leg, jacp, force);
+    if (sag > worst.sag_m) worst.sag_leg = static_cast<int>(i), worst.sag_m = sag;
     for (std::size_t k = 0; k < leg.joints.size(); ++k) {
       const double limit = JointLimit(m, leg.joints[k]);
       if (!(limit > 0)) continue;
@@ -54,17 +70,34 @@ StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
   return worst;
 }
 
-std::vector<std::string> StanceLoadWarnings(const StanceLoad& load, const mjModel* m, const LeggedRobot& robot) {
-  if (load.joint < 0 || load.needed <= load.limit) return {};
-  const char* joint = mj_id2name(m, mjOBJ_JOINT, load.joint);
+bool ServosGive(const StanceLoad& load, const LeggedRobot& robot) {
+  const double kSagShare = 0.1;  // of the stride
+  return robot.replay.empty() && load.sag_leg >= 0 && load.sag_m > kSagShare * robot.stride_m;
+}
+
+std::vector<std::string> StanceLoadWarnings(const StanceLoad& load, const mjModel* m, const LeggedRobot& robot,
+                                            bool feedforward) {
+  std::vector<std::string> out;
   char what[400];
-  std::snprintf(what, sizeof what,
-                "robot: its actuators cannot carry it: with its weight on %.3g feet (the gait's duty factor) joint "
-                "\"%s\" of leg %s needs %.3g at the stance, and its actuator gives at most %.3g (force range x gear); "
-                "expect it to sink or fall. Raise the actuators' force range, or stand lower or wider "
-                "(robot.gait.stance_height_m)",
-                load.feet, joint ? joint : "(unnamed)", robot.legs[load.leg].name.c_str(), load.needed, load.limit);
-  return {what};
+  if (load.joint >= 0 && load.needed > load.limit) {
+    const char* joint = mj_id2name(m, mjOBJ_JOINT, load.joint);
+    std::snprintf(what, sizeof what,
+                  "robot: its actuators cannot carry it: with its weight on %.3g feet (the gait's duty factor) joint "
+                  "\"%s\" of leg %s needs %.3g at the stance, and its actuator gives at most %.3g (force range x gear); "
+                  "expect it to sink or fall. Raise the actuators' force range, or stand lower or wider "
+                  "(robot.gait.stance_height_m)",
+                  load.feet, joint ? joint : "(unnamed)", robot.legs[load.leg].name.c_str(), load.needed, load.limit);
+    out.push_back(what);
+  }
+  if (!feedforward && ServosGive(load, robot)) {
+    std::snprintf(what, sizeof what,
+                  "robot: its servos give under its weight: at the stance leg %s's foot moves %.3g m (%.0f%% of the "
+                  "stride) under its share of the weight on %.3g feet, so the torso sinks at every step and drifts "
+                  "whatever the command; robot.gait.servo_feedforward: true sends targets that carry the weight",
+                  robot.legs[load.sag_leg].name.c_str(), load.sag_m, 100 * load.sag_m / robot.stride_m, load.feet);
+    out.push_back(what);
+  }
+  return out;
 }
 
 }  // namespace dgmm::sim

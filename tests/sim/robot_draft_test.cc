@@ -142,6 +142,29 @@ TEST(RobotDraft, ATorsoLongerAcrossTheForwardAxisIsNoted) {
   EXPECT_EQ(left, 2);  // the front legs are on the left of +y
 }
 
+// Servos soft for the robot's weight (the hexapod at kp 10 of 80: a foot gives about a quarter of
+// the stride) get the gait's servo feedforward, with a note; the shipped hexapod does not need it;
+// the sprawled quadruped at kp 30 of 160 gives as much, but its passive ankles give too: left off.
+TEST(RobotDraft, SoftServosGetTheServoFeedforwardUnlessTheLegsHavePassiveJoints) {
+  TempModel soft(EditedHexapod(R"(position kp="80")", R"(position kp="10")"));
+  const RobotDraft draft = DraftRobot(soft.path());
+  EXPECT_TRUE(draft.bind_error.empty()) << draft.bind_error;
+  EXPECT_TRUE(draft.robot.gait.servo_feedforward);
+  ASSERT_EQ(draft.notes.size(), 1u);
+  EXPECT_NE(draft.notes[0].find("servo_feedforward on"), std::string::npos) << draft.notes[0];
+  EXPECT_FALSE(DraftRobot(LoadSimConfig((kRobots / "hexapod.json").string()).mjcf_path).robot.gait.servo_feedforward);
+  std::string sprawled = ReadText(kRobots / "sprawled_quadruped.xml");
+  const std::string from = R"(position kp="160")";
+  ASSERT_NE(sprawled.find(from), std::string::npos);
+  sprawled.replace(sprawled.find(from), from.size(), R"(position kp="30")");
+  TempModel ankles(sprawled);
+  const RobotDraft passive = DraftRobot(ankles.path());
+  EXPECT_FALSE(passive.robot.gait.servo_feedforward);
+  bool noted = false;
+  for (const auto& note : passive.notes) noted |= note.find("passive joints give too") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
 TEST(RobotDraft, ModelsThatCannotBeDraftedAreRefusedNamingThePart) {
   EXPECT_NE(ErrorOf(EditedHexapod("<freejoint name=\"root\"/>", "")).find("one body with a free joint"),
             std::string::npos);

@@ -6,7 +6,6 @@
 
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <unistd.h>
 
 #include "sim/mujoco_model.h"
@@ -21,13 +20,10 @@ namespace fs = std::filesystem;
 
 using test::kRobots;
 
-// The hexapod with every servo's force range set to +-`limit` N m, written to `path`.
-SimConfig HexapodWithForceRange(const std::string& limit, const fs::path& path) {
-  std::stringstream text;
-  text << std::ifstream(kRobots / "hexapod.xml").rdbuf();
-  std::string xml = text.str();
-  const std::string from = R"(forcerange="-20 20")";
-  xml.replace(xml.find(from), from.size(), "forcerange=\"-" + limit + " " + limit + "\"");
+// The hexapod with `from` replaced by `to` in its MJCF, written to `path`.
+SimConfig EditedHexapod(const std::string& from, const std::string& to, const fs::path& path) {
+  std::string xml = test::ReadText(kRobots / "hexapod.xml");
+  xml.replace(xml.find(from), from.size(), to);
   std::ofstream(path) << xml;
   SimConfig c = LoadSimConfig((kRobots / "hexapod.json").string());
   c.mjcf_path = path.string();
@@ -54,7 +50,7 @@ TEST(StanceLoad, TheProjectsRobotsCarryThemselves) {
 // than the hexapod's (seed 1 of the paper protocol: every placement fell).
 TEST(StanceLoad, ServosTooWeakToCarryTheRobotAreNamedAndItSinks) {
   const fs::path path = fs::temp_directory_path() / ("dgmm_weak_servos_" + std::to_string(::getpid()) + ".xml");
-  const SimConfig c = HexapodWithForceRange("0.3", path);
+  const SimConfig c = EditedHexapod(R"(forcerange="-20 20")", R"(forcerange="-0.3 0.3")", path);
   const StanceLoad load = LoadOf(c);
   EXPECT_EQ(load.feet, 3);
   EXPECT_GT(load.needed, 2 * load.limit);
@@ -71,6 +67,30 @@ TEST(StanceLoad, ServosTooWeakToCarryTheRobotAreNamedAndItSinks) {
     z[s == &strong] = s->TorsoPose().position_m.z();
   }
   EXPECT_LT(z[0], z[1] - 0.01) << "the weak hexapod's torso at " << z[0] << " m, the hexapod's at " << z[1];
+}
+
+// At kp 10 of 80 the hexapod's feet give about a quarter of its stride under its weight: named
+// (the leg, how far) unless the gait's servo feedforward carries the weight. The project's robots
+// (the gait-driven ones) do not give that much.
+TEST(StanceLoad, ServosThatGiveUnderTheWeightAreNamedUnlessTheGaitCarriesIt) {
+  const fs::path path = fs::temp_directory_path() / ("dgmm_soft_servos_" + std::to_string(::getpid()) + ".xml");
+  SimConfig c = EditedHexapod(R"(position kp="80")", R"(position kp="10")", path);
+  const StanceLoad load = LoadOf(c);
+  const std::vector<std::string> warnings = Simulator(c).RobotWarnings();
+  c.robot->gait.servo_feedforward = true;
+  const std::vector<std::string> carried = Simulator(c).RobotWarnings();
+  fs::remove(path);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("robot: its servos give under its weight: at the stance leg"), std::string::npos)
+      << warnings[0];
+  // |J K^-1 J' F| scales as 1 / kp: eight times the shipped hexapod's give.
+  EXPECT_NEAR(load.sag_m / LoadOf(LoadSimConfig((kRobots / "hexapod.json").string())).sag_m, 8, 1e-6);
+  EXPECT_TRUE(carried.empty()) << carried[0];
+  for (const char* name : {"hexapod.json", "sprawled_quadruped.json", "scorpion_generic.json", "planar_quadruped.json"}) {
+    for (const auto& w : Simulator(LoadSimConfig((kRobots / name).string())).RobotWarnings()) {
+      EXPECT_EQ(w.find("servos give"), std::string::npos) << name << ": " << w;
+    }
+  }
 }
 
 }  // namespace
