@@ -217,11 +217,7 @@ void FeedforwardIfTheServosGive(const mjModel* m, const LeggedRobot& bound, Robo
                                 std::vector<std::string>* notes) {
   const StanceLoad load = MeasureStanceLoad(m, bound);
   if (!ServosGive(load, bound)) return;
-  bool passive = false;
-  for (const std::string& name : r->passive_joints) {
-    const int body = m->jnt_bodyid[mj_name2id(m, mjOBJ_JOINT, name.c_str())];
-    for (const LegChain& leg : bound.legs) passive |= IsDescendant(m, body, m->jnt_bodyid[leg.joints.front()]);
-  }
+  const bool passive = LegsHavePassiveJoints(m, bound);
   char what[300];
   std::snprintf(what, sizeof what, "gait: leg %s's foot gives %.3g m (%.0f%% of the stride) under its share of the weight",
                 bound.legs[load.sag_leg].name.c_str(), load.sag_m, 100 * load.sag_m / bound.stride_m);

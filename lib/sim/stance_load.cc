@@ -75,10 +75,23 @@ bool ServosGive(const StanceLoad& load, const LeggedRobot& robot) {
   return robot.replay.empty() && load.sag_leg >= 0 && load.sag_m > kSagShare * robot.stride_m;
 }
 
+bool LegsHavePassiveJoints(const mjModel* m, const LeggedRobot& robot) {
+  for (const LegChain& leg : robot.legs) {
+    const int first = m->jnt_bodyid[leg.joints.front()];
+    for (int b = leg.foot_body; b > 0; b = m->body_parentid[b]) {
+      for (int j = m->body_jntadr[b]; j >= 0 && j < m->body_jntadr[b] + m->body_jntnum[b]; ++j) {
+        if (std::find(leg.joints.begin(), leg.joints.end(), j) == leg.joints.end()) return true;
+      }
+      if (b == first) break;
+    }
+  }
+  return false;
+}
+
 std::vector<std::string> StanceLoadWarnings(const StanceLoad& load, const mjModel* m, const LeggedRobot& robot,
                                             bool feedforward) {
   std::vector<std::string> out;
-  char what[400];
+  char what[600];
   if (load.joint >= 0 && load.needed > load.limit) {
     const char* joint = mj_id2name(m, mjOBJ_JOINT, load.joint);
     std::snprintf(what, sizeof what,
@@ -93,8 +106,11 @@ std::vector<std::string> StanceLoadWarnings(const StanceLoad& load, const mjMode
     std::snprintf(what, sizeof what,
                   "robot: its servos give under its weight: at the stance leg %s's foot moves %.3g m (%.0f%% of the "
                   "stride) under its share of the weight on %.3g feet, so the torso sinks at every step and drifts "
-                  "whatever the command; robot.gait.servo_feedforward: true sends targets that carry the weight",
-                  robot.legs[load.sag_leg].name.c_str(), load.sag_m, 100 * load.sag_m / robot.stride_m, load.feet);
+                  "whatever the command; %s",
+                  robot.legs[load.sag_leg].name.c_str(), load.sag_m, 100 * load.sag_m / robot.stride_m, load.feet,
+                  LegsHavePassiveJoints(m, robot)
+                      ? "the legs' passive joints give too, which robot.gait.servo_feedforward cannot take out"
+                      : "robot.gait.servo_feedforward: true sends targets that carry the weight");
     out.push_back(what);
   }
   return out;

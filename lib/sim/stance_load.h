@@ -32,8 +32,13 @@ StanceLoad MeasureStanceLoad(const mjModel* model, const LeggedRobot& robot);
 // forward commands; our sprawled quadruped at 6% walks as commanded).
 bool ServosGive(const StanceLoad& load, const LeggedRobot& robot);
 
+// Whether a joint no servo drives lies on a leg's way from its first joint to its foot (a spring
+// ankle): its give under the weight is one the gait's servo feedforward cannot take out.
+bool LegsHavePassiveJoints(const mjModel* model, const LeggedRobot& robot);
+
 // Warnings when the worst joint needs more than its actuator's limit, and when the servos give
-// (ServosGive) and the gait does not carry the weight (`feedforward` false); empty otherwise.
+// (ServosGive) and the gait does not carry the weight (`feedforward` false: the feedforward is
+// suggested, or, with passive joints on the legs, said not to help); empty otherwise.
 std::vector<std::string> StanceLoadWarnings(const StanceLoad& load, const mjModel* model, const LeggedRobot& robot,
                                             bool feedforward = false);
 
