@@ -154,6 +154,10 @@ RobotDescription RobotDescriptionFromJson(const std::string& json_text, const st
   }
   if (gait) r.gait = ReadGait(*gait, source);
   if (controller) r.controller = ReadController(*controller, source);
+  if (r.gait.servo_feedforward && r.controller.replay()) {
+    f.Fail("robot.gait.servo_feedforward",
+           "the generic gait's option: a replay sends its recorded signals as they are (remove it, or the replay)");
+  }
   if (gains) {
     JsonFields g(*gains, "robot.leg_gain", source);
     for (const auto& [leg, value] : gains->items()) {

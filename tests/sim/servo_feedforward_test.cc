@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <nlohmann/json.hpp>
+
 #include <cstdio>
 #include <filesystem>
 #include <random>
@@ -55,6 +57,7 @@ TEST(SupportForces, ASwingingFootCarriesNothingAndTwoFeetShareByTheLever) {
   EXPECT_NEAR(f[3], 10, 1e-9);
 }
 
+// A boolean, written only when on, and refused beside a replayed controller (which it would not touch).
 TEST(ServoFeedforward, TheConfigFieldIsABooleanWrittenOnlyWhenOn) {
   SimConfig c = LoadSimConfig((test::kRobots / "hexapod.json").string());
   EXPECT_FALSE(c.robot->gait.servo_feedforward);
@@ -68,6 +71,19 @@ TEST(ServoFeedforward, TheConfigFieldIsABooleanWrittenOnlyWhenOn) {
     FAIL() << "a string accepted";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("robot.gait.servo_feedforward: expected true or false"), std::string::npos)
+        << e.what();
+  }
+  const std::string replay =
+      test::ReadText(test::kRobots / "mammal_quadruped" / "mammal_quadruped.json");
+  const auto robot = nlohmann::json::parse(replay)["robot"];
+  auto with = robot;
+  with["gait"]["servo_feedforward"] = true;
+  try {
+    RobotDescriptionFromJson(with.dump(), "mammal.json");
+    FAIL() << "a replay with the gait's feedforward accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("mammal.json: robot.gait.servo_feedforward: the generic gait's option"),
+              std::string::npos)
         << e.what();
   }
 }
