@@ -439,8 +439,7 @@ namespace {
 
 // The payload against the robot's own scale (the config's check is only for finite numbers).
 void CheckPayload(const PayloadConfig& p, const LeggedRobot& b, const mjModel* m, const std::string& source) {
-  double robot_kg = 0;
-  for (int i = 1; i < m->nbody; ++i) robot_kg += m->body_mass[i];
+  const double robot_kg = mj_getTotalmass(m);
   char what[160];
   if (p.mass_kg > 10 * robot_kg) {
     std::snprintf(what, sizeof what, "%.4g kg is over 10 times the robot's mass (%.4g kg)", p.mass_kg, robot_kg);
@@ -510,6 +509,11 @@ Eigen::Matrix3d RobotFrame(const Eigen::Vector3d& forward) {
 
 int FootSide(const Eigen::Matrix3d& robot_in_torso, const Eigen::Vector3d& foot) {
   return (robot_in_torso.transpose() * foot).y() >= 0 ? 1 : -1;
+}
+
+double ServoStiffness(const mjModel* m, int a) {
+  const double gear = m->actuator_gear[6 * a];
+  return -m->actuator_biasprm[mjNBIAS * a + 1] * gear * gear;
 }
 
 bool IsPositionServo(const mjModel* m, int a) {

@@ -89,6 +89,9 @@ Eigen::Vector3d FootPoint(const mjModel* model, const mjData* data, const LegCha
 // Actuator `a` is a position servo: force = gain * ctrl - gain * q (MuJoCo's <position>).
 bool IsPositionServo(const mjModel* model, int a);
 
+// A position servo's stiffness at its joint: torque per unit of joint error, -b1 gear^2.
+double ServoStiffness(const mjModel* model, int a);
+
 // Body `body` is `ancestor` or lies below it (every body lies below the world body, 0).
 bool IsDescendant(const mjModel* model, int body, int ancestor);
 

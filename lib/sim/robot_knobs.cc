@@ -93,8 +93,7 @@ std::vector<Knob> EnumerateRobotKnobs(const SimConfig& config) {
   MjModelPtr model = LoadRobotModel(config);
   const LeggedRobot bound = BindRobot(model.get(), *config.robot, source);
   const mjModel* m = model.get();
-  double total_kg = 0;
-  for (int b = 1; b < m->nbody; ++b) total_kg += m->body_mass[b];
+  const double total_kg = mj_getTotalmass(m);
   const double reach = bound.reach_m;
   std::vector<Knob> knobs;
   // Friction probed down to 0.35: slipping is the usual mismatch, and from 0.6 alone the signature

@@ -21,9 +21,8 @@ Eigen::VectorXd SupportForces(const std::vector<Eigen::Vector2d>& feet, const st
 ServoFeedforward::ServoFeedforward(const mjModel* m, const LeggedRobot& robot, double period_s) {
   for (const LegChain& leg : robot.legs) {
     for (std::size_t k = 0; k < leg.joints.size(); ++k) {
-      const int a = leg.actuators[k];  // a position servo: BindRobot refuses anything else under the gait
-      const double gear = m->actuator_gear[6 * a];
-      stiffness_.push_back(-m->actuator_biasprm[mjNBIAS * a + 1] * gear * gear);
+      // A position servo: BindRobot refuses anything else under the gait.
+      stiffness_.push_back(ServoStiffness(m, leg.actuators[k]));
       damping_.push_back(m->dof_damping[leg.dofs[k]]);
       friction_loss_.push_back(m->dof_frictionloss[leg.dofs[k]]);
       // Friction's sign smoothed over 5% of a joint's sweep per cycle (a radian, or a leg's reach).
@@ -35,13 +34,9 @@ ServoFeedforward::ServoFeedforward(const mjModel* m, const LeggedRobot& robot, d
       if (IsDescendant(m, b, m->jnt_bodyid[leg.joints.front()])) bodies_.back().push_back(b);
     }
   }
-  double mass = 0;
-  for (int b = 0; b < m->nbody; ++b) {
-    mass_kg_.push_back(m->body_mass[b]);
-    if (b > 0) mass += m->body_mass[b];
-  }
+  mass_kg_.assign(m->body_mass, m->body_mass + m->nbody);
   gravity_ = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]).norm();
-  weight_n_ = mass * gravity_;
+  weight_n_ = mj_getTotalmass(m) * gravity_;
   MjDataPtr d = RestPoseData(m, robot.torso_qpos);
   for (const LegChain& leg : robot.legs) {
     for (std::size_t k = 0; k < leg.qpos.size(); ++k) d->qpos[leg.qpos[k]] = leg.stance_q[k];

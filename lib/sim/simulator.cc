@@ -279,10 +279,7 @@ Eigen::Vector3d Simulator::Up() const { return impl_->up; }
 double Simulator::time_s() const { return impl_->walker ? impl_->walker->time_s() : impl_->time_s; }
 
 double Simulator::total_mass_kg() const {
-  const mjModel* m = impl_->walker ? impl_->walker->model() : impl_->model.get();
-  double total = 0;
-  for (int b = 1; b < m->nbody; ++b) total += m->body_mass[b];
-  return total;
+  return mj_getTotalmass(impl_->walker ? impl_->walker->model() : impl_->model.get());
 }
 
 double Simulator::leg_reach_m() const {

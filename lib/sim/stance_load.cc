@@ -28,9 +28,8 @@ double Sag(const mjModel* m, const LegChain& leg, const std::vector<mjtNum>& jac
   for (std::size_t k = 0; k < leg.dofs.size(); ++k) {
     const int a = leg.actuators[k];
     if (a < 0 || !IsPositionServo(m, a)) return -1;
-    const double gear = m->actuator_gear[6 * a];
     const Eigen::Vector3d column(jac[leg.dofs[k]], jac[m->nv + leg.dofs[k]], jac[2 * m->nv + leg.dofs[k]]);
-    give += column * column.dot(force) / (-m->actuator_biasprm[mjNBIAS * a + 1] * gear * gear);
+    give += column * column.dot(force) / ServoStiffness(m, a);
   }
   return give.norm();
 }
@@ -44,8 +43,7 @@ StanceLoad MeasureStanceLoad(const mjModel* m, const LeggedRobot& robot) {
   }
   mj_kinematics(m, d.get());
   mj_comPos(m, d.get());
-  double mass = 0;
-  for (int b = 1; b < m->nbody; ++b) mass += m->body_mass[b];
+  const double mass = mj_getTotalmass(m);
   StanceLoad worst;
   worst.feet = std::max(1.0, robot.legs.size() * robot.timing.duty);
   const double g = Eigen::Vector3d(m->opt.gravity[0], m->opt.gravity[1], m->opt.gravity[2]).norm();
@@ -79,7 +77,8 @@ bool LegsHavePassiveJoints(const mjModel* m, const LeggedRobot& robot) {
   for (const LegChain& leg : robot.legs) {
     const int first = m->jnt_bodyid[leg.joints.front()];
     for (int b = leg.foot_body; b > 0; b = m->body_parentid[b]) {
-      for (int j = m->body_jntadr[b]; j >= 0 && j < m->body_jntadr[b] + m->body_jntnum[b]; ++j) {
+      for (int k = 0; k < m->body_jntnum[b]; ++k) {
+        const int j = m->body_jntadr[b] + k;
         if (std::find(leg.joints.begin(), leg.joints.end(), j) == leg.joints.end()) return true;
       }
       if (b == first) break;
