@@ -17,13 +17,17 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v7";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v8";
 // v6: a recording runs in chunks of this many placements, each with its own random stream, so
 // one recording can use several threads (sim::ProtocolOptions::chunk_placements). v7: a servo
 // gets the ctrl that holds its joint at the target (through its gear) and the gait keeps within
 // its ctrlrange, a site, body or visual-geom foot is placed by its body's colliding geoms and a
 // mesh foot by its lowest vertex (recordings of robots with geared or ctrl-limited servos or such
 // feet changed; others not).
+// v8: a payload on a torso compiled with its centre of mass at its origin (MuJoCo's body_sameframe:
+// the hexapod, the planar quadruped, the scorpion and harvestman shapes with a robot block) moves
+// the centre MuJoCo simulates; before, only its mass and inertia acted (recordings of payloads off
+// the middle on such robots changed; others not).
 constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {

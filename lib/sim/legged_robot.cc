@@ -420,6 +420,30 @@ LeggedRobot BindRobot(const mjModel* m, const RobotDescription& r, const std::st
   return b;
 }
 
+namespace {
+
+// MuJoCo's compiler marks a body whose inertial frame is its own frame (body_sameframe), and its
+// geoms and sites sitting at the body's origin (1) or its centre of mass (2), and positions them by
+// copying instead of from body_ipos: after the centre of mass moved, kinematics must read it, and
+// what sat at the old centre must stay where it is on the body (geom_pos and site_pos are in the
+// body's frame either way).
+void UseTheInertialFrame(mjModel* m, int body) {
+  m->body_sameframe[body] = 0;
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] == body && m->geom_sameframe[g] == 2) m->geom_sameframe[g] = 0;
+  }
+  for (int s = 0; s < m->nsite; ++s) {
+    if (m->site_bodyid[s] == body && m->site_sameframe[s] == 2) m->site_sameframe[s] = 0;
+  }
+  if (!m->body_simple[body]) return;
+  m->body_simple[body] = 0;  // a simple body has a diagonal mass matrix at its own origin
+  for (int i = m->nv - 1, run = 0; i >= 0; --i) {
+    m->dof_simplenum[i] = m->body_simple[m->dof_bodyid[i]] ? ++run : (run = 0);
+  }
+}
+
+}  // namespace
+
 // The payload is a solid ball of radius 0.1 x the longest leg's reach (a compact block whatever the
 // robot's size) at p in the torso's frame, merged into the torso's mass, centre and inertia.
 void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass, double reach_m) {
@@ -433,6 +457,7 @@ void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass, do
     m->body_ipos[3 * torso + k] = c[k];
   }
   m->body_mass[torso] = m0 + mass;
+  UseTheInertialFrame(m, torso);
 }
 
 namespace {

@@ -241,6 +241,45 @@ TEST(LeggedRobot, APayloadMergesIntoTheTorsoAtTheRobotsScale) {
   }
 }
 
+// MuJoCo copies the body's own frame for a body compiled with its centre of mass at its origin
+// (the hexapod's torso: one box), and copies the centre for a geom compiled there (the torso's box
+// moved up 1 cm): a payload must move the centre MuJoCo simulates, not only body_ipos, and leave
+// the geoms where they are on the torso. Before 2026-12-05 a payload 3 cm ahead and 3 cm behind
+// the hexapod's middle gave the same recording to the last bit.
+TEST(LeggedRobot, APayloadMovesTheCentreOfMassMuJoCoSimulatesAndNoGeom) {
+  for (const std::string moved_box : {"", " pos=\"0 0 0.01\""}) {
+    std::string xml = ReadText(kRobots / "hexapod.xml");
+    const std::string box = "<geom name=\"torso\" type=\"box\"";
+    ASSERT_NE(xml.find(box), std::string::npos);
+    xml.insert(xml.find(box) + box.size(), moved_box);
+    const fs::path path = fs::temp_directory_path() / ("dgmm_payload_" + std::to_string(::getpid()) + ".xml");
+    std::ofstream(path) << xml;
+    SimConfig c = Hexapod();
+    c.mjcf_path = path.string();
+    c.payload.mass_kg = 0.8;
+    c.payload.position_body_m = Eigen::Vector3d(0.05, -0.02, 0.01);
+    MjModelPtr m = LoadRobotModel(c), original = LoadRobotModel(c);
+    fs::remove(path);
+    const LeggedRobot bound = BindRobot(m.get(), *c.robot, "hexapod");
+    const int t = bound.torso_body, g = mj_name2id(m.get(), mjOBJ_GEOM, "torso");
+    ASSERT_EQ(original->body_sameframe[t], moved_box.empty() ? 1 : 0);
+    ASSERT_EQ(original->geom_sameframe[g], moved_box.empty() ? 1 : 2);
+    ApplyExperiment(c, bound, m.get());
+    MjDataPtr d(mj_makeData(m.get())), d0(mj_makeData(original.get()));
+    d->qpos[3] = d0->qpos[3] = std::cos(0.2);  // the torso turned 0.4 rad about z: frames told apart
+    d->qpos[6] = d0->qpos[6] = std::sin(0.2);
+    mj_forward(m.get(), d.get());
+    mj_forward(original.get(), d0.get());
+    const Eigen::Map<const Eigen::Matrix3d> torso_rotation(d->xmat + 9 * t);  // row-major: transpose
+    const Eigen::Vector3d centre(m->body_ipos + 3 * t);
+    const Eigen::Vector3d simulated = Eigen::Vector3d(d->xipos + 3 * t) - Eigen::Vector3d(d->xpos + 3 * t);
+    EXPECT_LT((simulated - torso_rotation.transpose() * centre).norm(), 1e-12) << moved_box;
+    EXPECT_GT(centre.norm(), 0.005) << moved_box;
+    EXPECT_LT((Eigen::Vector3d(d->geom_xpos + 3 * g) - Eigen::Vector3d(d0->geom_xpos + 3 * g)).norm(), 1e-12)
+        << moved_box;
+  }
+}
+
 // A payload is bounded by the robot's own scale, not by metres and kilograms fixed for one robot:
 // the hexapod (3.2 kg, reach 0.30 m) refuses 40 kg and an offset of 0.7 m; a 1.5 m offset is
 // accepted from a config without a robot block only up to 1 m.
