@@ -51,6 +51,7 @@ struct Sim2RealArgs {
   bool spread_signatures = false;
   bool every_leg = false;
   bool leg_search = true;
+  bool payload_search = sim2real::PayloadSearchOptions{}.enabled;
   bool runoff = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
@@ -162,6 +163,8 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
   o.runoff.enabled = args.runoff;
+  o.payload.enabled = args.payload_search;
+  o.payload.search.sag_mode = args.leg_search_score == "sag";
   o.legs.sag_mode = args.leg_search_score == "sag";
   o.legs.only_with_tails = args.leg_search_on == "tails";
   o.legs.challenge_named = args.leg_search_on == "remaining";
@@ -375,6 +378,11 @@ void Setup(CLI::App& root) {
                 "when a mismatch is left that no leg explains (see --leg-search-on), search every leg's gain with "
                 "recordings scored by their own model (three per leg and two more, 5 executions per placement; on "
                 "by default, --no-leg-search turns it off; docs/sim2real.md)");
+  cmd->add_flag("--payload-search,!--no-payload-search", args->payload_search,
+                "experimental, off by default: on a plane, when nothing is named for a located mismatch after the "
+                "leg search, search a payload's mass and position (7 columns at 2 masses, a column keeping its moment "
+                "as the mass changes; then half-steps of the best column and its mass; each recording scored by its own "
+                "model, 5 executions per placement; docs/sim2real.md)");
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

@@ -117,7 +117,15 @@ LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
   return o;
 }
 
-// Stages 8a and 8b: the runoff on uneven ground, then the leg search when still nothing is named.
+// The payload search (stage 8c) runs when enabled, on a plane, when the stages before and the
+// leg search left a located mismatch with nothing named.
+bool WantPayloadSearch(const Analysis& a, const PayloadSearchOptions& options) {
+  return options.enabled && !a.baseline.permute_placements && a.verdict.status == "unexplained" &&
+         a.verdict.named.empty() && !a.runoff.search.named && !a.leg_search.named;
+}
+
+// Stages 8a to 8c: the runoff on uneven ground, then the leg search when still nothing is named,
+// then the payload search.
 template <typename Stage>
 void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
   if (WantRunoff(*a, options.runoff)) {
@@ -142,12 +150,21 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     AddLegSearch(a->leg_search, &a->verdict);
     a->seconds.legs = Since(t);
   }
+  if (WantPayloadSearch(*a, options.payload)) {
+    const auto t = Clock::now();
+    stage("payload search (its mass and position)");
+    PayloadSearchOptions payload = options.payload;
+    payload.search = OwnModels(payload.search, options);
+    a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload);
+    AddPayloadSearch(a->payload_search, &a->verdict);
+    a->seconds.payload = Since(t);
+  }
 }
 
 // The knobs the runoff or the leg search recorded without naming them.
 std::vector<std::string> SearchedWithoutName(const Analysis& a) {
   std::vector<std::string> knobs;
-  for (const LegSearch* s : {&a.runoff.search, &a.leg_search}) {
+  for (const LegSearch* s : {&a.runoff.search, &a.leg_search, &a.payload_search.search}) {
     if (!s->ran || s->named) continue;
     for (const LegSearchPoint& p : s->points) AddUnique(&knobs, p.knob);
   }
@@ -221,11 +238,13 @@ bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
          recorded_null.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
-         runoff.IsValid(error) && more_data.IsValid(error);
+         runoff.IsValid(error) && payload.IsValid(error) && more_data.IsValid(error);
 }
 
 const LegSearch* NamedByOwnModels(const Analysis& a) {
-  return a.runoff.search.named ? &a.runoff.search : a.leg_search.named ? &a.leg_search : nullptr;
+  if (a.runoff.search.named) return &a.runoff.search;
+  if (a.leg_search.named) return &a.leg_search;
+  return a.payload_search.search.named ? &a.payload_search.search : nullptr;
 }
 
 std::vector<int> ScreenedKnobs(const CandidateSet& set, const SelectionResult& selection, double from_z,
@@ -346,6 +365,7 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   if (const LegSearch* own = NamedByOwnModels(a)) {
     a.correction = LegSearchCorrection(*own);
     a.named_values = {{own->knob_index, own->value}};
+    a.named_values.insert(a.named_values.end(), own->also.begin(), own->also.end());
   } else {
     a.correction = MakeCorrection(a.inputs, a.baseline, a.candidates, a.refinement.selection.fit);
     a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);

@@ -18,6 +18,8 @@
 //                                    recorded again, each recording scored by its own model;
 //      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
 //                                    searched, each recording scored by its own model;
+//      payload     (payload_search.h) experimental, on a plane when still nothing is named: a
+//                                    payload's mass and position searched likewise;
 //      more data   (more_data.h)     when still nothing is named but a knob came near: how many
 //                                    placements the real set would need to decide it;
 //   9. report      (report.h)        report.json, report.html, the stdout summary (in the app).
@@ -30,6 +32,7 @@
 #include "sim2real/correction.h"
 #include "sim2real/leg_search.h"
 #include "sim2real/more_data.h"
+#include "sim2real/payload_search.h"
 #include "sim2real/recorded_null.h"
 #include "sim2real/runoff.h"
 #include "sim2real/verdict_stage.h"
@@ -46,6 +49,7 @@ struct AnalysisOptions {
   VerdictOptions verdict;
   LegSearchOptions legs;   // its model options are the baseline's (locate.model)
   RunoffOptions runoff;    // likewise
+  PayloadSearchOptions payload;  // likewise; off by default
   // When an effect fits on average but its size varies with the execution index and the
   // signatures recorded fewer executions per placement than the real set has, stages 3-8 run
   // again with signatures of every execution (Analysis::every_execution_because).
@@ -80,7 +84,7 @@ struct AnalysisOptions {
 };
 
 struct StageTimes {
-  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, total = 0;
+  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, payload = 0, total = 0;
 };
 
 struct Analysis {
@@ -101,6 +105,7 @@ struct Analysis {
   Verdict verdict;
   Runoff runoff;                   // ran only on uneven ground with a mismatch left (Runoff::ran)
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
+  PayloadSearch payload_search;    // ran only when enabled and still nothing was named (PayloadSearch::ran)
   MoreData more_data;              // how many placements would decide a near miss (MoreData::advised)
   Correction correction;           // the knob correction (empty without a simulator)
   std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)
@@ -110,7 +115,7 @@ struct Analysis {
 // `simulator` null: locate only, `no_simulator_reason` saying why. Throws InputError for sets
 // that cannot be compared and for a simulator that cannot record the sim set's protocol.
 // The search that named the verdict's knob by recordings scored with their own models (the runoff,
-// else the leg search), or nullptr when the knob path's correction stands.
+// else the leg search, else the payload search), or nullptr when the knob path's correction stands.
 const LegSearch* NamedByOwnModels(const Analysis& a);
 
 // Does the leg search run (stage 8b)? When the stages before named nothing for a located mismatch

@@ -152,6 +152,7 @@ struct SearchState {
   int nominal_size = 0;
   std::optional<SagReference> ref;  // with options.sag_mode
   const SagReference* Ref() const { return ref ? &*ref : nullptr; }
+  AlsoAt also;  // other knob values of a point (may be empty)
 };
 
 Recording SearchRecording(const CandidateSet& set, const LegSearchOptions& options) {
@@ -168,7 +169,13 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
   const bool need_nominal = state->nominal.rows.size() == 0;
   std::vector<std::vector<KnobValue>> requests;
   if (need_nominal) requests.push_back({});
-  for (const auto& [k, v] : wanted) requests.push_back({{k, v}});
+  for (const auto& [k, v] : wanted) {
+    requests.push_back({{k, v}});
+    if (state->also) {
+      const std::vector<KnobValue> extra = state->also(k, v);
+      requests.back().insert(requests.back().end(), extra.begin(), extra.end());
+    }
+  }
   RecordingBatch batch = RecordBatch(simulator, SearchRecording(set, options), requests, recording.recording);
   if (need_nominal) {
     state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size(), state->Ref());
@@ -244,6 +251,7 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
   }
   out->z_vs_nominal = PairedZ(state->scored[out->best].rows, state->nominal.rows, in.real.episode);
   out->leg = b.leg, out->knob = b.knob, out->knob_index = b.knob_index, out->value = b.value;
+  out->also = state->also ? state->also(b.knob_index, b.value) : std::vector<KnobValue>{};
   const Knob& knob = knobs[b.knob_index];
   out->nominal = knob.nominal, out->lo = knob.lo, out->hi = knob.hi;
   std::vector<double> values;
@@ -279,8 +287,10 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
 void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
                       const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
   out->misfit_elsewhere = true;
-  const RecordingBatch b = RecordBatch(simulator, RealDesign(in, options.elsewhere_seed),
-                                       {{}, {{out->knob_index, out->value}}}, recording.recording);
+  std::vector<KnobValue> best = {{out->knob_index, out->value}};
+  best.insert(best.end(), out->also.begin(), out->also.end());
+  const RecordingBatch b =
+      RecordBatch(simulator, RealDesign(in, options.elsewhere_seed), {{}, best}, recording.recording);
   out->recorded += b.recorded;
   out->from_cache += b.from_cache;
   double se = NAN;
@@ -369,7 +379,7 @@ std::vector<int> LegGainKnobs(const KnobSimulator& simulator) {
 
 LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                           const CandidateOptions& recording, const LegSearchOptions& options,
-                          const std::vector<std::pair<int, double>>& grid) {
+                          const std::vector<std::pair<int, double>>& grid, const AlsoAt& also) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "leg search options", error);
   const auto start = Clock::now();
@@ -382,6 +392,7 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
   out.score = options.sag_mode ? "sag" : "robust";
   const auto& knobs = simulator.knobs();
   SearchState state;
+  state.also = also;
   if (options.sag_mode) state.ref = MakeSagReference(in.sim, options.model);
   RecordPoints(simulator, in, set, recording, options, grid, &state, &out);
   out.nominal_model = state.nominal.model;

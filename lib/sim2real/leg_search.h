@@ -15,6 +15,7 @@
 // then the best gain is refined by `refine_steps` rounds of half-steps either side of it.
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -131,6 +132,7 @@ struct LegSearch {
   LinearGaussianModel nominal_model, best_model;  // the correction's two ends
   Eigen::VectorXd best_rows;          // the best point's score per real sample
   Eigen::VectorXd log_var;            // per axis log(residual variance best / nominal)
+  std::vector<KnobValue> also;        // the best point's other knob values (AlsoAt; the payload's position)
   int recorded = 0, from_cache = 0;
   double seconds = 0;
   // A challenge of named knobs (LegSearchOptions::challenge_named): what they were, and the best
@@ -154,12 +156,17 @@ std::vector<int> LegGainKnobs(const KnobSimulator& simulator);
 LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                          const CandidateOptions& recording, const LegSearchOptions& options);
 
+// Other knob values recorded with a point (knob, value): the payload search's position, which
+// depends on the payload's mass (payload_search.h).
+using AlsoAt = std::function<std::vector<KnobValue>(int knob, double value)>;
+
 // The same search over any (knob, value) points (the runoff on uneven ground, runoff.h): a point's
 // group (LegSearchPoint::leg) is its knob's leg, else the knob's name; the best's refinement steps
-// by the spacing of its knob's values in `grid`.
+// by the spacing of its knob's values in `grid`. With `also`, every point but the nominal is
+// recorded with also(knob, value) too.
 LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                           const CandidateOptions& recording, const LegSearchOptions& options,
-                          const std::vector<std::pair<int, double>>& grid);
+                          const std::vector<std::pair<int, double>>& grid, const AlsoAt& also = nullptr);
 
 // The search as a challenger of the knobs `named` before it, whose correction gives the real
 // samples the held-out log-likelihoods `corrected`: a named leg keeps its name only when its best

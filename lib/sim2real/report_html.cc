@@ -289,6 +289,20 @@ std::string LegSearchTable(const LegSearch& l, const std::string& title, bool le
   return o.str();
 }
 
+// The payload search: every position's best mass and score, then the best position's masses.
+std::string PayloadSearchTables(const PayloadSearch& p) {
+  std::ostringstream o;
+  o << "<h3>Search of a payload's mass and position</h3><table><tr><th>forward (m)</th><th>left (m)</th>"
+    << "<th>best mass (kg)</th><th>log-likelihood per real sample (own model)</th><th>fits as well as the best</th></tr>";
+  for (const PayloadColumn& c : p.columns) {
+    o << "<tr><td>" << F("%.4g", c.x) << "</td><td>" << F("%.4g", c.y) << "</td><td>" << F("%.4g", c.mass) << "</td><td>"
+      << (std::isfinite(c.score) ? F("%.4f", c.score) : std::string("fell")) << "</td><td>" << (c.fits_as_well ? "yes" : "")
+      << "</td></tr>";
+  }
+  o << "</table>\n" << LegSearchTable(p.search, "The payload's mass at the best position", false);
+  return o.str();
+}
+
 std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const std::filesystem::path& dir) {
   std::ostringstream o;
   o << "<h2>5. Details</h2>\n";
@@ -314,6 +328,7 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
                                          "by a model of its own)", false);
   }
   if (a.leg_search.ran) o << LegSearchTable(a.leg_search, "Search of every leg's gain", true);
+  if (a.payload_search.ran) o << PayloadSearchTables(a.payload_search);
   if (!ctx.recalibrated_config_file.empty()) {
     o << "<p>The simulator config at the named values: <code>" << Escape(ctx.recalibrated_config_file)
       << "</code> (<code>dgmm simulate --config</code>).</p>\n";

@@ -215,6 +215,28 @@ json RunoffJson(const Runoff& r) {
   return out;
 }
 
+// The payload search's best column as a search (its points: masses at that position) with every
+// position searched; null when it did not run.
+json PayloadSearchJson(const PayloadSearch& p) {
+  if (!p.ran) return p.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", p.why}});
+  json out = LegSearchJson(p.search);
+  for (const char* leg_only : {"leg", "legs_as_well", "challenged", "z_vs_named", "rivals_named"}) out.erase(leg_only);
+  json columns = json::array();
+  for (const PayloadColumn& c : p.columns) {
+    columns.push_back({{"forward_m", c.x}, {"left_m", c.y}, {"best_mass_kg", JsonNumber(c.mass)},
+                       {"best_forward_m", c.best_x}, {"best_left_m", c.best_y},
+                       {"score", JsonNumber(c.score)}, {"fits_as_well", c.fits_as_well}});
+  }
+  out["ran"] = true;
+  out["why"] = p.why;
+  out["forward_m"] = JsonNumber(p.x);
+  out["left_m"] = JsonNumber(p.y);
+  out["moment_kg_m"] = {JsonNumber(p.search.value * (p.x - p.x_nominal)), JsonNumber(p.search.value * (p.y - p.y_nominal))};
+  out["positions"] = columns;
+  out["seconds"] = p.seconds;
+  return out;
+}
+
 // The advice where the evidence stopped short of a name (more_data.h); null when not advised.
 json MoreDataJson(const MoreData& m) {
   if (!m.advised) return nullptr;
@@ -240,6 +262,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"adequacy", a.knobs_analysed ? AdequacyJson(a) : json(nullptr)},
               {"runoff", RunoffJson(a.runoff)},
               {"leg_search", LegSearchJson(a.leg_search)},
+              {"payload_search", PayloadSearchJson(a.payload_search)},
               {"more_data", MoreDataJson(a.more_data)},
               {"fit", FitJson(a)},
               {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},
@@ -255,7 +278,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"seconds", {{"locate", a.seconds.locate}, {"candidates", a.seconds.candidates},
                            {"refine", a.seconds.refine}, {"confidence", a.seconds.confidence},
                            {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"runoff", a.seconds.runoff},
-                           {"leg_search", a.seconds.legs},
+                           {"leg_search", a.seconds.legs}, {"payload_search", a.seconds.payload},
                            {"total", a.seconds.total}}}};
   for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});
   return out.dump(2) + "\n";

@@ -111,10 +111,7 @@ TEST(LegSearch, ANamedLegIsTheVerdictsOneStory) {
   const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
   const LegSearch r = Search(s);
   ASSERT_TRUE(r.named);
-  Verdict v;
-  v.status = "unexplained";
-  v.doubts = {"mismatch left in 12 regions"};
-  v.sentence = "Unexplained mismatch: no simulator knob or measurement effect fits.";
+  Verdict v = UnexplainedInRegions();
   AddLegSearch(r, &v);
   EXPECT_EQ(v.status, "partly_explained");
   ASSERT_EQ(v.named.size(), 1u);

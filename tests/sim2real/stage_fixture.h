@@ -51,6 +51,16 @@ inline Stages RunStages(const std::vector<KnobValue>& planted, int last, const F
   return RunStages(SharedFake(), planted, last, extras);
 }
 
+// An `unexplained` verdict that named nothing and located 12 regions: what a search that names a
+// knob replaces (its status, sentence and doubts).
+inline Verdict UnexplainedInRegions() {
+  Verdict v;
+  v.status = "unexplained";
+  v.doubts = {"mismatch left in 12 regions"};
+  v.sentence = "Unexplained mismatch: no simulator knob or measurement effect fits.";
+  return v;
+}
+
 inline int CandidateOf(const CandidateSet& set, const std::string& key) {
   for (size_t k = 0; k < set.candidates.size(); ++k) {
     if (set.candidates[k].key == key) return static_cast<int>(k);

@@ -1,0 +1,251 @@
+#include "sim2real/payload_search.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "sim2real/refine_search.h"
+#include "sim2real/sentence_format.h"
+#include "sim2real/verdict_stage.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// The probe's offset from the nominal (the first probe; 0 without one).
+double ProbeStep(const Knob& k) { return k.probes.empty() ? 0.0 : k.probes.front() - k.nominal; }
+
+double InRange(const Knob& k, double v) { return std::clamp(v, std::max(k.lo, k.physical_min), k.hi); }
+
+// The positions searched: forward offsets at the nominal sideways one, then sideways offsets at the
+// nominal forward one, inside the knobs' ranges, distinct.
+std::vector<std::pair<double, double>> Positions(const Knob& kx, const Knob& ky, const PayloadSearchOptions& o) {
+  std::vector<std::pair<double, double>> out;
+  auto add = [&](double x, double y) {
+    const std::pair<double, double> p{InRange(kx, x), InRange(ky, y)};
+    if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
+  };
+  for (double f : o.forward) add(kx.nominal + f * ProbeStep(kx), ky.nominal);
+  for (double s : o.sideways) add(kx.nominal, ky.nominal + s * ProbeStep(ky));
+  return out;
+}
+
+// The masses searched in every column: `masses` times the mass probe, inside the range, above 0.
+std::vector<std::pair<int, double>> MassGrid(int knob, const Knob& km, const PayloadSearchOptions& o) {
+  std::vector<std::pair<int, double>> out;
+  for (double f : o.masses) {
+    const double m = InRange(km, km.nominal + f * ProbeStep(km));
+    if (m > 0 && std::none_of(out.begin(), out.end(), [&](const auto& p) { return p.second == m; })) {
+      out.push_back({knob, m});
+    }
+  }
+  return out;
+}
+
+// "2.2 cm behind the middle", "1 cm ahead of and 0.5 cm left of the middle", "on the middle".
+std::string WhereSaid(double x, double y) {
+  std::vector<std::string> parts;
+  if (std::fabs(x) >= 5e-4) parts.push_back(Fmt("%.2g cm ", 100 * std::fabs(x)) + (x > 0 ? "ahead of" : "behind"));
+  if (std::fabs(y) >= 5e-4) parts.push_back(Fmt("%.2g cm ", 100 * std::fabs(y)) + (y > 0 ? "left of" : "right of"));
+  if (parts.empty()) return "on the middle";
+  return (parts.size() == 2 ? parts[0] + " and " + parts[1] : parts[0]) + " the middle";
+}
+
+// " (2.9 kg cm ahead of the middle)": the named payload's moment about the knobs' nominal position.
+std::string MomentSaid(const PayloadSearch& p) {
+  const double mx = p.search.value * (p.x - p.x_nominal), my = p.search.value * (p.y - p.y_nominal);
+  std::vector<std::string> parts;
+  if (std::fabs(mx) >= 1e-5) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(mx)) + (mx > 0 ? "ahead" : "behind"));
+  if (std::fabs(my) >= 1e-5) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(my)) + (my > 0 ? "to the left" : "to the right"));
+  return parts.empty() ? " (none: on the middle)" : " (" + JoinWords(parts) + ")";
+}
+
+// Marks the columns whose best point fits the real samples as well as the best column's.
+void MarkAsWell(const std::vector<LegSearch>& searches, const AnalysisInputs& in, double z, PayloadSearch* out) {
+  std::vector<Eigen::VectorXd> rows;
+  std::vector<int> column;
+  for (size_t j = 0; j < searches.size(); ++j) {
+    if (searches[j].best < 0) continue;
+    if (static_cast<int>(j) == out->best_column) out->best_column = static_cast<int>(rows.size());
+    rows.push_back(searches[j].best_rows);
+    column.push_back(static_cast<int>(j));
+  }
+  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, out->best_column, in.real.episode, z);
+  for (size_t r = 0; r < rows.size(); ++r) out->columns[column[r]].fits_as_well = as_well[r];
+  out->best_column = column[out->best_column];
+}
+
+// "; the searched positions 5 cm behind the middle and on the middle fit as well" (or "").
+std::string PositionsAsWell(const PayloadSearch& p) {
+  std::vector<std::string> where;
+  for (size_t j = 0; j < p.columns.size(); ++j) {
+    if (p.columns[j].fits_as_well && static_cast<int>(j) != p.best_column) {
+      where.push_back(WhereSaid(p.columns[j].best_x, p.columns[j].best_y));
+    }
+  }
+  if (where.empty()) return "";
+  return "; the searched position" + std::string(where.size() > 1 ? "s " : " ") + JoinWords(where) +
+         (where.size() > 1 ? " fit" : " fits") + " as well";
+}
+
+VerdictNamed NamedPayload(const PayloadSearch& p) {
+  const LegSearch& s = p.search;
+  VerdictNamed n = SearchNamed(s, "payload", "kg");
+  n.doubts.push_back(Fmt("found by a search of a payload's mass and position (%.0f positions, each recording scored by a ",
+                         static_cast<double>(p.columns.size())) +
+                     "model of its own) after the probes' mean shifts and the leg search named nothing: no bootstrap, "
+                     "its range is the masses that fit as well; it sits " + WhereSaid(p.x, p.y) + PositionsAsWell(p));
+  AddRemainingMismatchDoubt(s, "the payload", &n);
+  return n;
+}
+
+// The payload's columns screened so far: each position's masses scored (no refinement), the best
+// column kept in the search's result.
+struct Columns {
+  const KnobSimulator& simulator;
+  const AnalysisInputs& in;
+  const CandidateSet& set;
+  const CandidateOptions& recording;
+  LegSearchOptions options;
+  std::vector<std::pair<int, double>> grid;
+  PayloadKnobs k;
+  std::vector<LegSearch> searches;
+
+  // The column through (x, y) at the mass probe keeps its moment: a payload of mass m sits at
+  // nominal + (x - nominal) probe / m (clamped to the range), and likewise sideways.
+  AlsoAt Line(double x, double y) const {
+    const Knob &km = simulator.knobs()[k.mass], &kx = simulator.knobs()[k.x], &ky = simulator.knobs()[k.y];
+    const double probe = km.nominal + ProbeStep(km);
+    const int ix = k.x, iy = k.y;
+    return [=](int, double m) {
+      const double share = m > 0 ? probe / m : 0.0;  // no payload: where it sits does not matter
+      return std::vector<KnobValue>{{ix, InRange(kx, kx.nominal + (x - kx.nominal) * share)},
+                                    {iy, InRange(ky, ky.nominal + (y - ky.nominal) * share)}};
+    };
+  }
+
+  void Screen(const std::vector<std::pair<double, double>>& positions, PayloadSearch* out) {
+    for (const auto& [x, y] : positions) {
+      searches.push_back(SearchOwnModels(simulator, in, set, recording, options, grid, Line(x, y)));
+      const LegSearch& s = searches.back();
+      const bool any = s.best >= 0 && s.also.size() == 2;
+      out->columns.push_back({x, y, s.value, any ? s.also[0].value : x, any ? s.also[1].value : y, BestScore(s), false});
+      if (s.best >= 0 && (out->best_column < 0 || BestScore(s) > out->columns[out->best_column].score)) {
+        out->best_column = static_cast<int>(out->columns.size()) - 1;
+      }
+    }
+  }
+};
+
+// Half-way from the best column to its searched neighbours along its own axis (forward for a
+// column on the middle line, else sideways), or half a probe's offset beyond the last one, inside
+// the range, not yet searched.
+std::vector<std::pair<double, double>> PositionHalfSteps(const PayloadSearch& p, const Knob& kx, const Knob& ky) {
+  const PayloadColumn& b = p.columns[p.best_column];
+  const bool forward = b.y == InRange(ky, ky.nominal);
+  const double at = forward ? b.x : b.y, reach = std::fabs(ProbeStep(forward ? kx : ky));
+  double below = at - reach, above = at + reach;
+  for (const PayloadColumn& c : p.columns) {
+    const bool same_line = forward ? c.y == b.y : c.x == b.x;
+    const double v = forward ? c.x : c.y;
+    if (!same_line) continue;
+    if (v < at) below = std::max(below, v);
+    if (v > at) above = std::min(above, v);
+  }
+  std::vector<std::pair<double, double>> out;
+  for (double v : {0.5 * (at + below), 0.5 * (at + above)}) {
+    const std::pair<double, double> q = forward ? std::make_pair(InRange(kx, v), b.y) : std::make_pair(b.x, InRange(ky, v));
+    const bool searched = std::any_of(p.columns.begin(), p.columns.end(),
+                                      [&](const PayloadColumn& c) { return c.x == q.first && c.y == q.second; });
+    if (!searched && std::find(out.begin(), out.end(), q) == out.end()) out.push_back(q);
+  }
+  return out;
+}
+
+}  // namespace
+
+bool PayloadSearchOptions::IsValid(std::string* error) const {
+  if (masses.empty() || std::any_of(masses.begin(), masses.end(), [](double m) { return !(m > 0); })) {
+    *error = "payload search masses must be positive multiples of the mass probe";
+    return false;
+  }
+  if (position_steps < 0) {
+    *error = "payload search position_steps must be 0 or more";
+    return false;
+  }
+  if (forward.empty() && sideways.empty()) {
+    *error = "payload search needs at least one position";
+    return false;
+  }
+  return search.IsValid(error);
+}
+
+PayloadKnobs FindPayloadKnobs(const KnobSimulator& simulator) {
+  PayloadKnobs out;
+  const auto& knobs = simulator.knobs();
+  for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
+    if (knobs[k].role == Knob::Role::kPayloadMass) out.mass = k;
+    if (knobs[k].role == Knob::Role::kPayloadX) out.x = k;
+    if (knobs[k].role == Knob::Role::kPayloadY) out.y = k;
+  }
+  return out;
+}
+
+PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                            const CandidateOptions& recording, const PayloadSearchOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "payload search options", error);
+  const auto start = Clock::now();
+  PayloadSearch out;
+  const PayloadKnobs k = FindPayloadKnobs(simulator);
+  const auto& knobs = simulator.knobs();
+  const auto grid = k.found() ? MassGrid(k.mass, knobs[k.mass], options) : std::vector<std::pair<int, double>>{};
+  if (grid.empty()) {
+    out.why = "the simulator has no payload knobs";
+    return out;
+  }
+  out.ran = true;
+  Columns columns{simulator, in, set, recording, options.search, grid, k};
+  columns.options.refine_steps = 0;
+  columns.Screen(Positions(knobs[k.x], knobs[k.y], options), &out);
+  for (int round = 0; out.best_column >= 0 && round < options.position_steps; ++round) {
+    columns.Screen(PositionHalfSteps(out, knobs[k.x], knobs[k.y]), &out);
+  }
+  const std::vector<LegSearch>& searches = columns.searches;
+  if (out.best_column < 0) {
+    out.why = "every recording lost most of its placements (the robot fell)";
+    return out;
+  }
+  MarkAsWell(searches, in, options.search.z, &out);
+  const PayloadColumn& best = out.columns[out.best_column];
+  out.search = SearchOwnModels(simulator, in, set, recording, options.search, grid, columns.Line(best.x, best.y));
+  out.x_nominal = knobs[k.x].nominal, out.y_nominal = knobs[k.y].nominal;
+  out.x = out.search.also.empty() ? best.best_x : out.search.also[0].value;
+  out.y = out.search.also.empty() ? best.best_y : out.search.also[1].value;
+  for (const LegSearch& s : searches) out.search.recorded += s.recorded, out.search.from_cache += s.from_cache;
+  out.why = out.search.why;
+  out.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  return out;
+}
+
+void AddPayloadSearch(const PayloadSearch& p, Verdict* v) {
+  if (!p.ran) return;
+  const LegSearch& s = p.search;
+  const std::string what = Fmt("A search of a payload's mass and position (%.0f positions, each recording scored by a model "
+                               "of its own)",
+                               static_cast<double>(p.columns.size()));
+  if (!s.named) {
+    v->sentence += " " + what + " names none: " + p.why + ".";
+    return;
+  }
+  ReplaceNamed(s, NamedPayload(p), v);
+  v->sentence += " " + what + Fmt(": a payload of %.3g kg ", s.value) + WhereSaid(p.x, p.y) +
+                 Fmt(" fits the real samples %.3g nats per sample better than the nominal (z %.1f); ",
+                     s.points[s.best].score - s.nominal_score, s.z_vs_nominal) +
+                 "what the data fix is its moment, mass times offset" + MomentSaid(p) +
+                 ", more than its mass: every mass of its column sits at that moment.";
+}
+
+}  // namespace dgmm::sim2real

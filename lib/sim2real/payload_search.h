@@ -1,0 +1,76 @@
+#pragma once
+// Stage 8c of the analysis (analysis.h, experimental, off by default): a search of a payload's mass
+// and position, run when the stages before (the leg search too) named nothing for a located
+// mismatch. The probes read a payload linearly from three recordings (mass at the middle, ahead,
+// to the left), but a payload off the middle can change the gait's posture far from linearly: on
+// the hexapod on its 10° slope 0.88 kg 2.2 cm behind the middle sits the robot back 74 mrad in
+// pitch, 75 nats per real sample below the real-trained ceiling, which the probes' reading
+// fitted 1.2 of (docs/sim2real.md, "Payload offsets on the hexapod, simulated since 2026-12-05").
+// Here the payload is recorded in columns, each at masses `masses` times the mass probe: a column
+// keeps the moment of a position at the probe mass (forward offsets `forward` times the x probe's
+// offset, and sideways `sideways` times the y probe's, at forward 0), so a payload of mass m sits
+// at nominal + (position - nominal) probe / m. The data fix a payload's moment far better than its
+// mass or its offset (refine_payload.cc: on the hexapod 0.48 kg 5.9 cm ahead fitted a real payload
+// of 0.76 kg 3.7 cm ahead best on a grid of fixed offsets), and a grid of fixed offsets crosses
+// that ridge between its points. Then `position_steps` rounds of half-steps around the best column
+// along its line; every recording scored by a model of its own as the leg search
+// scores a leg (leg_search.h, SearchOwnModels: the same z over the nominal, misfit gate and
+// half-step refinement of the mass in the best column):
+//   l(m, x, y) = sum_i log p_{m,x,y}(x_i | c_i, z_i, f_i).
+// Positions whose best point fits as well as the best column's are listed: the data fix the mass
+// better than where it sits.
+#include <string>
+#include <vector>
+
+#include "sim2real/leg_search.h"
+#include "sim2real/verdict.h"
+
+namespace dgmm::sim2real {
+
+struct PayloadSearchOptions {
+  bool enabled = false;  // `dgmm sim2real --payload-search`
+  std::vector<double> masses = {1.0, 2.0};                   // of the mass knob's probe
+  std::vector<double> forward = {-1.0, -0.5, 0.0, 0.5, 1.0};  // of the x probe's offset, sideways 0
+  std::vector<double> sideways = {-1.0, 1.0};                 // of the y probe's offset, forward 0
+  // Rounds of half-steps of the position around the best column, along its line (two columns each).
+  int position_steps = 1;
+  LegSearchOptions search;  // the scoring and naming rules (its factors unused; the analysis's model)
+  PayloadSearchOptions() { search.refine_steps = 2; }  // the best column's mass, to a quarter of a step
+  bool IsValid(std::string* error) const;
+};
+
+struct PayloadColumn {
+  double x = 0, y = 0;          // the payload's position at the mass probe (m, the knobs' frame)
+  double mass = 0;              // its best mass (kg) ...
+  double best_x = 0, best_y = 0;  // ... and where the column places that mass (its moment kept)
+  double score = -INFINITY;     // that point's mean log-likelihood per real sample
+  bool fits_as_well = false;    // within z SE of the best column's best (placements as units)
+};
+
+struct PayloadSearch {
+  bool ran = false;
+  std::string why;                     // why it did not run or names nothing
+  std::vector<PayloadColumn> columns;  // every position searched
+  int best_column = -1;
+  LegSearch search;                    // the best column's search (its `also`: the position)
+  double x = NAN, y = NAN;             // where the named mass sits
+  double x_nominal = 0, y_nominal = 0; // the knobs' nominal position (the middle)
+  double seconds = 0;
+};
+
+// The payload's knobs in `simulator` (mass, x, y; -1 when missing).
+struct PayloadKnobs {
+  int mass = -1, x = -1, y = -1;
+  bool found() const { return mass >= 0 && x >= 0 && y >= 0; }
+};
+PayloadKnobs FindPayloadKnobs(const KnobSimulator& simulator);
+
+PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
+                            const CandidateOptions& recording, const PayloadSearchOptions& options);
+
+// The search's answer in the verdict: a named payload replaces an `unexplained` verdict that named
+// nothing (status partly_explained, with the doubts of a search without bootstrap); otherwise the
+// sentence says what the search found and why it names nothing.
+void AddPayloadSearch(const PayloadSearch& search, Verdict* verdict);
+
+}  // namespace dgmm::sim2real

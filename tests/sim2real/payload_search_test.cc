@@ -1,0 +1,94 @@
+// The search of a payload's mass and position (payload_search.h) on the fake simulator: a planted
+// payload behind the middle is named with its mass and side, a nominal "real" robot names none, the
+// verdict says one thing either way, and in the whole analysis the search runs only when enabled
+// and nothing else was named.
+#include "sim2real/payload_search.h"
+
+#include <gtest/gtest.h>
+
+#include "sim2real/analysis.h"
+#include "tests/sim2real/stage_fixture.h"
+
+namespace dgmm::sim2real::test {
+namespace {
+
+PayloadSearch Search(const Stages& s) {
+  PayloadSearchOptions o;
+  o.search.model = s.options.locate.model;
+  return SearchPayload(SharedFake(), s.in, s.set, s.options.candidates, o);
+}
+
+TEST(PayloadSearch, FindsThePayloadsThreeKnobs) {
+  const PayloadKnobs k = FindPayloadKnobs(SharedFake());
+  EXPECT_EQ(k.mass, kPayloadMass);
+  EXPECT_EQ(k.x, kPayloadX);
+  EXPECT_EQ(k.y, kPayloadY);
+}
+
+TEST(PayloadSearch, NamesAPlantedPayloadWithItsMassAndSide) {
+  const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
+  const PayloadSearch p = Search(s);
+  ASSERT_TRUE(p.ran);
+  ASSERT_TRUE(p.search.named) << p.why;
+  EXPECT_EQ(p.search.knob_index, kPayloadMass);
+  EXPECT_NEAR(p.search.value, 2.4, 0.25 * 2.4);
+  EXPECT_LT(p.x, 0) << "behind the middle";
+  EXPECT_NEAR(p.search.value * p.x, 2.4 * -0.1, 0.25 * 0.24) << "its moment";
+  EXPECT_EQ(p.y, 0);
+  EXPECT_EQ(p.columns.size(), 9u) << "five forward offsets and two sideways, then half-steps either side of the best";
+  EXPECT_TRUE(p.columns[p.best_column].fits_as_well);
+  EXPECT_GT(p.search.z_vs_nominal, 2.0);
+  ASSERT_EQ(p.search.also.size(), 2u) << "the position is recorded with every point";
+  EXPECT_EQ(p.search.also[0].knob, kPayloadX);
+  EXPECT_EQ(p.search.also[0].value, p.x);
+  EXPECT_GT(p.search.points.size(), 2u) << "two masses, then half-steps around the best";
+}
+
+TEST(PayloadSearch, ANominalRobotNamesNoPayload) {
+  const Stages s = RunStages({}, 3);
+  const PayloadSearch p = Search(s);
+  ASSERT_TRUE(p.ran);
+  EXPECT_FALSE(p.search.named) << "named " << p.search.value << " kg at " << p.x << ", " << p.y;
+  EXPECT_FALSE(p.why.empty());
+}
+
+TEST(PayloadSearch, ANamedPayloadIsTheVerdictsOneStory) {
+  const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
+  const PayloadSearch p = Search(s);
+  ASSERT_TRUE(p.search.named);
+  Verdict v = UnexplainedInRegions();
+  AddPayloadSearch(p, &v);
+  EXPECT_EQ(v.status, "partly_explained");
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "payload.mass_kg");
+  EXPECT_EQ(v.named[0].family, "payload");
+  EXPECT_EQ(v.sentence.find("Unexplained"), std::string::npos) << v.sentence;
+  EXPECT_NE(v.sentence.find("behind the middle"), std::string::npos) << v.sentence;
+  for (const std::string& d : v.doubts) EXPECT_EQ(d.find("regions"), std::string::npos) << "the old doubt stays: " << d;
+}
+
+// In the analysis: off by default; when enabled it runs on physics no knob describes (nothing named
+// by the probes or the leg search), names no payload there, and the report has it.
+TEST(PayloadSearch, RunsInTheAnalysisOnlyWhenEnabledAndNothingIsNamed) {
+  FakeExtras extras;
+  extras.geometry = 0.03;
+  const FakePair pair = MakeFakePair(SharedFake(), {}, extras);
+  AnalysisOptions options = FastOptions();
+  EXPECT_FALSE(options.payload.enabled);
+  EXPECT_FALSE(Analyse(pair.sim, pair.real, &SharedFake(), options).payload_search.ran);
+  options.payload.enabled = true;
+  const Analysis a = Analyse(pair.sim, pair.real, &SharedFake(), options);
+  ASSERT_TRUE(a.naming.named.empty() && !a.leg_search.named) << a.verdict.sentence;
+  ASSERT_TRUE(a.payload_search.ran) << a.verdict.sentence;
+  EXPECT_FALSE(a.payload_search.search.named) << a.verdict.sentence;
+  EXPECT_NE(a.verdict.sentence.find("A search of a payload's mass and position"), std::string::npos) << a.verdict.sentence;
+  EXPECT_EQ(Analyse(pair.sim, pair.real, &SharedFake(), options).verdict.sentence, a.verdict.sentence)
+      << "the same answer twice";
+  const auto friction = MakeFakePair(SharedFake(), {{kFriction, 0.6}});
+  const Analysis with_name = Analyse(friction.sim, friction.real, &SharedFake(), options);
+  ASSERT_FALSE(with_name.naming.named.empty()) << with_name.verdict.sentence;
+  EXPECT_FALSE(with_name.payload_search.ran) << "something was named";
+}
+
+}  // namespace
+}  // namespace dgmm::sim2real::test
