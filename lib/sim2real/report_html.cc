@@ -292,10 +292,13 @@ std::string LegSearchTable(const LegSearch& l, const std::string& title, bool le
 // The payload search: every position's best mass and score, then the best position's masses.
 std::string PayloadSearchTables(const PayloadSearch& p) {
   std::ostringstream o;
-  o << "<h3>Search of a payload's mass and position</h3><table><tr><th>forward (m)</th><th>left (m)</th>"
-    << "<th>best mass (kg)</th><th>log-likelihood per real sample (own model)</th><th>fits as well as the best</th></tr>";
+  o << "<h3>Search of a payload's mass and position</h3><p>Each column keeps a moment: a payload of mass m sits at "
+       "its position at the mass probe times probe / m.</p><table><tr><th>column: forward, left at the mass probe (m)"
+    << "</th><th>best mass (kg)</th><th>where it sits: forward, left (m)</th>"
+    << "<th>log-likelihood per real sample (own model)</th><th>fits as well as the best</th></tr>";
   for (const PayloadColumn& c : p.columns) {
-    o << "<tr><td>" << F("%.4g", c.x) << "</td><td>" << F("%.4g", c.y) << "</td><td>" << F("%.4g", c.mass) << "</td><td>"
+    o << "<tr><td>" << F("%.4g", c.x) << ", " << F("%.4g", c.y) << "</td><td>" << F("%.4g", c.mass) << "</td><td>"
+      << F("%.4g", c.best_x) << ", " << F("%.4g", c.best_y) << "</td><td>"
       << (std::isfinite(c.score) ? F("%.4f", c.score) : std::string("fell")) << "</td><td>" << (c.fits_as_well ? "yes" : "")
       << "</td></tr>";
   }

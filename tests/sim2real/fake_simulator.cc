@@ -40,6 +40,8 @@ Values ValuesOf(const std::vector<Knob>& knobs, const std::vector<KnobValue>& va
   bool mass = false, position = false;
   for (const auto& kv : values) {
     if (kv.knob < 0 || kv.knob >= kNumFakeKnobs) throw MakeInputError("fake simulator", "knob", "out of range");
+    // As lib/sim's config check: a knob at a value that is not a finite number is refused.
+    if (!std::isfinite(kv.value)) throw MakeInputError("fake simulator", knobs[kv.knob].name, "expected a finite value");
     out.v[kv.knob] = kv.value;
     mass |= kv.knob == kPayloadMass;
     position |= kv.knob == kPayloadX || kv.knob == kPayloadY;

@@ -52,6 +52,23 @@ TEST(PayloadSearch, ANominalRobotNamesNoPayload) {
   EXPECT_FALSE(p.why.empty());
 }
 
+// The mass's half-steps can reach no payload at all (mass 0): the column's position is then the
+// middle, not probe / 0 (the simulator refuses a position that is not a finite number).
+TEST(PayloadSearch, AColumnRefinedDownToNoPayloadRecordsNoPosition) {
+  const Stages s = RunStages({{kPayloadMass, 1.0}}, 3);  // two thirds of the mass probe, on the middle
+  PayloadSearchOptions o;
+  o.search.model = s.options.locate.model;
+  o.forward = {0.0};
+  o.sideways = {};
+  const PayloadSearch p = SearchPayload(SharedFake(), s.in, s.set, s.options.candidates, o);
+  ASSERT_TRUE(p.ran);
+  ASSERT_TRUE(p.search.named) << p.why;
+  bool zero = false;
+  for (const LegSearchPoint& q : p.search.points) zero |= q.value == 0;
+  EXPECT_TRUE(zero) << "the lighter mass fits best, and the half-steps go below it to 0";
+  EXPECT_EQ(p.x, 0);
+}
+
 TEST(PayloadSearch, ANamedPayloadIsTheVerdictsOneStory) {
   const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
   const PayloadSearch p = Search(s);
