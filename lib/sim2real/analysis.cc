@@ -161,7 +161,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   }
 }
 
-// The knobs the runoff or the leg search recorded without naming them.
+// The knobs the runoff, the leg search or the payload search recorded without naming them.
 std::vector<std::string> SearchedWithoutName(const Analysis& a) {
   std::vector<std::string> knobs;
   for (const LegSearch* s : {&a.runoff.search, &a.leg_search, &a.payload_search.search}) {

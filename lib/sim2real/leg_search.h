@@ -110,7 +110,8 @@ struct LegSearchPoint {
 
 struct LegSearch {
   bool ran = false;
-  std::string by = "leg_search";      // which stage searched: "leg_search" or "runoff" (runoff.h)
+  std::string by = "leg_search";      // which stage searched: "leg_search", "runoff" (runoff.h) or
+                                      // "payload_search" (payload_search.h)
   std::string score;                  // "sag" or "robust" (LegSearchOptions::sag_mode)
   std::string why;                    // why it did not run, or what it found, in words
   std::vector<LegSearchPoint> points; // every leg and gain scored

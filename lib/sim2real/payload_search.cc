@@ -221,6 +221,7 @@ PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs
   MarkAsWell(searches, in, options.search.z, &out);
   const PayloadColumn& best = out.columns[out.best_column];
   out.search = SearchOwnModels(simulator, in, set, recording, options.search, grid, columns.Line(best.x, best.y));
+  out.search.by = "payload_search";
   out.x_nominal = knobs[k.x].nominal, out.y_nominal = knobs[k.y].nominal;
   out.x = out.search.also.empty() ? best.best_x : out.search.also[0].value;
   out.y = out.search.also.empty() ? best.best_y : out.search.also[1].value;

@@ -175,14 +175,16 @@ std::string PhysicsSection(const Analysis& a) {
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
   if (const LegSearch* own = NamedByOwnModels(a)) {
-    const bool runoff = own->by == "runoff";
-    o << (runoff ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
-                   "each recorded again and scored by a model of its own (section 5), named "
-                 : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
+    const bool runoff = own->by == "runoff", payload = own->by == "payload_search";
+    o << (runoff    ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
+                      "each recorded again and scored by a model of its own (section 5), named "
+          : payload ? "<p>The forward selection below and the search of every leg's gain named nothing; the search of "
+                      "a payload's mass and position (section 5) named "
+                    : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
       << Escape(own->knob) << F(" = %.4g", own->value) << ": its recording fits the real samples "
-      << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, no other "
-      << (runoff ? "contender's" : "leg's") << " as well, and " << MisfitSaid(*own)
-      << ". It has no bootstrap: inclusion is not computed.</p>\n";
+      << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, "
+      << (payload ? "" : runoff ? "no other contender's as well, " : "no other leg's as well, ") << "and "
+      << MisfitSaid(*own) << ". It has no bootstrap: inclusion is not computed.</p>\n";
   }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
   else o << NamedTable(a.verdict);
@@ -222,7 +224,10 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
        "sample</th></tr><tr><td>(a) sim-trained</td><td>" << F("%.3f", b.ll_sim) << "</td></tr>";
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
-    o << "<tr><td>(b) corrected (" << (own->by == "runoff" ? "the runoff's named knob" : "the weak leg of the leg search")
+    o << "<tr><td>(b) corrected ("
+      << (own->by == "runoff"           ? "the runoff's named knob"
+          : own->by == "payload_search" ? "the payload of the payload search"
+                                        : "the weak leg of the leg search")
       << ", its recording's own model under the search's score: sags and a broad floor included)</td><td>"
       << F("%.3f", BestScore(*own)) << "</td></tr>";
   } else if (a.knobs_analysed) {
@@ -375,7 +380,8 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
-    o << ", corrected (" << (own->by == "runoff" ? own->knob : "weak " + own->leg) << ") " << F("%.3f", BestScore(*own));
+    const std::string named = own->by == "runoff" ? own->knob : own->by == "payload_search" ? "payload" : "weak " + own->leg;
+    o << ", corrected (" << named << ") " << F("%.3f", BestScore(*own));
   } else if (a.knobs_analysed) {
     o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);
   }

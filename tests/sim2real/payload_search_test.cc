@@ -30,6 +30,7 @@ TEST(PayloadSearch, NamesAPlantedPayloadWithItsMassAndSide) {
   const PayloadSearch p = Search(s);
   ASSERT_TRUE(p.ran);
   ASSERT_TRUE(p.search.named) << p.why;
+  EXPECT_EQ(p.search.by, "payload_search") << "what the report says corrected the model";
   EXPECT_EQ(p.search.knob_index, kPayloadMass);
   EXPECT_NEAR(p.search.value, 2.4, 0.25 * 2.4);
   EXPECT_LT(p.x, 0) << "behind the middle";
