@@ -7,6 +7,7 @@
 //
 // lib/sim2real never sees MuJoCo: the app wires this interface to lib/sim
 // (app/wiring/mujoco_knob_simulator.h); tests of the analysis's logic use a fake.
+#include <algorithm>
 #include <Eigen/Core>
 #include <cstdint>
 #include <limits>
@@ -41,6 +42,9 @@ struct Knob {
   std::string side;             // "left" or "right" for a per-side knob, else ""
   std::vector<std::string> members;  // a per-side knob: the `leg` of every per-leg knob it scales
 };
+
+// v inside the knob's range and above its physical limit.
+inline double WithinKnob(const Knob& k, double v) { return std::clamp(v, std::max(k.lo, k.physical_min), k.hi); }
 
 // A knob (index into KnobSimulator::knobs()) at a value in its unit.
 struct KnobValue {

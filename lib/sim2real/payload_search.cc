@@ -17,14 +17,12 @@ using Clock = std::chrono::steady_clock;
 // The probe's offset from the nominal (the first probe; 0 without one).
 double ProbeStep(const Knob& k) { return k.probes.empty() ? 0.0 : k.probes.front() - k.nominal; }
 
-double InRange(const Knob& k, double v) { return std::clamp(v, std::max(k.lo, k.physical_min), k.hi); }
-
 // The positions searched: forward offsets at the nominal sideways one, then sideways offsets at the
 // nominal forward one, inside the knobs' ranges, distinct.
 std::vector<std::pair<double, double>> Positions(const Knob& kx, const Knob& ky, const PayloadSearchOptions& o) {
   std::vector<std::pair<double, double>> out;
   auto add = [&](double x, double y) {
-    const std::pair<double, double> p{InRange(kx, x), InRange(ky, y)};
+    const std::pair<double, double> p{WithinKnob(kx, x), WithinKnob(ky, y)};
     if (std::find(out.begin(), out.end(), p) == out.end()) out.push_back(p);
   };
   for (double f : o.forward) add(kx.nominal + f * ProbeStep(kx), ky.nominal);
@@ -36,7 +34,7 @@ std::vector<std::pair<double, double>> Positions(const Knob& kx, const Knob& ky,
 std::vector<std::pair<int, double>> MassGrid(int knob, const Knob& km, const PayloadSearchOptions& o) {
   std::vector<std::pair<int, double>> out;
   for (double f : o.masses) {
-    const double m = InRange(km, km.nominal + f * ProbeStep(km));
+    const double m = WithinKnob(km, km.nominal + f * ProbeStep(km));
     if (m > 0 && std::none_of(out.begin(), out.end(), [&](const auto& p) { return p.second == m; })) {
       out.push_back({knob, m});
     }
@@ -55,7 +53,7 @@ std::string WhereSaid(double x, double y) {
 
 // " (2.9 kg cm ahead of the middle)": the named payload's moment about the knobs' nominal position.
 std::string MomentSaid(const PayloadSearch& p) {
-  const double mx = p.search.value * (p.x - p.x_nominal), my = p.search.value * (p.y - p.y_nominal);
+  const auto [mx, my] = PayloadMoment(p);
   std::vector<std::string> parts;
   if (std::fabs(mx) >= 1e-5) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(mx)) + (mx > 0 ? "ahead" : "behind"));
   if (std::fabs(my) >= 1e-5) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(my)) + (my > 0 ? "to the left" : "to the right"));
@@ -66,15 +64,15 @@ std::string MomentSaid(const PayloadSearch& p) {
 void MarkAsWell(const std::vector<LegSearch>& searches, const AnalysisInputs& in, double z, PayloadSearch* out) {
   std::vector<Eigen::VectorXd> rows;
   std::vector<int> column;
+  int best_row = -1;
   for (size_t j = 0; j < searches.size(); ++j) {
     if (searches[j].best < 0) continue;
-    if (static_cast<int>(j) == out->best_column) out->best_column = static_cast<int>(rows.size());
+    if (static_cast<int>(j) == out->best_column) best_row = static_cast<int>(rows.size());
     rows.push_back(searches[j].best_rows);
     column.push_back(static_cast<int>(j));
   }
-  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, out->best_column, in.real.episode, z);
+  const std::vector<bool> as_well = FitAsWellAsTheBest(rows, best_row, in.real.episode, z);
   for (size_t r = 0; r < rows.size(); ++r) out->columns[column[r]].fits_as_well = as_well[r];
-  out->best_column = column[out->best_column];
 }
 
 // "; the searched positions 5 cm behind the middle and on the middle fit as well" (or "").
@@ -121,8 +119,8 @@ struct Columns {
     const int ix = k.x, iy = k.y;
     return [=](int, double m) {
       const double share = m > 0 ? probe / m : 0.0;  // no payload: where it sits does not matter
-      return std::vector<KnobValue>{{ix, InRange(kx, kx.nominal + (x - kx.nominal) * share)},
-                                    {iy, InRange(ky, ky.nominal + (y - ky.nominal) * share)}};
+      return std::vector<KnobValue>{{ix, WithinKnob(kx, kx.nominal + (x - kx.nominal) * share)},
+                                    {iy, WithinKnob(ky, ky.nominal + (y - ky.nominal) * share)}};
     };
   }
 
@@ -144,7 +142,7 @@ struct Columns {
 // the range, not yet searched.
 std::vector<std::pair<double, double>> PositionHalfSteps(const PayloadSearch& p, const Knob& kx, const Knob& ky) {
   const PayloadColumn& b = p.columns[p.best_column];
-  const bool forward = b.y == InRange(ky, ky.nominal);
+  const bool forward = b.y == WithinKnob(ky, ky.nominal);
   const double at = forward ? b.x : b.y, reach = std::fabs(ProbeStep(forward ? kx : ky));
   double below = at - reach, above = at + reach;
   for (const PayloadColumn& c : p.columns) {
@@ -156,7 +154,7 @@ std::vector<std::pair<double, double>> PositionHalfSteps(const PayloadSearch& p,
   }
   std::vector<std::pair<double, double>> out;
   for (double v : {0.5 * (at + below), 0.5 * (at + above)}) {
-    const std::pair<double, double> q = forward ? std::make_pair(InRange(kx, v), b.y) : std::make_pair(b.x, InRange(ky, v));
+    const std::pair<double, double> q = forward ? std::make_pair(WithinKnob(kx, v), b.y) : std::make_pair(b.x, WithinKnob(ky, v));
     const bool searched = std::any_of(p.columns.begin(), p.columns.end(),
                                       [&](const PayloadColumn& c) { return c.x == q.first && c.y == q.second; });
     if (!searched && std::find(out.begin(), out.end(), q) == out.end()) out.push_back(q);
@@ -180,6 +178,10 @@ bool PayloadSearchOptions::IsValid(std::string* error) const {
     return false;
   }
   return search.IsValid(error);
+}
+
+std::pair<double, double> PayloadMoment(const PayloadSearch& p) {
+  return {p.search.value * (p.x - p.x_nominal), p.search.value * (p.y - p.y_nominal)};
 }
 
 PayloadKnobs FindPayloadKnobs(const KnobSimulator& simulator) {

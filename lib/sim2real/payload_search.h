@@ -20,6 +20,7 @@
 // Positions whose best point fits as well as the best column's are listed: the data fix the mass
 // better than where it sits.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "sim2real/leg_search.h"
@@ -57,6 +58,9 @@ struct PayloadSearch {
   double x_nominal = 0, y_nominal = 0; // the knobs' nominal position (the middle)
   double seconds = 0;
 };
+
+// The named (best) payload's moment about the knobs' nominal position, forward and left (kg m).
+std::pair<double, double> PayloadMoment(const PayloadSearch& search);
 
 // The payload's knobs in `simulator` (mass, x, y; -1 when missing).
 struct PayloadKnobs {

@@ -192,6 +192,11 @@ json LegSearchJson(const LegSearch& l) {
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 
+// The leg search's fields that only a search of legs has (its challenge, the legs that fit as well).
+void EraseLegOnlyFields(json* out) {
+  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named", "rivals_named"}) out->erase(leg_only);
+}
+
 // The runoff's rows are knobs: a point's `leg` is null unless its knob is a leg's, the knobs whose
 // points fit as well as the best are `knobs_as_well`, and the leg search's challenge fields go.
 json RunoffJson(const Runoff& r) {
@@ -199,7 +204,7 @@ json RunoffJson(const Runoff& r) {
   if (!r.ran) return {{"ran", false}, {"why_not", r.why_not}};
   const LegSearch& s = r.search;
   json out = LegSearchJson(s);
-  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named", "rivals_named"}) out.erase(leg_only);
+  EraseLegOnlyFields(&out);
   const auto leg_of = [](const LegSearchPoint& p) { return p.leg == p.knob ? json(nullptr) : json(p.leg); };
   json knobs_as_well = json::array();
   for (size_t j = 0; j < s.points.size(); ++j) {
@@ -220,7 +225,8 @@ json RunoffJson(const Runoff& r) {
 json PayloadSearchJson(const PayloadSearch& p) {
   if (!p.ran) return p.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", p.why}});
   json out = LegSearchJson(p.search);
-  for (const char* leg_only : {"leg", "legs_as_well", "challenged", "z_vs_named", "rivals_named"}) out.erase(leg_only);
+  EraseLegOnlyFields(&out);
+  out.erase("leg");
   json columns = json::array();
   for (const PayloadColumn& c : p.columns) {
     columns.push_back({{"forward_m", c.x}, {"left_m", c.y}, {"best_mass_kg", JsonNumber(c.mass)},
@@ -231,7 +237,8 @@ json PayloadSearchJson(const PayloadSearch& p) {
   out["why"] = p.why;
   out["forward_m"] = JsonNumber(p.x);
   out["left_m"] = JsonNumber(p.y);
-  out["moment_kg_m"] = {JsonNumber(p.search.value * (p.x - p.x_nominal)), JsonNumber(p.search.value * (p.y - p.y_nominal))};
+  const auto [forward, left] = PayloadMoment(p);
+  out["moment_kg_m"] = {JsonNumber(forward), JsonNumber(left)};
   out["positions"] = columns;
   out["seconds"] = p.seconds;
   return out;

@@ -15,9 +15,8 @@ bool OneParameter(const Knob& k) { return k.role == Knob::Role::kShift || k.role
 // nominal + t (probe - nominal) for every t, inside the knob's range and physical limit, distinct.
 std::vector<double> StepValues(const Knob& k, double probe, const std::vector<double>& steps) {
   std::vector<double> out;
-  const double lo = std::max(k.lo, k.physical_min);
   for (double t : steps) {
-    const double v = std::clamp(k.nominal + t * (probe - k.nominal), lo, k.hi);
+    const double v = WithinKnob(k, k.nominal + t * (probe - k.nominal));
     const double tol = 1e-9 * std::max(std::fabs(k.nominal), std::fabs(probe));
     if (v != k.nominal && std::none_of(out.begin(), out.end(), [&](double u) { return std::fabs(u - v) <= tol; })) {
       out.push_back(v);
