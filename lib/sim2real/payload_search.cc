@@ -42,11 +42,12 @@ std::vector<std::pair<int, double>> MassGrid(int knob, const Knob& km, const Pay
   return out;
 }
 
-// "2.2 cm behind the middle", "1 cm ahead of and 0.5 cm left of the middle", "on the middle".
+// "2.2 cm behind the middle", "1 cm ahead of and 0.5 cm left of the middle", "on the middle" (a
+// column on a line through the middle keeps the other offset at exactly 0).
 std::string WhereSaid(double x, double y) {
   std::vector<std::string> parts;
-  if (std::fabs(x) >= 5e-4) parts.push_back(Fmt("%.2g cm ", 100 * std::fabs(x)) + (x > 0 ? "ahead of" : "behind"));
-  if (std::fabs(y) >= 5e-4) parts.push_back(Fmt("%.2g cm ", 100 * std::fabs(y)) + (y > 0 ? "left of" : "right of"));
+  if (x != 0) parts.push_back(Fmt("%.2g cm ", 100 * std::fabs(x)) + (x > 0 ? "ahead of" : "behind"));
+  if (y != 0) parts.push_back(Fmt("%.2g cm ", 100 * std::fabs(y)) + (y > 0 ? "left of" : "right of"));
   if (parts.empty()) return "on the middle";
   return (parts.size() == 2 ? parts[0] + " and " + parts[1] : parts[0]) + " the middle";
 }
@@ -55,8 +56,8 @@ std::string WhereSaid(double x, double y) {
 std::string MomentSaid(const PayloadSearch& p) {
   const auto [mx, my] = PayloadMoment(p);
   std::vector<std::string> parts;
-  if (std::fabs(mx) >= 1e-5) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(mx)) + (mx > 0 ? "ahead" : "behind"));
-  if (std::fabs(my) >= 1e-5) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(my)) + (my > 0 ? "to the left" : "to the right"));
+  if (mx != 0) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(mx)) + (mx > 0 ? "ahead" : "behind"));
+  if (my != 0) parts.push_back(Fmt("%.2g kg cm ", 100 * std::fabs(my)) + (my > 0 ? "to the left" : "to the right"));
   return parts.empty() ? " (none: on the middle)" : " (" + JoinWords(parts) + ")";
 }
 
