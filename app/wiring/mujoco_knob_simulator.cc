@@ -17,7 +17,7 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v8";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v9";
 // v6: a recording runs in chunks of this many placements, each with its own random stream, so
 // one recording can use several threads (sim::ProtocolOptions::chunk_placements). v7: a servo
 // gets the ctrl that holds its joint at the target (through its gear) and the gait keeps within
@@ -28,6 +28,11 @@ constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v8";
 // the hexapod, the planar quadruped, the scorpion and harvestman shapes with a robot block) moves
 // the centre MuJoCo simulates; before, only its mass and inertia acted (recordings of payloads off
 // the middle on such robots changed; others not).
+// v9: a payload merged into a torso whose principal axes are turned (the sprawled and mammal-shaped
+// quadrupeds') or placed off the torso's axes adds its inertia in the torso's principal frame,
+// products of inertia included; before, its parallel-axis terms were added per axis of the body's
+// frame to the moments of the principal frame (such recordings changed; the hexapod's, planar
+// quadruped's and octopod's not).
 constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {

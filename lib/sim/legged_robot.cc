@@ -445,17 +445,34 @@ void UseTheInertialFrame(mjModel* m, int body) {
 }  // namespace
 
 // The payload is a solid ball of radius 0.1 x the longest leg's reach (a compact block whatever the
-// robot's size) at p in the torso's frame, merged into the torso's mass, centre and inertia.
+// robot's size) at p in the torso's frame, merged into the torso's mass, centre and inertia: about
+// the new centre c, in the body's frame (R the inertial frame's rotation, D its principal moments),
+//   I = R D R^T + m0 (|c0-c|^2 1 - (c0-c)(c0-c)^T) + m (|p-c|^2 1 - (p-c)(p-c)^T + 0.4 r^2 1),
+// whose principal axes become the body's inertial frame (mju_eig3, as MuJoCo's compiler turns a
+// fullinertia into one). A tensor that stays diagonal in the inertial frame keeps its axes as they were.
 void AddPayload(mjModel* m, int torso, const Eigen::Vector3d& p, double mass, double reach_m) {
+  using Matrix3 = Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>;  // MuJoCo's layout
   const double m0 = m->body_mass[torso];
   const Eigen::Vector3d c0(m->body_ipos[3 * torso], m->body_ipos[3 * torso + 1], m->body_ipos[3 * torso + 2]);
   const Eigen::Vector3d c = (m0 * c0 + mass * p) / (m0 + mass);
   const double kRadius = 0.1 * reach_m;
-  auto perp = [](const Eigen::Vector3d& d, int k) { return d.squaredNorm() - d[k] * d[k]; };
-  for (int k = 0; k < 3; ++k) {
-    m->body_inertia[3 * torso + k] += m0 * perp(c0 - c, k) + mass * perp(p - c, k) + 0.4 * mass * kRadius * kRadius;
-    m->body_ipos[3 * torso + k] = c[k];
+  auto moved = [](double kg, const Eigen::Vector3d& d) -> Matrix3 {
+    return kg * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose());
+  };
+  Matrix3 rotation;
+  mju_quat2Mat(rotation.data(), m->body_iquat + 4 * torso);
+  const Eigen::Vector3d principal(m->body_inertia + 3 * torso);
+  const Matrix3 added = moved(m0, c0 - c) + moved(mass, p - c) + 0.4 * mass * kRadius * kRadius * Matrix3::Identity();
+  const Matrix3 in_frame = principal.asDiagonal().toDenseMatrix() + rotation.transpose() * added * rotation;
+  const bool diagonal = (in_frame - Matrix3(in_frame.diagonal().asDiagonal())).isZero(0);
+  if (diagonal) {
+    for (int k = 0; k < 3; ++k) m->body_inertia[3 * torso + k] = in_frame(k, k);
+  } else {
+    const Matrix3 full = rotation * in_frame * rotation.transpose();
+    Matrix3 axes;
+    mju_eig3(m->body_inertia + 3 * torso, axes.data(), m->body_iquat + 4 * torso, full.data());
   }
+  for (int k = 0; k < 3; ++k) m->body_ipos[3 * torso + k] = c[k];
   m->body_mass[torso] = m0 + mass;
   UseTheInertialFrame(m, torso);
 }

@@ -60,8 +60,8 @@ LeggedRobot BindRobot(const mjModel* model, const RobotDescription& robot, const
 void ApplyExperiment(const SimConfig& config, const LeggedRobot& bound, mjModel* model, const std::string& source = "");
 
 // A compact ball (radius 0.1 leg reach) rigidly added to body `torso` at `p_m` (body frame): the
-// body's mass, centre of mass and inertia (parallel axes, in its principal frame: an approximation
-// when that frame is rotated) updated.
+// body's mass, centre of mass and inertia (parallel axes; the principal frame turns when the payload
+// adds products of inertia) updated.
 void AddPayload(mjModel* model, int torso, const Eigen::Vector3d& p_m, double mass_kg, double reach_m);
 
 // Damped least squares on the foot's Jacobian restricted to the leg's joints, joint ranges

@@ -9,6 +9,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <memory>
 #include <regex>
 #include <sstream>
@@ -212,10 +213,12 @@ TEST(LeggedRobot, ALegGainScalesThatLegsServosOnly) {
   }
 }
 
-// A payload merges into the torso: total mass, centre of mass, and an inertia that adds the
-// parallel-axis terms plus the payload's own, a ball of radius 0.1 x the robot's reach (so the
-// block scales with the robot instead of being 3 cm for every robot).
+// A payload merges into the torso: total mass, centre of mass, and an inertia tensor that adds the
+// parallel-axis terms (products of inertia too: the payload is off every axis) plus the payload's
+// own, a ball of radius 0.1 x the robot's reach (so the block scales with the robot instead of
+// being 3 cm for every robot), its principal axes the torso's new inertial frame.
 TEST(LeggedRobot, APayloadMergesIntoTheTorsoAtTheRobotsScale) {
+  using Matrix3 = Eigen::Matrix<mjtNum, 3, 3, Eigen::RowMajor>;
   SimConfig c = Hexapod();
   c.payload.mass_kg = 0.8;
   c.payload.position_body_m = Eigen::Vector3d(0.05, -0.02, 0.01);
@@ -228,14 +231,21 @@ TEST(LeggedRobot, APayloadMergesIntoTheTorsoAtTheRobotsScale) {
   EXPECT_DOUBLE_EQ(m->body_mass[t], m0 + mass);
   const Eigen::Vector3d c0(original->body_ipos + 3 * t), p = bound.robot_in_torso * c.payload.position_body_m;
   const Eigen::Vector3d centre = (m0 * c0 + mass * p) / (m0 + mass);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(m->body_ipos[3 * t + k], centre[k], 1e-12);
+  auto tensor = [](const mjModel* model, int body) {  // in the body's frame
+    Matrix3 r;
+    mju_quat2Mat(r.data(), model->body_iquat + 4 * body);
+    return Matrix3(r * Eigen::Vector3d(model->body_inertia + 3 * body).asDiagonal() * r.transpose());
+  };
+  auto moved = [](double kg, const Eigen::Vector3d& d) {
+    return Matrix3(kg * (d.squaredNorm() * Matrix3::Identity() - d * d.transpose()));
+  };
   const double radius = 0.1 * bound.reach_m;
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(m->body_ipos[3 * t + k], centre[k], 1e-12);
-    auto perp = [k](const Eigen::Vector3d& d) { return d.squaredNorm() - d[k] * d[k]; };
-    const double want = original->body_inertia[3 * t + k] + m0 * perp(c0 - centre) +
-                        mass * perp(p - centre) + 0.4 * mass * radius * radius;
-    EXPECT_NEAR(m->body_inertia[3 * t + k], want, 1e-12) << "axis " << k;
-  }
+  const Matrix3 want = tensor(original.get(), t) + moved(m0, c0 - centre) + moved(mass, p - centre) +
+                       0.4 * mass * radius * radius * Matrix3::Identity();
+  // mju_eig3 stops turning the axes below 1.4e-6 rad: agreement to about 1e-6 of the tensor's size.
+  EXPECT_LT((tensor(m.get(), t) - want).cwiseAbs().maxCoeff(), 2e-6 * want.cwiseAbs().maxCoeff()) << want;
+  EXPECT_GT(std::fabs(want(0, 1)), 1e-4);  // products of inertia the old per-axis sum left out
   for (int b = 0; b < m->nbody; ++b) {
     if (b != t) EXPECT_EQ(m->body_mass[b], original->body_mass[b]) << "body " << b;
   }
@@ -277,6 +287,58 @@ TEST(LeggedRobot, APayloadMovesTheCentreOfMassMuJoCoSimulatesAndNoGeom) {
     EXPECT_GT(centre.norm(), 0.005) << moved_box;
     EXPECT_LT((Eigen::Vector3d(d->geom_xpos + 3 * g) - Eigen::Vector3d(d0->geom_xpos + 3 * g)).norm(), 1e-12)
         << moved_box;
+  }
+}
+
+// The merged payload is the rigid body MuJoCo would simulate: the sprawled quadruped's torso has
+// its principal axes turned (its compiled body_iquat is not the unit quaternion) and a payload off
+// every axis adds products of inertia; the torso's composite inertia (mj_crb: mass, centre and the
+// full tensor of it and everything below it) equals that of the same robot with the payload as a
+// body of its own welded to the torso.
+TEST(LeggedRobot, AMergedPayloadHasTheInertiaOfTheSameBallWeldedOn) {
+  const Eigen::Vector3d at(0.05, -0.02, 0.01);
+  const double kg = 0.8;
+  SimConfig c = LoadSimConfig((kRobots / "sprawled_quadruped.json").string());
+  c.payload.mass_kg = kg;
+  c.payload.position_body_m = at;
+  MjModelPtr merged = LoadRobotModel(c);
+  const LeggedRobot bound = BindRobot(merged.get(), *c.robot, "sprawled_quadruped");
+  const int t = bound.torso_body;
+  ASSERT_LT(std::fabs(merged->body_iquat[4 * t]), 0.999);  // turned: not the unit quaternion
+  ApplyExperiment(c, bound, merged.get());
+
+  std::string xml = ReadText(kRobots / "sprawled_quadruped.xml");
+  const std::string torso = "<body name=\"body\" pos=\"0 0 0.25\">";
+  ASSERT_NE(xml.find(torso), std::string::npos);
+  const Eigen::Vector3d p = bound.robot_in_torso * at;
+  const double ball = 0.4 * kg * std::pow(0.1 * bound.reach_m, 2);
+  std::ostringstream welded;
+  welded << std::setprecision(17) << "<body name=\"welded_payload\" pos=\"" << p.x() << " " << p.y() << " " << p.z()
+         << "\"><inertial pos=\"0 0 0\" mass=\"" << kg << "\" diaginertia=\"" << ball << " " << ball << " " << ball
+         << "\"/></body>";
+  xml.insert(xml.find(torso) + torso.size(), welded.str());
+  const fs::path path = fs::temp_directory_path() / ("dgmm_welded_" + std::to_string(::getpid()) + ".xml");
+  std::ofstream(path) << xml;
+  char error[1000] = "";
+  MjModelPtr reference(mj_loadXML(path.string().c_str(), nullptr, error, sizeof error));
+  fs::remove(path);
+  ASSERT_TRUE(reference) << error;
+  ASSERT_EQ(reference->nq, merged->nq);
+  ASSERT_EQ(mj_name2id(reference.get(), mjOBJ_BODY, "body"), t);
+
+  MjDataPtr d(mj_makeData(merged.get())), r(mj_makeData(reference.get()));
+  for (int i = 0; i < merged->nq; ++i) d->qpos[i] = r->qpos[i] = reference->qpos0[i];
+  d->qpos[3] = r->qpos[3] = std::cos(0.2);  // the torso turned 0.4 rad about z
+  d->qpos[6] = r->qpos[6] = std::sin(0.2);
+  mj_forward(merged.get(), d.get());
+  mj_forward(reference.get(), r.get());
+  // crb: the tensor (xx, yy, zz, xy, xz, yz), mass times centre, mass. mju_eig3 stops turning the
+  // axes below 1.4e-6 rad (1 - cos under 1e-12), so the tensor agrees to about 1e-6 of its size;
+  // the old per-axis sum missed the products of inertia by 8e-4 kg m^2 here.
+  const double size = Eigen::Vector3d(r->crb + 10 * t).cwiseAbs().maxCoeff();
+  for (int k = 0; k < 10; ++k) {
+    const double tolerance = k < 6 ? 2e-6 * size : 1e-12 * (1 + std::fabs(r->crb[10 * t + k]));
+    EXPECT_NEAR(d->crb[10 * t + k], r->crb[10 * t + k], tolerance) << "crb " << k;
   }
 }
 
