@@ -380,9 +380,10 @@ void Setup(CLI::App& root) {
                 "by default, --no-leg-search turns it off; docs/sim2real.md)");
   cmd->add_flag("--payload-search,!--no-payload-search", args->payload_search,
                 "experimental, off by default: on a plane, when nothing is named for a located mismatch after the "
-                "leg search, search a payload's mass and position (7 columns at 2 masses, a column keeping its moment "
-                "as the mass changes; then half-steps of the best column and its mass; each recording scored by its own "
-                "model, 5 executions per placement; docs/sim2real.md)");
+                "leg search or the leg search challenged the named knobs and kept them, search a payload's mass and "
+                "position (named only when it beats a challenged name's correction by 2 SE; 7 columns at 2 masses, a "
+                "column keeping its moment as the mass changes; then half-steps of the best column and its mass; each "
+                "recording scored by its own model, 5 executions per placement; docs/sim2real.md)");
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

@@ -117,17 +117,28 @@ LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
   return o;
 }
 
-// The payload search (stage 8c) runs when enabled, on a plane, when the stages before and the
-// leg search left a located mismatch with nothing named.
-bool WantPayloadSearch(const Analysis& a, const PayloadSearchOptions& options) {
-  return options.enabled && !a.baseline.permute_placements && a.verdict.status == "unexplained" &&
-         a.verdict.named.empty() && !a.runoff.search.named && !a.leg_search.named;
+// The payload search (stage 8c) runs when enabled, on a plane, when neither the runoff nor the leg
+// search named anything and the stages before either left a located mismatch with nothing named
+// or named knobs the leg search was to challenge (`challenge`, WantChallenge before it ran).
+bool WantPayloadSearch(const Analysis& a, const PayloadSearchOptions& options, bool challenge) {
+  if (!options.enabled || a.baseline.permute_placements || a.runoff.search.named || a.leg_search.named) return false;
+  if (!a.naming.named.empty()) return options.challenge_named && challenge;
+  return a.verdict.status == "unexplained" && a.verdict.named.empty();
+}
+
+// The knobs the probes named, as the verdict says them.
+std::vector<std::string> NamedKnobs(const Analysis& a) {
+  std::vector<std::string> named;
+  for (const VerdictNamed& n : a.verdict.named) named.push_back(n.knob);
+  return named;
 }
 
 // Stages 8a to 8c: the runoff on uneven ground, then the leg search when still nothing is named,
 // then the payload search.
 template <typename Stage>
 void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
+  const bool challenge = !a->naming.named.empty() && WantChallenge(*a, options.legs);
+  const std::vector<std::string> named = NamedKnobs(*a);
   if (WantRunoff(*a, options.runoff)) {
     const auto t = Clock::now();
     stage("runoff (contenders scored by models of their own)");
@@ -143,19 +154,20 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     const LegSearchOptions legs = OwnModels(options.legs, options);
     a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs);
     if (!a->naming.named.empty()) {
-      std::vector<std::string> named;
-      for (const VerdictNamed& n : a->verdict.named) named.push_back(n.knob);
       LegSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, legs, &a->leg_search);
     }
     AddLegSearch(a->leg_search, &a->verdict);
     a->seconds.legs = Since(t);
   }
-  if (WantPayloadSearch(*a, options.payload)) {
+  if (WantPayloadSearch(*a, options.payload, challenge)) {
     const auto t = Clock::now();
     stage("payload search (its mass and position)");
     PayloadSearchOptions payload = options.payload;
     payload.search = OwnModels(payload.search, options);
     a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload);
+    if (!a->naming.named.empty()) {
+      PayloadSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, payload, &a->payload_search);
+    }
     AddPayloadSearch(a->payload_search, &a->verdict);
     a->seconds.payload = Since(t);
   }

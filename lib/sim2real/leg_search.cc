@@ -426,7 +426,7 @@ LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& i
 }
 
 void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named, const Eigen::VectorXd& corrected,
-                        const LegSearchOptions& options, LegSearch* s) {
+                        const LegSearchOptions& options, LegSearch* s, const std::string& best_point) {
   s->challenged = named;
   if (!s->ran || s->best < 0 || corrected.size() != in.real.size() || s->best_rows.size() != in.real.size()) return;
   // The correction with the floor the search's score gives every sample: its broad component.
@@ -441,7 +441,8 @@ void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>
   s->bar_z = options.z;
   const std::string than = s->rivals_named ? Fmt(" better than the named knobs' correction, but by under %.3g SE", options.z)
                                            : " no better than the named knobs' correction";
-  s->why = "its best point (" + s->leg + Fmt(" at gain %.3g) fits the real samples", s->value) + than +
+  const std::string point = best_point.empty() ? s->leg + Fmt(" at gain %.3g", s->value) : best_point;
+  s->why = "its best point (" + point + ") fits the real samples" + than +
            Fmt(" (%.3g against %.3g nats per sample, z %.2f)", s->best_rows.mean(), floored.mean(), s->z_vs_named);
 }
 

@@ -175,9 +175,10 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
 // the correction given the same floor as that score (the sag reference's broad component, share e):
 //   l'_i = log((1 - e) exp(l_corrected,i) + e N(x_i - ref(c_i, z_i); 0, k^2 S)),
 //   z = sum_i (score_best,i - l'_i) / SE;
-// else the search names nothing and says so in `why` (with `rivals_named` when z is above 0).
+// else the search names nothing and says so in `why` (with `rivals_named` when z is above 0), its
+// best point said as `best_point` ("rear_left at gain 0.45" when empty).
 void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named, const Eigen::VectorXd& corrected,
-                        const LegSearchOptions& options, LegSearch* search);
+                        const LegSearchOptions& options, LegSearch* search, const std::string& best_point = "");
 
 // The named leg as a correction of the sim model: the best recording's own means minus the
 // nominal's, and the per-axis ratio of their residual variances.

@@ -89,13 +89,20 @@ std::string PositionsAsWell(const PayloadSearch& p) {
          (where.size() > 1 ? " fit" : " fits") + " as well";
 }
 
+// "a payload of 0.85 kg 3.4 cm ahead of the middle"
+std::string PayloadSaid(const PayloadSearch& p) { return Fmt("a payload of %.3g kg ", p.search.value) + WhereSaid(p.x, p.y); }
+
 VerdictNamed NamedPayload(const PayloadSearch& p) {
   const LegSearch& s = p.search;
   VerdictNamed n = SearchNamed(s, "payload", "kg");
+  const std::string after = s.challenged.empty()
+                                ? "after the probes' mean shifts and the leg search named nothing"
+                                : "after the probes' mean shifts named " + JoinWords(s.challenged) +
+                                      Fmt(", which it fits the real samples better than (z %.1f)", s.z_vs_named);
   n.doubts.push_back(Fmt("found by a search of a payload's mass and position (%.0f positions, each recording scored by a ",
                          static_cast<double>(p.columns.size())) +
-                     "model of its own) after the probes' mean shifts and the leg search named nothing: no bootstrap, "
-                     "its range is the masses that fit as well; it sits " + WhereSaid(p.x, p.y) + PositionsAsWell(p));
+                     "model of its own) " + after + ": no bootstrap, its range is the masses that fit as well; it sits " +
+                     WhereSaid(p.x, p.y) + PositionsAsWell(p));
   AddRemainingMismatchDoubt(s, "the payload", &n);
   return n;
 }
@@ -234,6 +241,13 @@ PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs
   return out;
 }
 
+void PayloadSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named,
+                            const Eigen::VectorXd& corrected, const PayloadSearchOptions& options, PayloadSearch* p) {
+  if (!p->ran || p->search.best < 0) return;
+  LegSearchChallenge(in, named, corrected, options.search, &p->search, PayloadSaid(*p));
+  p->why = p->search.why;
+}
+
 void AddPayloadSearch(const PayloadSearch& p, Verdict* v) {
   if (!p.ran) return;
   const LegSearch& s = p.search;
@@ -242,12 +256,18 @@ void AddPayloadSearch(const PayloadSearch& p, Verdict* v) {
                                static_cast<double>(p.columns.size()));
   if (!s.named) {
     v->sentence += " " + what + " names none: " + p.why + ".";
+    if (s.rivals_named) {
+      v->doubts.push_back(PayloadSaid(p) + Fmt(" fits the real samples as well as the named knobs (better by z %.2f, ", s.z_vs_named) +
+                          Fmt("under the search's bar of %.3g): these data do not tell the two apart", s.bar_z));
+      if (v->status == "explained") v->status = "partly_explained";
+    }
     return;
   }
   ReplaceNamed(s, NamedPayload(p), v);
-  v->sentence += " " + what + Fmt(": a payload of %.3g kg ", s.value) + WhereSaid(p.x, p.y) +
-                 Fmt(" fits the real samples %.3g nats per sample better than the nominal (z %.1f); ",
-                     s.points[s.best].score - s.nominal_score, s.z_vs_nominal) +
+  const std::string than_named = s.challenged.empty() ? "" : Fmt(" and than the named knobs' correction (z %.1f)", s.z_vs_named);
+  v->sentence += " " + what + ": " + PayloadSaid(p) +
+                 Fmt(" fits the real samples %.3g nats per sample better than the nominal (z %.1f)",
+                     s.points[s.best].score - s.nominal_score, s.z_vs_nominal) + than_named + "; " +
                  "what the data fix is its moment, mass times offset" + MomentSaid(p) +
                  ", more than its mass: every mass of its column sits at that moment.";
 }

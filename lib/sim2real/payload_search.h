@@ -18,7 +18,11 @@
 // half-step refinement of the mass in the best column):
 //   l(m, x, y) = sum_i log p_{m,x,y}(x_i | c_i, z_i, f_i).
 // Positions whose best point fits as well as the best column's are listed: the data fix the mass
-// better than where it sits.
+// better than where it sits. With `challenge_named` it also runs where the probes named knobs that
+// the leg search challenged and did not replace (short of the ceiling, or seldom agreed on: a
+// payload off the middle read as a small payload and a tracker offset on the planar quadruped,
+// pair 59000), and names its payload only when it beats their correction as a leg would
+// (PayloadSearchChallenge).
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,6 +34,7 @@ namespace dgmm::sim2real {
 
 struct PayloadSearchOptions {
   bool enabled = false;  // `dgmm sim2real --payload-search`
+  bool challenge_named = true;  // also challenge named knobs the leg search challenged
   std::vector<double> masses = {1.0, 2.0};                   // of the mass knob's probe
   std::vector<double> forward = {-1.0, -0.5, 0.0, 0.5, 1.0};  // of the x probe's offset, sideways 0
   std::vector<double> sideways = {-1.0, 1.0};                 // of the y probe's offset, forward 0
@@ -72,9 +77,16 @@ PayloadKnobs FindPayloadKnobs(const KnobSimulator& simulator);
 PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                             const CandidateOptions& recording, const PayloadSearchOptions& options);
 
-// The search's answer in the verdict: a named payload replaces an `unexplained` verdict that named
-// nothing (status partly_explained, with the doubts of a search without bootstrap); otherwise the
-// sentence says what the search found and why it names nothing.
+// The search as a challenger of the knobs `named` before it (LegSearchChallenge): its payload keeps
+// its name only when it fits the real samples better than their correction `corrected` by the
+// search's z; `why` then says so.
+void PayloadSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named,
+                            const Eigen::VectorXd& corrected, const PayloadSearchOptions& options, PayloadSearch* search);
+
+// The search's answer in the verdict: a named payload replaces the verdict (an `unexplained` one
+// that named nothing, or the challenged knobs; status partly_explained, with the doubts of a search
+// without bootstrap); otherwise the sentence says what the search found and why it names nothing,
+// and a doubt when its payload fits as well as the challenged knobs.
 void AddPayloadSearch(const PayloadSearch& search, Verdict* verdict);
 
 }  // namespace dgmm::sim2real

@@ -192,9 +192,12 @@ json LegSearchJson(const LegSearch& l) {
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }
 
-// The leg search's fields that only a search of legs has (its challenge, the legs that fit as well).
-void EraseLegOnlyFields(json* out) {
-  for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named", "rivals_named"}) out->erase(leg_only);
+// The leg search's fields that only a search of legs has: the legs that fit as well, and its
+// challenge of named knobs unless the search also challenges them (the payload search does).
+void EraseLegOnlyFields(json* out, bool challenges = false) {
+  out->erase("legs_as_well");
+  if (challenges) return;
+  for (const char* leg_only : {"challenged", "z_vs_named", "rivals_named"}) out->erase(leg_only);
 }
 
 // The runoff's rows are knobs: a point's `leg` is null unless its knob is a leg's, the knobs whose
@@ -225,7 +228,7 @@ json RunoffJson(const Runoff& r) {
 json PayloadSearchJson(const PayloadSearch& p) {
   if (!p.ran) return p.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", p.why}});
   json out = LegSearchJson(p.search);
-  EraseLegOnlyFields(&out);
+  EraseLegOnlyFields(&out, true);
   out.erase("leg");
   json columns = json::array();
   for (const PayloadColumn& c : p.columns) {

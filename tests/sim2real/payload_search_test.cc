@@ -85,8 +85,59 @@ TEST(PayloadSearch, ANamedPayloadIsTheVerdictsOneStory) {
   for (const std::string& d : v.doubts) EXPECT_EQ(d.find("regions"), std::string::npos) << "the old doubt stays: " << d;
 }
 
+// A challenge of knobs the probes named (PayloadSearchOptions::challenge_named): the payload replaces
+// them only when its recording fits the real samples better than their correction; one that fits
+// better by under the bar is a doubt of theirs, said with its mass and side.
+TEST(PayloadSearch, AChallengedNameGivesWayOnlyToAPayloadThatFitsBetter) {
+  const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
+  const std::vector<std::string> before = {"tracker.offset", "payload.mass_kg"};
+  PayloadSearchOptions o;
+  o.search.model = s.options.locate.model;
+  PayloadSearch poor = Search(s);
+  ASSERT_TRUE(poor.search.named) << poor.why;
+  PayloadSearchChallenge(s.in, before, poor.search.nominal_model.LogLikelihood(s.in.real), o, &poor);
+  EXPECT_TRUE(poor.search.named) << poor.why;
+  EXPECT_GT(poor.search.z_vs_named, 2.0);
+  Verdict v = UnexplainedInRegions();
+  AddPayloadSearch(poor, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_NE(v.named[0].doubts[0].find("named tracker.offset and payload.mass_kg, which it fits"), std::string::npos)
+      << v.named[0].doubts[0];
+  EXPECT_NE(v.sentence.find("than the named knobs' correction (z"), std::string::npos) << v.sentence;
+
+  PayloadSearch good = Search(s);
+  PayloadSearchChallenge(s.in, before, good.search.best_rows.array() + 1.0, o, &good);
+  EXPECT_FALSE(good.search.named);
+  EXPECT_FALSE(good.search.rivals_named);
+  EXPECT_NE(good.why.find("(a payload of "), std::string::npos) << "said as a payload, not a gain: " << good.why;
+  EXPECT_NE(good.why.find("behind the middle) fits the real samples no better"), std::string::npos) << good.why;
+
+  PayloadSearch rival;
+  for (double t : {0.5, 1.0, 2.0, 4.0, 8.0, 16.0}) {  // corrections better at some placements, worse at others
+    Eigen::VectorXd corrected = poor.search.best_rows;
+    for (int i = 0; i < corrected.size(); ++i) corrected(i) += (s.in.real.episode[i] % 2 ? t : -t);
+    rival = Search(s);
+    PayloadSearchChallenge(s.in, before, corrected, o, &rival);
+    if (rival.search.z_vs_named > 0 && rival.search.z_vs_named < o.search.z) break;
+  }
+  ASSERT_TRUE(rival.search.rivals_named) << rival.why;
+  Verdict kept;
+  kept.status = "explained";
+  kept.sentence = "Simulator knobs and measurement effects, in order of evidence: (1) tracker_bias.";
+  kept.named.resize(1);
+  kept.named[0].knob = "tracker.offset";
+  AddPayloadSearch(rival, &kept);
+  ASSERT_EQ(kept.named.size(), 1u);
+  EXPECT_EQ(kept.named[0].knob, "tracker.offset");
+  EXPECT_EQ(kept.status, "partly_explained");
+  ASSERT_EQ(kept.doubts.size(), 1u);
+  EXPECT_NE(kept.doubts[0].find("behind the middle fits the real samples as well as the named knobs"), std::string::npos)
+      << kept.doubts[0];
+}
+
 // In the analysis: off by default; when enabled it runs on physics no knob describes (nothing named
-// by the probes or the leg search), names no payload there, and the report has it.
+// by the probes or the leg search; or a name the leg search challenged), names no payload there,
+// and the report has it.
 TEST(PayloadSearch, RunsInTheAnalysisOnlyWhenEnabledAndNothingIsNamed) {
   FakeExtras extras;
   extras.geometry = 0.03;
@@ -105,7 +156,7 @@ TEST(PayloadSearch, RunsInTheAnalysisOnlyWhenEnabledAndNothingIsNamed) {
   const auto friction = MakeFakePair(SharedFake(), {{kFriction, 0.6}});
   const Analysis with_name = Analyse(friction.sim, friction.real, &SharedFake(), options);
   ASSERT_FALSE(with_name.naming.named.empty()) << with_name.verdict.sentence;
-  EXPECT_FALSE(with_name.payload_search.ran) << "something was named";
+  EXPECT_FALSE(with_name.payload_search.ran) << "something was named and not challenged";
 }
 
 }  // namespace
