@@ -193,6 +193,11 @@ VerdictNamed SearchNamed(const LegSearch& search, const std::string& family, con
 // remains ("<subject> removes N% ..."); the same rule marks the verdict's unexplained_present.
 void AddRemainingMismatchDoubt(const LegSearch& search, const std::string& subject, VerdictNamed* named);
 
+// A challenger's best point (`subject`, "a weak rear_left leg (gain 0.45)") that fits the real
+// samples better than the named knobs' correction by under the search's bar: the doubt that the
+// data do not tell the two apart; an `explained` verdict becomes `partly_explained`.
+void AddRivalDoubt(const LegSearch& search, const std::string& subject, Verdict* verdict);
+
 // The verdict's one story when a search named a knob: `named` alone, status partly_explained, its
 // doubts the verdict's, the gap closed the search's, the sentence written again.
 void ReplaceNamed(const LegSearch& search, const VerdictNamed& named, Verdict* verdict);

@@ -23,18 +23,18 @@ VerdictNamed NamedLeg(const LegSearch& s) {
   return n;
 }
 
-// A weak leg that fits the real samples at least as well as the named knobs: the data do not tell
+}  // namespace
+
+// A challenger that fits the real samples at least as well as the named knobs: the data do not tell
 // them apart, so the named knobs are not the only reading.
-void AddRivalDoubt(const LegSearch& s, Verdict* v) {
-  v->doubts.push_back("a weak " + s.leg + Fmt(" leg (gain %.3g)", s.value) +
+void AddRivalDoubt(const LegSearch& s, const std::string& subject, Verdict* v) {
+  v->doubts.push_back(subject +
                       Fmt(" fits the real samples as well as the named knobs (better by z %.2f, under the search's bar of "
                           "%.3g):",
                           s.z_vs_named, s.bar_z) +
                       " these data do not tell the two apart");
   if (v->status == "explained") v->status = "partly_explained";
 }
-
-}  // namespace
 
 VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const std::string& unit) {
   VerdictNamed n;
@@ -84,7 +84,7 @@ void AddLegSearch(const LegSearch& s, Verdict* v) {
     v->sentence += Fmt(" A search of every leg's gain (%.0f recordings, each scored by a model of its own) names no leg: ",
                        static_cast<double>(s.points.size())) +
                    s.why + ".";
-    if (s.rivals_named) AddRivalDoubt(s, v);
+    if (s.rivals_named) AddRivalDoubt(s, "a weak " + s.leg + Fmt(" leg (gain %.3g)", s.value), v);
     return;
   }
   ReplaceNamed(s, NamedLeg(s), v);

@@ -256,11 +256,7 @@ void AddPayloadSearch(const PayloadSearch& p, Verdict* v) {
                                static_cast<double>(p.columns.size()));
   if (!s.named) {
     v->sentence += " " + what + " names none: " + p.why + ".";
-    if (s.rivals_named) {
-      v->doubts.push_back(PayloadSaid(p) + Fmt(" fits the real samples as well as the named knobs (better by z %.2f, ", s.z_vs_named) +
-                          Fmt("under the search's bar of %.3g): these data do not tell the two apart", s.bar_z));
-      if (v->status == "explained") v->status = "partly_explained";
-    }
+    if (s.rivals_named) AddRivalDoubt(s, PayloadSaid(p), v);
     return;
   }
   ReplaceNamed(s, NamedPayload(p), v);
