@@ -57,7 +57,7 @@ struct Sim2RealArgs {
   std::string leg_search_on = "remaining";
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
   double challenge_inclusion = sim2real::LegSearchOptions{}.challenge_inclusion;
-  bool leg_second_look = false;
+  bool leg_second_look = true;
   std::string null_source = "auto";
   int null_recordings = sim2real::RecordedNullOptions{}.draws;
   bool locate_only = false;
@@ -171,6 +171,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.legs.challenge_gap_closed = args.challenge_gap_closed;
   o.legs.challenge_inclusion = args.challenge_inclusion;
   o.legs.second_look_elsewhere = args.leg_second_look;
+  o.payload.search.second_look_elsewhere = args.leg_second_look;
   o.candidates.recording.cache_dir = args.cache;
   o.candidates.recording.threads = threads;
   o.refine.seed = args.seed;
@@ -406,9 +407,10 @@ void Setup(CLI::App& root) {
                   "... and also when a named family's bootstrap inclusion is under this (0: never; "
                   "docs/sim2real.md)")
       ->capture_default_str()->check(CLI::Range(0.0, 1.0));
-  cmd->add_flag("--leg-second-look", args->leg_second_look,
-               "experimental: on a plane, a leg the search's misfit gate refuses is looked at again against "
-               "recordings at other places, the uneven ground's gate (docs/sim2real.md)");
+  cmd->add_flag("--leg-second-look,!--no-leg-second-look", args->leg_second_look,
+               "on a plane, a point the leg or payload search's misfit gate refuses is looked at again against "
+               "recordings at other places, the uneven ground's gate (on by default since 2026-12-05; "
+               "docs/sim2real.md)");
   cmd->add_flag("--spread-signatures", args->spread_signatures,
                "experimental: a knob's coefficient also scales the corrected covariance by the spread change of "
                "its recording (a weak leg widens the motion more than it shifts it; docs/sim2real.md)");

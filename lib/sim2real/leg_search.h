@@ -89,12 +89,16 @@ struct LegSearchOptions {
   // 544 and 549 the real samples fit the nominal's model better than a nominal recording at other
   // places does (misfit -0.14 and -0.10: low friction makes outcomes more predictable).
   bool misfit_elsewhere = false;
-  // Without misfit_elsewhere, a best point the gate refuses gets a second look at other places
-  // (experimental, off by default, not yet measured on the batteries): on a plane the odd
-  // executions at the same places can flatter a point too. The hexapod without its rear right leg,
-  // 55002: a weak front_left at 0.481 searched to 0.45 (3.2 nats per sample over the nominal) was
-  // refused because its misfit, 0.30 nats per sample, was above the nominal's, 0.18.
-  bool second_look_elsewhere = false;
+  // Without misfit_elsewhere, a best point the gate refuses gets a second look at other places: on
+  // a plane the odd executions at the same places can flatter a point too. The hexapod without its
+  // rear right leg, 55002: a weak front_left at 0.481 searched to 0.45 (3.2 nats per sample over
+  // the nominal) was refused because its misfit, 0.30 nats per sample, was above the nominal's,
+  // 0.18. On by default since 2026-12-05 (`--no-leg-second-look` turns it off): of the 7 pairs
+  // on record whose best point the same-place gate refused, it named the truth on 4 (55002,
+  // 55014, and the payload search's 58005 and 59208), refused both out-of-library ones and one
+  // weak leg (57012); blind on the five-legged hexapod (60000-60011) 4 of 4 weak legs named (3
+  // without it), both short tibias it looked at refused (docs/sim2real.md).
+  bool second_look_elsewhere = true;
   std::uint64_t elsewhere_seed = 1;
   LinearGaussianOptions model;   // each recording's own model (the analysis copies the baseline's)
   bool IsValid(std::string* error) const;

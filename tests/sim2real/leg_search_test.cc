@@ -81,6 +81,7 @@ TEST(LegSearch, ASecondLookAtOtherPlacesNamesALegTheSamePlaceGateRefused) {
   const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
   LegSearchOptions o = Options(s);
   o.min_gap_closed = 1;  // a share of the nominal's misfit no point removes here
+  o.second_look_elsewhere = false;
   const LegSearch refused = SearchLegGains(SharedFake(), s.in, s.set, s.options.candidates, o);
   ASSERT_FALSE(refused.named) << "gap closed " << refused.gap_closed;
   EXPECT_FALSE(refused.misfit_elsewhere);
