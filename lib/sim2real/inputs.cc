@@ -180,4 +180,12 @@ std::vector<int> RealSteps(const AnalysisInputs& in) {
   return step;
 }
 
+std::vector<int> SimSteps(const AnalysisInputs& in) {
+  std::vector<int> step(in.sim.size(), -1);
+  if (in.sim.has_sequence && in.sim_set.has_sequence() && in.sim_set.size() == in.sim.size()) {
+    for (int i = 0; i < in.sim.size(); ++i) step[i] = in.sim_set.step(i);
+  }
+  return step;
+}
+
 }  // namespace dgmm::sim2real

@@ -37,6 +37,8 @@ AnalysisInputs PrepareInputs(const SampleSet& sim, const SampleSet& real, std::u
 // Per real sample (in.real's order) its execution index within its placement; all -1 without
 // sequence data.
 std::vector<int> RealSteps(const AnalysisInputs& in);
+// The same for the sim samples (in.sim's order).
+std::vector<int> SimSteps(const AnalysisInputs& in);
 
 // The real set's placements and executions per placement (without sequence data each sample is
 // its own placement, as the analysis treats it).

@@ -137,50 +137,97 @@ void GroupTest(const EpisodeUnits& e, const std::string& where, const std::vecto
   out->tests.push_back(t);
 }
 
-// Sum of squares of the step-index means of `centred` for step labels s; the means in *means.
-double StepSS(const Eigen::MatrixXd& centred, const std::vector<int>& s, int max_step, Eigen::MatrixXd* means) {
-  Eigen::MatrixXd m = Eigen::MatrixXd::Zero(max_step + 1, centred.cols());
-  Eigen::VectorXd c = Eigen::VectorXd::Zero(max_step + 1);
-  for (int i = 0; i < centred.rows(); ++i) {
-    if (s[i] < 0) continue;
-    m.row(s[i]) += centred.row(i);
-    c(s[i]) += 1;
+// Residuals minus their episode's mean, their step labels and each episode's rows.
+struct StepRows {
+  Eigen::MatrixXd centred;
+  std::vector<int> step;
+  std::map<int, std::vector<int>> rows_of;  // per episode
+};
+
+StepRows CentreByEpisode(const Eigen::MatrixXd& r, const std::vector<int>& episode, const std::vector<int>& step) {
+  StepRows out;
+  out.step = step;
+  std::map<int, Eigen::VectorXd> mean;
+  for (int i = 0; i < r.rows(); ++i) out.rows_of[episode[i]].push_back(i);
+  out.centred.resize(r.rows(), r.cols());
+  for (const auto& [u, rows] : out.rows_of) {
+    Eigen::VectorXd m = Eigen::VectorXd::Zero(r.cols());
+    for (int i : rows) m += r.row(i).transpose();
+    m /= static_cast<double>(rows.size());
+    for (int i : rows) out.centred.row(i) = r.row(i) - m.transpose();
   }
-  double ss = 0;
-  for (int k = 0; k <= max_step; ++k) {
-    if (c(k) > 0) {
-      ss += m.row(k).squaredNorm() / c(k);
-      m.row(k) /= c(k);
-    }
-  }
-  if (means) *means = m;
-  return ss;
+  return out;
 }
 
-// Step: the residual minus its episode mean, step labels permuted within each episode; then the
+// Step labels shuffled within each episode.
+std::vector<int> ShuffledWithinEpisodes(const StepRows& s, std::mt19937_64& rng) {
+  std::vector<int> perm = s.step;
+  for (const auto& [u, rows] : s.rows_of) {
+    std::vector<int> labels;
+    for (int i : rows) labels.push_back(s.step[i]);
+    std::shuffle(labels.begin(), labels.end(), rng);
+    for (size_t k = 0; k < rows.size(); ++k) perm[rows[k]] = labels[k];
+  }
+  return perm;
+}
+
+// Mean of `centred` per step label (rows of *means) and the count of each (steps < 0 skipped).
+void StepMeans(const Eigen::MatrixXd& centred, const std::vector<int>& s, int max_step, Eigen::MatrixXd* means,
+               Eigen::VectorXd* counts) {
+  *means = Eigen::MatrixXd::Zero(max_step + 1, centred.cols());
+  *counts = Eigen::VectorXd::Zero(max_step + 1);
+  for (int i = 0; i < centred.rows(); ++i) {
+    if (s[i] < 0 || s[i] > max_step) continue;
+    means->row(s[i]) += centred.row(i);
+    (*counts)(s[i]) += 1;
+  }
+  for (int k = 0; k <= max_step; ++k) {
+    if ((*counts)(k) > 0) means->row(k) /= (*counts)(k);
+  }
+}
+
+// The step statistic: sum over steps of c_k |m_k|^2 (one set), or against the sim set's profile
+//   T = sum_k w_k |m_real,k - m_sim,k|^2,  w_k = c_real,k c_sim,k / (c_real,k + c_sim,k);
+// *profile gets the step means (their difference with a sim set).
+double StepStatistic(const StepRows& real, const std::vector<int>& real_step, const StepRows* sim,
+                     const std::vector<int>* sim_step, int max_step, Eigen::MatrixXd* profile) {
+  Eigen::MatrixXd m;
+  Eigen::VectorXd c;
+  StepMeans(real.centred, real_step, max_step, &m, &c);
+  Eigen::VectorXd w = c;
+  if (sim) {
+    Eigen::MatrixXd ms;
+    Eigen::VectorXd cs;
+    StepMeans(sim->centred, *sim_step, max_step, &ms, &cs);
+    m -= ms;
+    for (int k = 0; k <= max_step; ++k) w(k) = c(k) + cs(k) > 0 ? c(k) * cs(k) / (c(k) + cs(k)) : 0;
+  }
+  double t = 0;
+  for (int k = 0; k <= max_step; ++k) t += w(k) * m.row(k).squaredNorm();
+  if (profile) *profile = m;
+  return t;
+}
+
+// Step: the residual minus its episode mean, step labels permuted within each episode (in both sets
+// when the sim set's own residuals are given: then the question is whether the real step profile
+// differs from the sim set's, which the model's own shortcomings shape as much); then the
 // periodicity of the step-mean profile (its main direction's lag-1 autocorrelation).
-void StepTest(const Eigen::MatrixXd& r, const EpisodeUnits& e, const std::vector<int>& step, int permutations,
-              std::mt19937_64& rng, ResidualStructure* out) {
-  const int n = static_cast<int>(r.rows());
-  Eigen::MatrixXd centred(n, r.cols());
-  for (int i = 0; i < n; ++i) centred.row(i) = r.row(i) - e.sum.row(e.unit[i]) / e.count[e.unit[i]];
+void StepTest(const Eigen::MatrixXd& r, const std::vector<int>& episode, const std::vector<int>& step,
+              const SimStepReference& sim_ref, int permutations, std::mt19937_64& rng, ResidualStructure* out) {
+  const StepRows real = CentreByEpisode(r, episode, step);
+  const bool two = sim_ref.residuals && sim_ref.episode && sim_ref.step && sim_ref.residuals->rows() > 0;
+  StepRows sim;
+  if (two) sim = CentreByEpisode(*sim_ref.residuals, *sim_ref.episode, *sim_ref.step);
   const int max_step = *std::max_element(step.begin(), step.end());
   Eigen::MatrixXd means;
   ResidualTest t;
   t.where = "step";
-  t.statistic = StepSS(centred, step, max_step, &means);
-  std::map<int, std::vector<int>> rows_of;
-  for (int i = 0; i < n; ++i) rows_of[e.unit[i]].push_back(i);
+  t.statistic = StepStatistic(real, real.step, two ? &sim : nullptr, two ? &sim.step : nullptr, max_step, &means);
   std::vector<double> null;
-  std::vector<int> perm = step;
   for (int p = 0; p < permutations; ++p) {
-    for (const auto& [u, rows] : rows_of) {
-      std::vector<int> s;
-      for (int i : rows) s.push_back(step[i]);
-      std::shuffle(s.begin(), s.end(), rng);
-      for (size_t k = 0; k < rows.size(); ++k) perm[rows[k]] = s[k];
-    }
-    null.push_back(StepSS(centred, perm, max_step, nullptr));
+    const std::vector<int> perm = ShuffledWithinEpisodes(real, rng);
+    const std::vector<int> sim_perm = two ? ShuffledWithinEpisodes(sim, rng) : std::vector<int>();
+    null.push_back(StepStatistic(real, perm, two ? &sim : nullptr, two ? &sim_perm : nullptr, max_step, nullptr));
   }
   t.p_value = PermutationP(t.statistic, null);
   out->tests.push_back(t);
@@ -204,7 +251,7 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vec
                                         const std::vector<int>& terrain, const std::vector<int>& episode,
                                         const std::vector<int>& step, double sim_kurtosis,
                                         const ResidualStructureOptions& options, std::uint64_t seed,
-                                        double sim_kurtosis_se) {
+                                        double sim_kurtosis_se, const SimStepReference& sim_steps) {
   ResidualStructure out;
   const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
   std::mt19937_64 rng(seed);
@@ -212,7 +259,7 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vec
   GroupTest(e, "command", e.command, options.permutations, rng, &out);
   GroupTest(e, "terrain", e.terrain, options.permutations, rng, &out);
   const bool has_steps = std::any_of(step.begin(), step.end(), [](int s) { return s > 0; });
-  if (has_steps && static_cast<int>(e.count.size()) < n) StepTest(r, e, step, options.permutations, rng, &out);
+  if (has_steps && static_cast<int>(e.count.size()) < n) StepTest(r, episode, step, sim_steps, options.permutations, rng, &out);
   if (std::isfinite(sim_kurtosis)) {
     ResidualTest t;
     t.where = "tails";

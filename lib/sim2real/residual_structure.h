@@ -5,8 +5,9 @@
 //   command:  between-command sum of squares of the episode means (labels permuted over episodes)
 //   terrain:  the same over terrain regions (nearest k-means centre of each episode's mean z)
 //   step:     sum of squares of the step-index means of r_i - (episode mean) (steps permuted
-//             within each episode); "periodic" when the step means alternate in sign
-//             (lag-1 autocorrelation of the step-mean profile < -0.3)
+//             within each episode), or of their difference from the sim set's own residuals'
+//             (SimStepReference); "periodic" when the step means alternate in sign (lag-1
+//             autocorrelation of the step-mean profile < -0.3)
 //   tails:    excess kurtosis of |r_i|^2-normalised residuals over the sim set's own
 //             (a difference > max(1, 4 SE) with SE = sqrt(24 / (n dx)), or, where the executions
 //             at one placement are dependent, the two kurtoses' placement-bootstrap SEs combined)
@@ -40,6 +41,15 @@ struct ResidualStructure {
   Eigen::VectorXd step_profile;            // mean whitened residual norm direction per step
 };
 
+// The sim set's own residuals (cross-fitted), placements and execution indices for the step test:
+// with them it asks whether the real set's step profile differs from the sim set's (what the
+// model leaves in both), not from none. Null pointers: the one-set test.
+struct SimStepReference {
+  const Eigen::MatrixXd* residuals = nullptr;
+  const std::vector<int>* episode = nullptr;
+  const std::vector<int>* step = nullptr;
+};
+
 // `residuals` n x dx; `command`, `terrain` (region id, -1: none), `episode`, `step` per sample
 // (step -1: no sequence data); `sim_kurtosis` the excess kurtosis of the sim set's own
 // whitened residuals (NaN: skip the tails test) and `sim_kurtosis_se` its standard error (used
@@ -48,7 +58,7 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& residuals, const 
                                         const std::vector<int>& terrain, const std::vector<int>& episode,
                                         const std::vector<int>& step, double sim_kurtosis,
                                         const ResidualStructureOptions& options, std::uint64_t seed,
-                                        double sim_kurtosis_se = 0);
+                                        double sim_kurtosis_se = 0, const SimStepReference& sim_steps = {});
 
 // Mean excess kurtosis over the columns of r (n x dx).
 double ExcessKurtosis(const Eigen::MatrixXd& r);

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <random>
 
 
@@ -84,6 +85,51 @@ TEST(ResidualStructure, TailsAreCountedInPlacementsWhenTheyHangUpTogether) {
   }
   const double flat_se = ExcessKurtosisSe(HangUps(166, 0, rng, &sim_episode), sim_episode, 200, 4);
   EXPECT_TRUE(tails(TestResidualStructure(heavy, command, terrain, real_episode, step, 0.0, by_placements, 1, flat_se)));
+}
+
+// Unit-noise residuals of `episodes` placements of five executions, each execution offset by
+// `profile` (its step's offset on column 1).
+Eigen::MatrixXd StepProfiled(int episodes, const std::vector<double>& profile, std::mt19937_64& rng,
+                             std::vector<int>* episode, std::vector<int>* step) {
+  std::normal_distribution<double> unit(0, 1);
+  Eigen::MatrixXd r(5 * episodes, 3);
+  episode->resize(r.rows());
+  step->resize(r.rows());
+  for (int i = 0; i < r.rows(); ++i) {
+    for (int j = 0; j < 3; ++j) r(i, j) = unit(rng);
+    (*episode)[i] = i / 5;
+    (*step)[i] = i % 5;
+    r(i, 1) += profile[i % 5];
+  }
+  return r;
+}
+
+// A step profile that the model leaves in the sim set's own residuals as much as in the real set's
+// (a robot whose executions drift the same way in both, which the model's first-execution term does
+// not describe) is no mismatch: against the sim set's profile it is not structure; a real profile
+// that differs from the sim set's still is. Planar quadruped null pairs 59005 and 59007 came out
+// `unexplained` in "step" when the test asked whether the real profile differed from none.
+TEST(ResidualStructure, AStepProfileTheSimSetSharesIsNotStructure) {
+  std::mt19937_64 rng(11);
+  const std::vector<double> shared = {0.0, 0.35, 0.2, 0.05, -0.1};
+  std::vector<int> sim_episode, sim_step, real_episode, real_step;
+  const Eigen::MatrixXd sim = StepProfiled(166, shared, rng, &sim_episode, &sim_step);
+  const Eigen::MatrixXd real = StepProfiled(78, shared, rng, &real_episode, &real_step);
+  const int n = static_cast<int>(real.rows());
+  std::vector<int> command(n), terrain(n, -1);
+  for (int i = 0; i < n; ++i) command[i] = (i / 5) % 26;
+  auto step = [&](const ResidualStructure& s) {
+    return std::find(s.structured_in.begin(), s.structured_in.end(), "step") != s.structured_in.end();
+  };
+  const ResidualStructureOptions options;
+  const double no_tails = NAN;
+  EXPECT_TRUE(step(TestResidualStructure(real, command, terrain, real_episode, real_step, no_tails, options, 1)));
+  const SimStepReference reference{&sim, &sim_episode, &sim_step};
+  EXPECT_FALSE(step(TestResidualStructure(real, command, terrain, real_episode, real_step, no_tails, options, 1, 0,
+                                          reference)));
+  const Eigen::MatrixXd other = StepProfiled(78, {0.0, -0.2, 0.3, -0.2, 0.3}, rng, &real_episode, &real_step);
+  EXPECT_TRUE(step(TestResidualStructure(other, command, terrain, real_episode, real_step, no_tails, options, 1, 0,
+                                         reference)));
 }
 
 }  // namespace
