@@ -215,7 +215,9 @@ double StepStatistic(const StepRows& real, const std::vector<int>& real_step, co
 void StepTest(const Eigen::MatrixXd& r, const std::vector<int>& episode, const std::vector<int>& step,
               const SimStepReference& sim_ref, int permutations, std::mt19937_64& rng, ResidualStructure* out) {
   const StepRows real = CentreByEpisode(r, episode, step);
-  const bool two = sim_ref.residuals && sim_ref.episode && sim_ref.step && sim_ref.residuals->rows() > 0;
+  // A sim set without execution indices (no sequence data) has no profile to compare with.
+  const bool two = sim_ref.residuals && sim_ref.episode && sim_ref.step && sim_ref.residuals->rows() > 0 &&
+                   std::any_of(sim_ref.step->begin(), sim_ref.step->end(), [](int s) { return s > 0; });
   StepRows sim;
   if (two) sim = CentreByEpisode(*sim_ref.residuals, *sim_ref.episode, *sim_ref.step);
   const int max_step = *std::max_element(step.begin(), step.end());

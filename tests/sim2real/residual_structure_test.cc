@@ -127,6 +127,10 @@ TEST(ResidualStructure, AStepProfileTheSimSetSharesIsNotStructure) {
   const SimStepReference reference{&sim, &sim_episode, &sim_step};
   EXPECT_FALSE(step(TestResidualStructure(real, command, terrain, real_episode, real_step, no_tails, options, 1, 0,
                                           reference)));
+  // A sim set without execution indices gives no profile: the one-set test.
+  const std::vector<int> no_steps(sim_step.size(), -1);
+  EXPECT_TRUE(step(TestResidualStructure(real, command, terrain, real_episode, real_step, no_tails, options, 1, 0,
+                                         {&sim, &sim_episode, &no_steps})));
   const Eigen::MatrixXd other = StepProfiled(78, {0.0, -0.2, 0.3, -0.2, 0.3}, rng, &real_episode, &real_step);
   EXPECT_TRUE(step(TestResidualStructure(other, command, terrain, real_episode, real_step, no_tails, options, 1, 0,
                                          reference)));
