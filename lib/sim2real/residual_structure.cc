@@ -141,16 +141,15 @@ void GroupTest(const EpisodeUnits& e, const std::string& where, const std::vecto
 struct StepRows {
   Eigen::MatrixXd centred;
   std::vector<int> step;
-  std::map<int, std::vector<int>> rows_of;  // per episode
+  std::vector<std::vector<int>> rows_of;  // per episode, in ascending episode id
 };
 
 StepRows CentreByEpisode(const Eigen::MatrixXd& r, const std::vector<int>& episode, const std::vector<int>& step) {
   StepRows out;
   out.step = step;
-  std::map<int, Eigen::VectorXd> mean;
-  for (int i = 0; i < r.rows(); ++i) out.rows_of[episode[i]].push_back(i);
+  out.rows_of = RowsOfUnits(NumberUnitsAscending(episode));
   out.centred.resize(r.rows(), r.cols());
-  for (const auto& [u, rows] : out.rows_of) {
+  for (const std::vector<int>& rows : out.rows_of) {
     Eigen::VectorXd m = Eigen::VectorXd::Zero(r.cols());
     for (int i : rows) m += r.row(i).transpose();
     m /= static_cast<double>(rows.size());
@@ -162,7 +161,7 @@ StepRows CentreByEpisode(const Eigen::MatrixXd& r, const std::vector<int>& episo
 // Step labels shuffled within each episode.
 std::vector<int> ShuffledWithinEpisodes(const StepRows& s, std::mt19937_64& rng) {
   std::vector<int> perm = s.step;
-  for (const auto& [u, rows] : s.rows_of) {
+  for (const std::vector<int>& rows : s.rows_of) {
     std::vector<int> labels;
     for (int i : rows) labels.push_back(s.step[i]);
     std::shuffle(labels.begin(), labels.end(), rng);

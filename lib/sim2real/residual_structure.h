@@ -9,8 +9,9 @@
 //             (SimStepReference); "periodic" when the step means alternate in sign (lag-1
 //             autocorrelation of the step-mean profile < -0.3)
 //   tails:    excess kurtosis of |r_i|^2-normalised residuals over the sim set's own
-//             (a difference > max(1, 4 SE) with SE = sqrt(24 / (n dx)), or, where the executions
-//             at one placement are dependent, the two kurtoses' placement-bootstrap SEs combined)
+//             (a difference > max(1, 4 SE) with SE = sqrt(24 / (n dx)), or with tails_bootstrap,
+//             which the analysis sets on every ground, the two kurtoses' placement-bootstrap SEs
+//             combined)
 // Bonferroni over the four tests.
 #include <Eigen/Dense>
 #include <cstdint>
