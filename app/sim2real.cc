@@ -52,6 +52,9 @@ struct Sim2RealArgs {
   bool every_leg = false;
   bool leg_search = true;
   bool payload_search = sim2real::PayloadSearchOptions{}.enabled;
+  bool payload_on_posture = sim2real::PayloadSearchOptions{}.on_posture;
+  bool posture = sim2real::PostureOptions{}.enabled;
+  double posture_z = sim2real::PostureOptions{}.z;
   bool runoff = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
@@ -164,6 +167,9 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.legs.enabled = args.leg_search;
   o.runoff.enabled = args.runoff;
   o.payload.enabled = args.payload_search;
+  o.payload.on_posture = args.payload_on_posture;
+  o.posture.enabled = args.posture;
+  o.posture.z = args.posture_z;
   o.payload.search.sag_mode = args.leg_search_score == "sag";
   o.legs.sag_mode = args.leg_search_score == "sag";
   o.legs.only_with_tails = args.leg_search_on == "tails";
@@ -384,7 +390,18 @@ void Setup(CLI::App& root) {
                 "leg search or the leg search challenged the named knobs and kept them, search a payload's mass and "
                 "position (named only when it beats a challenged name's correction by 2 SE; 7 columns at 2 masses, a "
                 "column keeping its moment as the mass changes; then half-steps of the best column and its mass; each "
-                "recording scored by its own model, 5 executions per placement; docs/sim2real.md)");
+                "recording scored by its own model, 5 executions per placement; it also runs without this flag where the "
+                "named physics leaves the torso's posture out, --payload-on-posture; docs/sim2real.md)");
+  cmd->add_flag("--payload-on-posture,!--no-payload-on-posture", args->payload_on_posture,
+                "run the payload search also when the named physics leaves the torso's posture out (--posture; on "
+                "by default)");
+  cmd->add_flag("--posture,!--no-posture", args->posture,
+                "on level ground, check that the named physics gives the real torso's mean pitch and roll (its "
+                "recording at the sim set's places); a posture it leaves out is a doubt and lets the leg and payload "
+                "searches challenge the names (on by default; docs/sim2real.md)");
+  cmd->add_option("--posture-z", args->posture_z,
+                  "standard errors (placements resampled) a posture left out must reach to be a doubt")
+      ->capture_default_str()->check(CLI::PositiveNumber);
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

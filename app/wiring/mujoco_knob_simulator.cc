@@ -84,6 +84,7 @@ MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_
   const sim::Simulator robot(config_);
   total_mass_kg_ = robot.total_mass_kg();
   leg_reach_m_ = robot.leg_reach_m();
+  level_ground_ = robot.LevelGround();
 }
 
 std::vector<sim::KnobValue> MujocoKnobSimulator::ToSim(const std::vector<sim2real::KnobValue>& values) const {

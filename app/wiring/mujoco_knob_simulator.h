@@ -27,6 +27,7 @@ class MujocoKnobSimulator : public sim2real::KnobSimulator {
   std::string ConfigJson(const std::vector<sim2real::KnobValue>& values) const override;
   double total_mass_kg() const override { return total_mass_kg_; }
   double leg_reach_m() const override { return leg_reach_m_; }
+  bool level_ground() const override { return level_ground_; }
 
   const sim::SimConfig& config() const { return config_; }
 
@@ -38,6 +39,7 @@ class MujocoKnobSimulator : public sim2real::KnobSimulator {
   std::vector<sim2real::Knob> knobs_;
   std::string fingerprint_;
   double total_mass_kg_ = 0, leg_reach_m_ = 0;
+  bool level_ground_ = false;
 };
 
 }  // namespace dgmm::app

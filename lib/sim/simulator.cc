@@ -271,6 +271,17 @@ std::string Simulator::SelfContactPair() const {
 
 double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->ground->HeightAt(x_m, y_m); }
 
+bool Simulator::LevelGround() const {
+  if (impl_->config.slope_deg != 0 || impl_->config.terrain) return false;
+  const mjModel* m = impl_->walker ? impl_->walker->model() : impl_->model.get();
+  for (int g = 0; g < m->ngeom; ++g) {
+    if (m->geom_bodyid[g] != 0 || (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0)) continue;
+    const mjtNum* q = m->geom_quat + 4 * g;  // a plane faces up when its rotation keeps z
+    if (m->geom_type[g] != mjGEOM_PLANE || std::abs(q[1]) > 1e-9 || std::abs(q[2]) > 1e-9) return false;
+  }
+  return true;
+}
+
 Eigen::Vector2d Simulator::TruePitchRoll() const {
   return PitchRollFromGravity(TorsoPose().rotation, impl_->up);
 }

@@ -72,6 +72,9 @@ class Simulator {
   std::vector<Eigen::Vector3d> FootPositions() const;
   // The ground's height along the slope normal at (x, y) of the slope frame (0 on the plane).
   double GroundHeight(double x_m, double y_m) const;
+  // Is the ground level: no slope, no height field, and every geom of the world that the robot can
+  // touch a plane facing up (a model's own ramps, boxes or height fields make it uneven)?
+  bool LevelGround() const;
   Eigen::Vector2d TruePitchRoll() const; // <pitch, roll> relative to gravity (rad)
   Eigen::Vector3d Up() const;            // unit vector against gravity, slope frame
   double time_s() const;                 // simulated time since construction

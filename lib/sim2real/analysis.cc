@@ -44,8 +44,8 @@ bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
     return n.inclusion >= 0 && n.inclusion < options.challenge_inclusion;
   });
   const bool short_of_it =
-      a.adequacy.below_ceiling || a.adequacy.gap_closed < options.challenge_gap_closed || unsure;
-  if (a.verdict.status == "explained" || !short_of_it) return false;
+      a.adequacy.below_ceiling || a.adequacy.gap_closed < options.challenge_gap_closed || unsure || a.posture.left_out;
+  if ((a.verdict.status == "explained" && !a.posture.left_out) || !short_of_it) return false;
   return std::none_of(a.naming.named.begin(), a.naming.named.end(),
                       [&](int c) { return !a.candidates.candidates[c].leg.empty(); });
 }
@@ -117,11 +117,13 @@ LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
   return o;
 }
 
-// The payload search (stage 8c) runs when enabled, on a plane, when neither the runoff nor the leg
-// search named anything and the stages before either left a located mismatch with nothing named
-// or named knobs the leg search was to challenge (`challenge`, WantChallenge before it ran).
+// The payload search (stage 8c) runs when enabled or the posture is left out (PostureCheck), on a
+// plane, when neither the runoff nor the leg search named anything and the stages before either
+// left a located mismatch with nothing named or named knobs the leg search was to challenge
+// (`challenge`, WantChallenge before it ran).
 bool WantPayloadSearch(const Analysis& a, const PayloadSearchOptions& options, bool challenge) {
-  if (!options.enabled || a.baseline.permute_placements || a.runoff.search.named || a.leg_search.named) return false;
+  const bool on = options.enabled || (options.on_posture && a.posture.left_out);
+  if (!on || a.baseline.permute_placements || a.runoff.search.named || a.leg_search.named) return false;
   if (!a.naming.named.empty()) return options.challenge_named && challenge;
   return a.verdict.status == "unexplained" && a.verdict.named.empty();
 }
@@ -236,6 +238,51 @@ void RunAgainWithEveryExecution(const KnobSimulator& simulator, const AnalysisOp
   a->refinement.recorded += refined, a->refinement.from_cache += refined_from_cache;
 }
 
+// The IMU offset the verdict names (rad, pitch and roll; zero when none is named).
+Eigen::Vector2d NamedImuOffset(const Analysis& a) {
+  const std::vector<int>& selected = a.refinement.selection.selected;
+  for (int k : a.naming.named) {
+    const auto it = std::find(selected.begin(), selected.end(), k);
+    if (a.candidates.candidates[k].family != "imu_bias" || it == selected.end()) continue;
+    const Eigen::VectorXd& theta = a.refinement.selection.fit.theta[it - selected.begin()];
+    if (theta.size() >= 2) return theta.head<2>();
+  }
+  return Eigen::Vector2d::Zero();
+}
+
+// "the named correction (floor.friction.sliding 0.708, tracker_bias)" or "nothing named".
+std::string CorrectionWords(const Verdict& v) {
+  std::vector<std::string> words;
+  for (const VerdictNamed& n : v.named) words.push_back(n.knob + (std::isfinite(n.lo) ? Fmt(" %.3g", n.value) : ""));
+  return words.empty() ? "nothing named" : "the named correction (" + JoinWords(words) + ")";
+}
+
+// The posture check (posture.h) of the simulator knobs `values` and the IMU offset `imu`.
+PostureCheck CheckNamedPosture(const KnobSimulator& simulator, const AnalysisOptions& options, const Analysis& a,
+                               const std::vector<KnobValue>& values, const Eigen::Vector2d& imu) {
+  PostureOptions o = options.posture;
+  o.seed = options.seed + 19;
+  return CheckPosture(simulator, a.inputs, a.candidates.nominal, a.candidates.recording, options.candidates.recording,
+                      values, imu, CorrectionWords(a.verdict), o);
+}
+
+// The correction of what is named at the end (a search's recording when a search named it, else the
+// knobs' fit), its simulator knobs' values, and the posture check of a search's name; then the
+// posture in the verdict.
+void CorrectAndCheckPosture(const KnobSimulator& simulator, const AnalysisOptions& options, Analysis* a) {
+  if (const LegSearch* own = NamedByOwnModels(*a)) {
+    a->correction = LegSearchCorrection(*own);
+    a->named_values = {{own->knob_index, own->value}};
+    a->named_values.insert(a->named_values.end(), own->also.begin(), own->also.end());
+    const auto t = Clock::now();
+    a->posture = CheckNamedPosture(simulator, options, *a, a->named_values, Eigen::Vector2d::Zero());
+    a->seconds.posture += Since(t);
+  } else {
+    a->correction = MakeCorrection(a->inputs, a->baseline, a->candidates, a->refinement.selection.fit);
+  }
+  AddPostureCheck(a->posture, options.posture.z, &a->verdict);
+}
+
 }  // namespace
 
 bool AnalysisOptions::IsValid(std::string* error) const {
@@ -250,7 +297,7 @@ bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
          recorded_null.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
-         runoff.IsValid(error) && payload.IsValid(error) && more_data.IsValid(error);
+         runoff.IsValid(error) && payload.IsValid(error) && posture.IsValid(error) && more_data.IsValid(error);
 }
 
 const LegSearch* NamedByOwnModels(const Analysis& a) {
@@ -370,18 +417,16 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   } else if (screen && !a.refinement.selection.selected.empty()) {
     SelectToVerdict(*simulator, options, stage, &a);  // not looked at again (every_execution_from_z): searched now
   }
+  const auto t = Clock::now();
+  stage("posture (the named physics against the real torso's)");
+  a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);
+  a.posture = CheckNamedPosture(*simulator, options, a, a.named_values, NamedImuOffset(a));
+  a.seconds.posture = Since(t);
   SearchByOwnModels(*simulator, options, stage, &a);
+  CorrectAndCheckPosture(*simulator, options, &a);
   a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, SearchedWithoutName(a),
                                options.more_data);
   a.verdict.sentence += MoreDataSentence(a.more_data);
-  if (const LegSearch* own = NamedByOwnModels(a)) {
-    a.correction = LegSearchCorrection(*own);
-    a.named_values = {{own->knob_index, own->value}};
-    a.named_values.insert(a.named_values.end(), own->also.begin(), own->also.end());
-  } else {
-    a.correction = MakeCorrection(a.inputs, a.baseline, a.candidates, a.refinement.selection.fit);
-    a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);
-  }
   a.seconds.total = Since(start);
   return a;
 }

@@ -18,8 +18,11 @@
 //                                    recorded again, each recording scored by its own model;
 //      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
 //                                    searched, each recording scored by its own model;
-//      payload     (payload_search.h) experimental, on a plane when still nothing is named: a
-//                                    payload's mass and position searched likewise;
+//      posture     (posture.h)       on level ground: does the named physics give the real torso's
+//                                    posture (pitch, roll)? Checked before the searches (a posture
+//                                    left out lets them challenge the names) and on the final names;
+//      payload     (payload_search.h) on a plane when still nothing is named, or the posture is left
+//                                    out (else experimental): a payload's mass and position searched likewise;
 //      more data   (more_data.h)     when still nothing is named but a knob came near: how many
 //                                    placements the real set would need to decide it;
 //   9. report      (report.h)        report.json, report.html, the stdout summary (in the app).
@@ -33,6 +36,7 @@
 #include "sim2real/leg_search.h"
 #include "sim2real/more_data.h"
 #include "sim2real/payload_search.h"
+#include "sim2real/posture.h"
 #include "sim2real/recorded_null.h"
 #include "sim2real/runoff.h"
 #include "sim2real/verdict_stage.h"
@@ -50,6 +54,7 @@ struct AnalysisOptions {
   LegSearchOptions legs;   // its model options are the baseline's (locate.model)
   RunoffOptions runoff;    // likewise
   PayloadSearchOptions payload;  // likewise; off by default
+  PostureOptions posture;        // the torso's posture beside the motion (level ground; seed: the analysis's)
   // When an effect fits on average but its size varies with the execution index and the
   // signatures recorded fewer executions per placement than the real set has, stages 3-8 run
   // again with signatures of every execution (Analysis::every_execution_because).
@@ -84,7 +89,8 @@ struct AnalysisOptions {
 };
 
 struct StageTimes {
-  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, payload = 0, total = 0;
+  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, payload = 0,
+         posture = 0, total = 0;
 };
 
 struct Analysis {
@@ -106,6 +112,7 @@ struct Analysis {
   Runoff runoff;                   // ran only on uneven ground with a mismatch left (Runoff::ran)
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
   PayloadSearch payload_search;    // ran only when enabled and still nothing was named (PayloadSearch::ran)
+  PostureCheck posture;            // does the named physics give the real torso's posture (level ground)
   MoreData more_data;              // how many placements would decide a near miss (MoreData::advised)
   Correction correction;           // the knob correction (empty without a simulator)
   std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)
@@ -120,8 +127,9 @@ const LegSearch* NamedByOwnModels(const Analysis& a);
 
 // Does the leg search run (stage 8b)? When the stages before named nothing for a located mismatch
 // (with LegSearchOptions::only_with_tails, one whose residual has heavy tails), or as a challenge
-// (challenge_named): on a plane, knobs named but no leg's, the verdict not `explained`, and the
-// corrected model below the real-trained ceiling or closing under challenge_gap_closed of the gap.
+// (challenge_named): on a plane, knobs named but no leg's, and the corrected model below the
+// real-trained ceiling or closing under challenge_gap_closed of the gap (the verdict then not
+// `explained`), or the torso's posture left out by the named physics (PostureCheck).
 bool WantLegSearch(const Analysis& a, const LegSearchOptions& options);
 
 // Why stages 3-8 run again with signatures of every execution of a placement (empty: they do

@@ -100,6 +100,10 @@ class KnobSimulator {
   // The simulator's config with the knob values applied: a file a user re-simulates with.
   virtual std::string ConfigJson(const std::vector<KnobValue>& values) const = 0;
 
+  // Is the ground level (a plane facing up, no slope, no height field)? Then the torso's posture
+  // compares between sets of other placements (posture.h); false by default.
+  virtual bool level_ground() const { return false; }
+
   // Scales for constants relative to the robot: its total mass (kg), leg reach (m).
   virtual double total_mass_kg() const = 0;
   virtual double leg_reach_m() const = 0;

@@ -34,6 +34,8 @@ namespace dgmm::sim2real {
 
 struct PayloadSearchOptions {
   bool enabled = false;  // `dgmm sim2real --payload-search`
+  // Run also when the torso's posture is left out by the named physics (posture.h), enabled or not.
+  bool on_posture = true;
   bool challenge_named = true;  // also challenge named knobs the leg search challenged
   std::vector<double> masses = {1.0, 2.0};                   // of the mass knob's probe
   std::vector<double> forward = {-1.0, -0.5, 0.0, 0.5, 1.0};  // of the x probe's offset, sideways 0

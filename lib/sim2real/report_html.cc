@@ -311,6 +311,17 @@ std::string PayloadSearchTables(const PayloadSearch& p) {
   return o.str();
 }
 
+// "The torso's posture (mrad, pitch and roll): real minus sim while walking ..., standing ...; the
+// named correction gives ..., leaving ... (z)" or why it was not checked.
+std::string PostureParagraph(const PostureCheck& c) {
+  if (!c.ran) return c.why.empty() ? "" : "<p>The torso's posture was not checked: " + Escape(c.why) + ".</p>\n";
+  const auto mrad = [](const Eigen::Vector2d& v) { return F("%+.1f", 1e3 * v(0)) + ", " + F("%+.1f", 1e3 * v(1)); };
+  return "<p>The torso's posture (mrad, pitch, roll): real minus sim " + mrad(c.walking.shift) + " while walking (SE " +
+         mrad(c.walking.se) + "), " + mrad(c.standing.shift) + " standing after a placement (SE " +
+         mrad(c.standing.se) + "); " + Escape(c.correction) + " gives " + mrad(c.predicted) + ", leaving " +
+         F("%.1f", c.z_left) + " SE" + (c.left_out ? " (a doubt)" : "") + ".</p>\n";
+}
+
 std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const std::filesystem::path& dir) {
   std::ostringstream o;
   o << "<h2>5. Details</h2>\n";
@@ -337,6 +348,7 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
   }
   if (a.leg_search.ran) o << LegSearchTable(a.leg_search, "Search of every leg's gain", true);
   if (a.payload_search.ran) o << PayloadSearchTables(a.payload_search);
+  o << PostureParagraph(a.posture);
   if (!ctx.recalibrated_config_file.empty()) {
     o << "<p>The simulator config at the named values: <code>" << Escape(ctx.recalibrated_config_file)
       << "</code> (<code>dgmm simulate --config</code>).</p>\n";

@@ -258,6 +258,22 @@ json MoreDataJson(const MoreData& m) {
           {"max_factor", JsonNumber(m.max_factor)}};
 }
 
+json Pair(const Eigen::Vector2d& v) { return json::array({JsonNumber(v(0)), JsonNumber(v(1))}); }
+
+// The posture check (rad, pitch and roll); null when it did not run for want of a simulator.
+json PostureJson(const PostureCheck& c) {
+  if (!c.ran) return c.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", c.why}});
+  return {{"ran", true},
+          {"walking", {{"shift", Pair(c.walking.shift)}, {"se", Pair(c.walking.se)}}},
+          {"standing", {{"shift", Pair(c.standing.shift)}, {"se", Pair(c.standing.se)}}},
+          {"correction", c.correction}, {"recorded", c.recorded},
+          {"predicted", Pair(c.predicted)}, {"predicted_se", Pair(c.predicted_se)},
+          {"predicted_standing", Pair(c.predicted_standing)},
+          {"imu_offset", Pair(c.imu)}, {"left", Pair(c.left)}, {"z_left", JsonNumber(c.z_left)},
+          {"z_left_without_imu", JsonNumber(c.z_left_without_imu)}, {"z_moved", JsonNumber(c.z_moved)},
+          {"left_out", c.left_out}};
+}
+
 }  // namespace
 
 std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
@@ -273,6 +289,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"runoff", RunoffJson(a.runoff)},
               {"leg_search", LegSearchJson(a.leg_search)},
               {"payload_search", PayloadSearchJson(a.payload_search)},
+              {"posture", PostureJson(a.posture)},
               {"more_data", MoreDataJson(a.more_data)},
               {"fit", FitJson(a)},
               {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},
@@ -289,7 +306,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
                            {"refine", a.seconds.refine}, {"confidence", a.seconds.confidence},
                            {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"runoff", a.seconds.runoff},
                            {"leg_search", a.seconds.legs}, {"payload_search", a.seconds.payload},
-                           {"total", a.seconds.total}}}};
+                           {"posture", a.seconds.posture}, {"total", a.seconds.total}}}};
   for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});
   return out.dump(2) + "\n";
 }

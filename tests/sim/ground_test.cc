@@ -127,6 +127,17 @@ TEST_F(GroundTest, AnyRobotFromItsOwnFolderWalksOnRoughGround) {
   EXPECT_GT(DeltaPoseBody(start, sim.TorsoPose())[0], 0.05);
 }
 
+// Level ground is a plane facing up: no slope, no height field (the posture check of
+// lib/sim2real/posture.h runs only there).
+TEST_F(GroundTest, LevelGroundIsAPlaneWithoutSlopeOrHeights) {
+  SimConfig c = LoadSimConfig((fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots" / "hexapod.json").string());
+  EXPECT_FALSE(Simulator(c).LevelGround()) << "the hexapod's 10 degree slope";
+  c.slope_deg = 0;
+  EXPECT_TRUE(Simulator(c).LevelGround());
+  c.terrain = Stony();
+  EXPECT_FALSE(Simulator(c).LevelGround()) << "a height field";
+}
+
 TEST_F(GroundTest, MissingRobotFileIsNamed) {
   SimConfig c = OnGround(Stony());
   c.mjcf_path = "/nonexistent/robot.xml";

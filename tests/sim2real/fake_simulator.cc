@@ -87,6 +87,13 @@ Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, do
   return x;
 }
 
+// The torso's tilt on level ground (FakeSimulator::level).
+Eigen::Vector2d Posture(const Values& k, const FakeExtras& extras) {
+  const double m = k.v[kPayloadMass];
+  return Eigen::Vector2d(0.1 * m * k.v[kPayloadX], 0.1 * m * k.v[kPayloadY] + 0.04 * (k.v[kLeftGain] - k.v[kRightGain])) +
+         extras.posture;
+}
+
 // Placement p of a recording: its command (the protocol cycles every command over 6 headings).
 void Placement(std::uint64_t seed, int p, std::mt19937_64* rng, int* command, double* heading) {
   rng->seed(seed * 1000003 + p);
@@ -161,8 +168,9 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
     }
     for (int e = 0; e < executions; ++e) {
       const int i = executions * p + e;
-      const double pitch = kSlopeRad * std::cos(heading) + 0.02 * unit(rng);
-      const double roll = kSlopeRad * std::sin(heading) + 0.02 * unit(rng);
+      const Eigen::Vector2d tilt = level ? Posture(k, extras) : kSlopeRad * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      const double pitch = tilt(0) + 0.02 * unit(rng);
+      const double roll = tilt(1) + 0.02 * unit(rng);
       Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
       s.z.row(i) << pitch, roll;

@@ -54,6 +54,8 @@ struct FakeExtras {
   Eigen::Vector3d tracker_bias = Eigen::Vector3d::Zero();  // added to (dx, dy, dyaw); yaw entry unused
   // Physics no knob describes: dy += geometry * long * (1 + 2 roll), dx -= geometry * |turn|.
   double geometry = 0;
+  // On level ground (FakeSimulator::level): a tilt of z (pitch, roll; rad) no knob gives.
+  Eigen::Vector2d posture = Eigen::Vector2d::Zero();
 };
 
 class FakeSimulator : public KnobSimulator {
@@ -71,13 +73,14 @@ class FakeSimulator : public KnobSimulator {
                 ? "-payload-" + std::to_string(payload.gain) + "-" + std::to_string(payload.power) + "-" +
                       std::to_string(payload.bend)
                 : "") +
-           (payload.offset_alone ? "-offset-alone" : "");
+           (payload.offset_alone ? "-offset-alone" : "") + (level ? "-level" : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
   std::string ConfigJson(const std::vector<KnobValue>& values) const override;
   double total_mass_kg() const override { return 10.0; }
   double leg_reach_m() const override { return 0.3; }
+  bool level_ground() const override { return level; }
 
   // A recording with extras (the planted real set), `seed` its common random numbers.
   SampleSet RecordWith(const Recording& recording, const std::vector<KnobValue>& values, const FakeExtras& extras) const;
@@ -93,6 +96,10 @@ class FakeSimulator : public KnobSimulator {
   // Rough ground: every execution at a placement shares an offset of this many noise sds, drawn
   // per (recording seed, placement): where the robot stands, which z does not tell.
   double ground_sd = 0;
+  // Level ground: z is noise about the posture the payload's moments and the sides' gains give,
+  // (pitch, roll) = (0.1 M x, 0.1 M y + 0.04 (left gain - right gain)) + extras' posture, instead
+  // of the slope's tilt at the heading.
+  bool level = false;
   // How the payload acts (FakePayload); the default is linear in its mass and moments.
   FakePayload payload;
   // Record as many executions per placement as the recording asks for (else always 5, the

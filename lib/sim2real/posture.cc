@@ -1,0 +1,240 @@
+#include "sim2real/posture.h"
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "sim2real/sentence_format.h"
+#include "sim2real/units.h"
+#include "sim2real/verdict.h"
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+
+namespace {
+
+// Mean z (pitch, roll) per command label over `rows`.
+std::map<std::string, Eigen::Vector2d> MeanPerCommand(const SampleSet& s, const std::vector<int>& rows, int pitch_col,
+                                                      int roll_col) {
+  std::map<std::string, Eigen::Vector2d> sum;
+  std::map<std::string, int> n;
+  for (int i : rows) {
+    const std::string& label = s.command_labels[s.command(i)];
+    auto [it, fresh] = sum.emplace(label, Eigen::Vector2d::Zero());
+    it->second += Eigen::Vector2d(s.z(i, pitch_col), s.z(i, roll_col));
+    ++n[label];
+  }
+  for (auto& [label, v] : sum) v /= n[label];
+  return sum;
+}
+
+// The rows of each placement (each row its own without sequence data); `first_only` keeps the
+// first execution of each.
+std::vector<std::vector<int>> Placements(const SampleSet& s, bool first_only) {
+  std::vector<int> labels(s.size());
+  for (int i = 0; i < s.size(); ++i) labels[i] = s.has_sequence() ? s.episode(i) : i;
+  std::vector<std::vector<int>> rows = RowsOfUnits(NumberUnitsAscending(labels));
+  if (!first_only) return rows;
+  std::vector<std::vector<int>> first;
+  for (const std::vector<int>& p : rows) {
+    for (int i : p) {
+      if (s.step(i) == 0) first.push_back({i});
+    }
+  }
+  return first;
+}
+
+std::vector<int> Concatenate(const std::vector<std::vector<int>>& units, const std::vector<int>& pick) {
+  std::vector<int> rows;
+  for (int u : pick) rows.insert(rows.end(), units[u].begin(), units[u].end());
+  return rows;
+}
+
+std::vector<int> All(int n) {
+  std::vector<int> pick(n);
+  for (int u = 0; u < n; ++u) pick[u] = u;
+  return pick;
+}
+
+std::vector<int> Resample(int n, std::mt19937_64* rng) {
+  std::uniform_int_distribution<int> draw(0, n - 1);
+  std::vector<int> pick(n);
+  for (int& u : pick) u = draw(*rng);
+  return pick;
+}
+
+// The standard deviation of `draw(&rng)` over `resamples` draws (NaN draws skipped; NaN from fewer
+// than two).
+template <typename Draw>
+Eigen::Vector2d SpreadOfDraws(int resamples, std::uint64_t seed, const Draw& draw) {
+  std::mt19937_64 rng(seed);
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero(), sq = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (int r = 0; r < resamples; ++r) {
+    const Eigen::Vector2d d = draw(&rng);
+    if (!d.allFinite()) continue;
+    sum += d, sq += d.cwiseAbs2(), ++n;
+  }
+  if (n < 2) return Eigen::Vector2d::Constant(NAN);
+  return ((sq - sum.cwiseAbs2() / n) / (n - 1)).cwiseMax(0).cwiseSqrt();
+}
+
+std::string Mrad(const Eigen::Vector2d& v) { return Fmt("%+.1f mrad in pitch, %+.1f in roll", 1e3 * v(0), 1e3 * v(1)); }
+
+double MaxZ(const Eigen::Vector2d& v, const Eigen::Vector2d& se) {
+  return std::max(std::abs(v(0)) / se(0), std::abs(v(1)) / se(1));
+}
+
+// Where the check cannot run (empty: it can).
+std::string WhyNot(const KnobSimulator& simulator, const AnalysisInputs& in, const PostureOptions& options) {
+  if (!options.enabled) return "turned off (--no-posture)";
+  if (in.pitch_col < 0 || in.roll_col < 0) return "the sets' z has no pitch and roll";
+  if (!simulator.level_ground()) return "the simulator's ground is not level (a slope or a height field)";
+  if (!in.sim_set.has_sequence() || !in.real_set.has_sequence()) return "a set has no placements (episodes)";
+  return "";
+}
+
+}  // namespace
+
+bool PostureOptions::IsValid(std::string* error) const {
+  if (!(z > 0) || resamples < 10) {
+    *error = "posture z must be positive and resamples at least 10";
+    return false;
+  }
+  return true;
+}
+
+Eigen::Vector2d PostureDifference(const SampleSet& a, const std::vector<int>& rows_a, const SampleSet& b,
+                                  const std::vector<int>& rows_b, int pitch_col, int roll_col) {
+  const auto ma = MeanPerCommand(a, rows_a, pitch_col, roll_col), mb = MeanPerCommand(b, rows_b, pitch_col, roll_col);
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (const auto& [label, v] : ma) {
+    const auto it = mb.find(label);
+    if (it == mb.end()) continue;
+    sum += v - it->second;
+    ++n;
+  }
+  return n > 0 ? Eigen::Vector2d(sum / n) : Eigen::Vector2d::Constant(NAN);
+}
+
+PostureShift MeasurePostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col, bool first_only,
+                                 int resamples, std::uint64_t seed) {
+  const auto ua = Placements(a, first_only), ub = Placements(b, first_only);
+  PostureShift out;
+  if (ua.empty() || ub.empty()) return out;
+  const int na = static_cast<int>(ua.size()), nb = static_cast<int>(ub.size());
+  out.shift = PostureDifference(a, Concatenate(ua, All(na)), b, Concatenate(ub, All(nb)), pitch_col, roll_col);
+  out.se = SpreadOfDraws(resamples, seed, [&](std::mt19937_64* rng) {
+    const std::vector<int> pick_a = Resample(na, rng), pick_b = Resample(nb, rng);
+    return PostureDifference(a, Concatenate(ua, pick_a), b, Concatenate(ub, pick_b), pitch_col, roll_col);
+  });
+  return out;
+}
+
+PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col,
+                                       bool first_only, int resamples, std::uint64_t seed) {
+  PostureShift out;
+  if (!a.has_sequence() || !b.has_sequence()) return out;
+  // The placements both recordings kept (a probe that topples the robot keeps fewer), by episode id.
+  std::map<int, std::vector<int>> in_a, in_b;
+  const auto group = [&](const SampleSet& s, std::map<int, std::vector<int>>* m) {
+    for (int i = 0; i < s.size(); ++i) {
+      if (!first_only || s.step(i) == 0) (*m)[s.episode(i)].push_back(i);
+    }
+  };
+  group(a, &in_a), group(b, &in_b);
+  std::vector<std::vector<int>> ua, ub;
+  for (const auto& [episode, rows] : in_a) {
+    const auto it = in_b.find(episode);
+    if (it == in_b.end()) continue;
+    ua.push_back(rows), ub.push_back(it->second);
+  }
+  const int n = static_cast<int>(ua.size());
+  if (n == 0) return out;
+  out.shift = PostureDifference(a, Concatenate(ua, All(n)), b, Concatenate(ub, All(n)), pitch_col, roll_col);
+  out.se = SpreadOfDraws(resamples, seed, [&](std::mt19937_64* rng) {
+    const std::vector<int> pick = Resample(n, rng);
+    return PostureDifference(a, Concatenate(ua, pick), b, Concatenate(ub, pick), pitch_col, roll_col);
+  });
+  return out;
+}
+
+PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& in, const SampleSet& nominal,
+                          const Recording& recording, const RecordingOptions& recording_options,
+                          const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
+                          const std::string& correction, const PostureOptions& options) {
+  std::string error;
+  if (!options.IsValid(&error)) throw MakeInputError("", "posture options", error);
+  PostureCheck c;
+  c.correction = correction;
+  c.why = WhyNot(simulator, in, options);
+  if (!c.why.empty()) return c;
+  const int p = in.pitch_col, r = in.roll_col;
+  c.walking = MeasurePostureShift(in.real_set, in.sim_set, p, r, false, options.resamples, options.seed);
+  c.standing = MeasurePostureShift(in.real_set, in.sim_set, p, r, true, options.resamples, options.seed + 1);
+  if (!c.walking.shift.allFinite() || !(c.walking.se.minCoeff() > 0)) {
+    c.why = "the sets share no command with a measurable spread of z";
+    return c;
+  }
+  c.ran = true;
+  c.predicted = c.predicted_standing = imu;
+  if (!values.empty()) {
+    const SampleSet corrected = RecordBatch(simulator, recording, {values}, recording_options).sets.at(0);
+    c.recorded = true;
+    const PostureShift walking = MeasurePairedPostureShift(corrected, nominal, p, r, false, options.resamples,
+                                                           options.seed + 2);
+    const PostureShift standing = MeasurePairedPostureShift(corrected, nominal, p, r, true, options.resamples,
+                                                            options.seed + 3);
+    if (walking.shift.allFinite() && walking.se.allFinite()) c.predicted += walking.shift, c.predicted_se = walking.se;
+    if (standing.shift.allFinite()) c.predicted_standing += standing.shift;
+  }
+  c.imu = imu;
+  c.left = c.walking.shift - c.predicted;
+  const Eigen::Vector2d se = (c.walking.se.cwiseAbs2() + c.predicted_se.cwiseAbs2()).cwiseSqrt();
+  c.z_left = MaxZ(c.left, se);
+  c.z_left_without_imu = MaxZ(c.left + imu, se);
+  c.z_moved = MaxZ(c.walking.shift, c.walking.se);
+  c.left_out = c.z_left >= options.z;
+  return c;
+}
+
+namespace {
+
+// A posture left out in the verdict: a doubt, `explained` becomes `partly_explained` and `clean`
+// becomes `unexplained`.
+void AddDoubt(const std::string& doubt, Verdict* v) {
+  v->doubts.push_back(doubt);
+  if (v->status == "explained") v->status = "partly_explained";
+  if (v->status == "clean") v->status = "unexplained";
+  v->unexplained_present = true;
+  AddUnique(&v->structured_in, "posture");
+  v->sentence += " The posture: " + doubt + ".";
+}
+
+}  // namespace
+
+void AddPostureCheck(const PostureCheck& c, double z, Verdict* v) {
+  if (!c.ran || !c.left_out) return;
+  std::string doubt = "the torso's posture while walking differs from the simulation's by " + Mrad(c.walking.shift) +
+                      Fmt(" (SE %.1f, %.1f mrad)", 1e3 * c.walking.se(0), 1e3 * c.walking.se(1));
+  const bool moves = c.recorded || c.predicted.norm() > 0;
+  doubt += "; " + c.correction + (moves ? " gives " + Mrad(c.predicted) + "," : " moves no posture,") +
+           Fmt(" leaving %.1f SE (a doubt from %.3g)", c.z_left, z);
+  if (c.imu.norm() > 0 && c.z_left_without_imu < z) {
+    doubt += Fmt("; without the named IMU offset (%+.1f, %+.1f mrad) it gives the real posture", 1e3 * c.imu(0),
+                 1e3 * c.imu(1)) +
+             Fmt(" (%.1f SE): the offset is not what the IMU reads", c.z_left_without_imu);
+    AddDoubt(doubt, v);
+    return;
+  }
+  const bool standing_alike = c.standing.shift.allFinite() && c.standing.se.allFinite() &&
+                              MaxZ(c.standing.shift - c.predicted_standing - c.left, c.standing.se) < 2 &&
+                              MaxZ(c.standing.shift - c.predicted_standing, c.standing.se) >= 2;
+  doubt += standing_alike ? "; the standing posture moved alike, as an IMU mounted off level reads"
+                          : "; standing after a placement " + Mrad(c.standing.shift) +
+                                ": something that tilts the walking robot (a payload, a weak leg) is not named";
+  AddDoubt(doubt, v);
+}
+
+}  // namespace dgmm::sim2real

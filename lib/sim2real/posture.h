@@ -1,0 +1,89 @@
+#pragma once
+// The torso's posture as evidence beside the motion (docs/sim2real.md, "The torso's posture"):
+// every model here is of x given z, so z itself, the IMU's pitch and roll at the start of each
+// execution, is never compared; yet a payload or a weak leg tilts how the robot stands and walks,
+// and a tracker offset, heading drift or friction does not. On level ground z does not depend on
+// the heading, so sets of other placements compare by their mean z per command:
+//   d(a, b) = mean_c (mean z_a|c - mean z_b|c)          (commands both sets have)
+// observed d(real, sim) with a standard error from resampling both sets' placements (seeded), the
+// correction's own shift d(corrected, nominal) from its recording at the sim set's places (its
+// error from resampling those places jointly: a legged robot's roll can switch between gaits from
+// one placement to the next) plus a named IMU offset b (recorded z = true z + b), and what is left
+//   l = d(real, sim) - d(corrected, nominal) - b.
+// A component of l at >= z standard errors is a posture the named physics does not give. The same
+// for the first execution of each placement (the robot standing after it was placed) tells the
+// two apart: an IMU mounted off level moves both alike, a payload or a weak leg the walking
+// posture far more than the standing one. On a slope z lies on a circle around the posture and on
+// a height field it depends on where the robot stands: the check does not run there.
+#include <Eigen/Dense>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/sample_set.h"
+#include "sim2real/inputs.h"
+#include "sim2real/knob_simulator.h"
+#include "sim2real/simulation_cache.h"
+
+namespace dgmm::sim2real {
+
+struct PostureOptions {
+  bool enabled = true;  // `dgmm sim2real --no-posture` turns it off
+  // Standard errors a component of the posture left must reach (two components, pitch and roll;
+  // the nulls of the planar and sprawled quadrupeds reached at most 2.8, docs/sim2real.md).
+  double z = 4.0;
+  int resamples = 200;  // placement resamples of both sets for the standard errors
+  std::uint64_t seed = 1;
+  bool IsValid(std::string* error) const;
+};
+
+// Per command mean z (pitch, roll columns) of `a` minus that of `b`, averaged over the commands
+// both have (matched by label), on the rows `rows_a` and `rows_b`; NaN without a shared command.
+Eigen::Vector2d PostureDifference(const SampleSet& a, const std::vector<int>& rows_a, const SampleSet& b,
+                                  const std::vector<int>& rows_b, int pitch_col, int roll_col);
+
+// d(a, b) on every row (`first_only`: the first execution of each placement) and its standard
+// error from `resamples` draws of each set's placements with replacement.
+struct PostureShift {
+  Eigen::Vector2d shift = Eigen::Vector2d::Constant(NAN), se = Eigen::Vector2d::Constant(NAN);
+};
+PostureShift MeasurePostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col, bool first_only,
+                                 int resamples, std::uint64_t seed);
+
+// d(a, b) of two recordings at the same places (`a` a knob's, `b` the nominal's), its standard
+// error from resampling the placements both have, jointly (a paired difference).
+PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col,
+                                       bool first_only, int resamples, std::uint64_t seed);
+
+struct PostureCheck {
+  bool ran = false;
+  std::string why;             // why it did not run
+  PostureShift walking;        // real minus sim, every execution (rad)
+  PostureShift standing;       // real minus sim, first executions of a placement (rad)
+  Eigen::Vector2d predicted = Eigen::Vector2d::Zero();           // the correction's own shift (rad)
+  Eigen::Vector2d predicted_se = Eigen::Vector2d::Zero();        // its paired standard error
+  Eigen::Vector2d predicted_standing = Eigen::Vector2d::Zero();
+  Eigen::Vector2d left = Eigen::Vector2d::Zero();                // walking minus predicted
+  double z_left = 0;           // max |left| / sqrt(se^2 + predicted_se^2) over pitch and roll
+  double z_moved = 0;          // max |walking| / se: did the posture move at all
+  bool left_out = false;       // z_left >= options.z: a posture the named physics does not give
+  Eigen::Vector2d imu = Eigen::Vector2d::Zero();  // the named IMU offset in `predicted`
+  double z_left_without_imu = 0;  // the same without it (a named IMU offset the posture contradicts)
+  bool recorded = false;       // the correction was recorded (false: it holds no simulator knob)
+  std::string correction;      // what was checked, in words ("nothing named", "the named correction")
+};
+
+// The check for a correction of simulator knobs `values` (may be empty) and an IMU offset `imu`
+// (rad, pitch and roll; zero when none is named). `level_ground` from the simulator; `nominal` the
+// nominal re-recording at the sim set's places the correction's recording pairs with.
+PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& in, const SampleSet& nominal,
+                          const Recording& recording, const RecordingOptions& recording_options,
+                          const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
+                          const std::string& correction, const PostureOptions& options);
+
+// The check in the verdict: a posture left out is a doubt (explained becomes partly_explained,
+// clean becomes unexplained) and a sentence.
+struct Verdict;
+void AddPostureCheck(const PostureCheck& check, double z, Verdict* v);
+
+}  // namespace dgmm::sim2real
