@@ -328,6 +328,25 @@ std::vector<PairedShift> RecordShifts(const KnobSimulator& simulator, const Anal
   return out;
 }
 
+std::vector<std::optional<PairedShift>> RecordWalkableShifts(const KnobSimulator& simulator, const AnalysisInputs& in,
+                                                             const CandidateSet& set,
+                                                             const std::vector<std::vector<KnobValue>>& requests,
+                                                             const CandidateOptions& options, int* recorded,
+                                                             int* from_cache) {
+  const RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), requests, options.recording);
+  *recorded += batch.recorded;
+  *from_cache += batch.from_cache;
+  std::vector<std::optional<PairedShift>> out;
+  for (const SampleSet& s : batch.sets) {
+    try {
+      out.push_back(PairedShift::Fit(set.nominal, s, in.sim_set, options.slope_ridge));
+    } catch (const InputError&) {  // too few paired samples: the robot fell at these values
+      out.push_back(std::nullopt);
+    }
+  }
+  return out;
+}
+
 CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInputs& in, const Baseline& base,
                              const CandidateOptions& options) {
   std::string error;

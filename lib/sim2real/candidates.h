@@ -114,9 +114,18 @@ void FillCandidateDesign(const AnalysisInputs& in, const Baseline& base, const C
 PairedShift RecordShift(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                         const std::vector<KnobValue>& values, const CandidateOptions& options, int* recorded,
                         int* from_cache);
-// The same for several requests at once (recorded in parallel, options.recording.threads).
+// The same for several requests at once (recorded in parallel, options.recording.threads); throws
+// InputError when a recording kept too few paired samples (RecordWalkableShifts does not).
 std::vector<PairedShift> RecordShifts(const KnobSimulator& simulator, const AnalysisInputs& in,
                                       const CandidateSet& set, const std::vector<std::vector<KnobValue>>& requests,
                                       const CandidateOptions& options, int* recorded, int* from_cache);
+
+// RecordShifts with an empty entry for a request whose recording kept too few paired samples
+// (the robot fell in most placements at those values): a value no walking robot has.
+std::vector<std::optional<PairedShift>> RecordWalkableShifts(const KnobSimulator& simulator, const AnalysisInputs& in,
+                                                             const CandidateSet& set,
+                                                             const std::vector<std::vector<KnobValue>>& requests,
+                                                             const CandidateOptions& options, int* recorded,
+                                                             int* from_cache);
 
 }  // namespace dgmm::sim2real

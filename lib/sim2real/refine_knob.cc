@@ -15,6 +15,7 @@
 
 #include "sim2real/refine.h"
 #include "sim2real/refine_search.h"
+#include "sim2real/sentence_format.h"
 
 namespace dgmm::sim2real {
 namespace {
@@ -67,19 +68,31 @@ struct KnobSearch : SearchContext {
     r->trace.push_back({set->candidates[k].knob, p.value, NAN, p.score / in.real.size()});
     pts->push_back(p);
   }
-  // Records the values not yet known (one batch) and scores them into `pts`.
+  // Values at which the robot fell (too few paired samples): not points, and the search's limit.
+  mutable std::vector<double> fell = {};
+  bool Fell(double v) const {
+    const double tol = 1e-6 * (f.c->hi - f.c->lo);
+    return std::any_of(fell.begin(), fell.end(), [&](double x) { return std::abs(x - v) <= tol; });
+  }
+  // Records the values not yet known (one batch) and scores them into `pts`; a value at which the
+  // robot fell is listed in `fell` and the candidate set's unwalkable probes instead.
   void RecordAndScore(const std::vector<double>& values, std::vector<KnobPoint>* pts) const {
     std::vector<double> fresh;
     for (double v : values) {
-      if (std::isfinite(f.UOf(v)) && !f.Known(*pts, v)) fresh.push_back(v);
+      if (std::isfinite(f.UOf(v)) && !f.Known(*pts, v) && !Fell(v)) fresh.push_back(v);
     }
     std::sort(fresh.begin(), fresh.end());
     fresh.erase(std::unique(fresh.begin(), fresh.end()), fresh.end());
     std::vector<std::vector<KnobValue>> requests;
     for (double v : fresh) requests.push_back({KnobValue{set->candidates[k].knob_index, v}});
-    auto shifts = RecordShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
+    auto shifts = RecordWalkableShifts(simulator, in, *set, requests, recording, &r->recorded, &r->from_cache);
     for (size_t i = 0; i < fresh.size(); ++i) {
-      set->shifts.push_back(std::move(shifts[i]));
+      if (!shifts[i]) {
+        fell.push_back(fresh[i]);
+        AddUnique(&set->unwalkable_probes, set->candidates[k].knob + Fmt("@%.4g", fresh[i]));
+        continue;
+      }
+      set->shifts.push_back(std::move(*shifts[i]));
       Add(fresh[i], static_cast<int>(set->shifts.size()) - 1, pts);
     }
   }
@@ -164,7 +177,7 @@ void SearchKnob(const KnobSimulator& simulator, const AnalysisInputs& in, const 
     const double u = below && above ? NextInside(*below, best, *above) : best.u + (above ? -1 : 1);
     if (!std::isfinite(u)) break;  // bracketed within kResolution
     const double next = s.f.ValueAt(u);
-    if (s.f.Known(pts, next) || !std::isfinite(s.f.UOf(next))) break;  // at the knob's range limit
+    if (s.f.Known(pts, next) || s.Fell(next) || !std::isfinite(s.f.UOf(next))) break;  // at a limit
     s.RecordAndScore({next}, &pts);
   }
   const KnobPoint& best = *std::max_element(pts.begin(), pts.end(), ByScore);

@@ -47,6 +47,22 @@ TEST(Analysis, PlantedFrictionIsNamedWithItsValue) {
   EXPECT_FALSE(a.candidates.legs_probed) << "no side is implicated by friction: " << a.candidates.legs_note;
 }
 
+// A refinement step to a value at which the robot falls (too few paired samples) is a limit of the
+// search, not the end of the analysis: until 2026-12-05 it threw, and the analysis fell back to
+// locating only (planar quadruped pair 60304).
+TEST(Analysis, AValueTheRobotFallsAtBoundsTheRefinement) {
+  FakeSimulator toppling;
+  toppling.topples_below_friction = 0.6;  // the probe stands; the search's step down to 0.52 falls
+  const auto pair = test::MakeFakePair(toppling, {{test::kFriction, 0.7}});
+  const Analysis a = Analyse(pair.sim, pair.real, &toppling, test::FastOptions());
+  ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
+  EXPECT_EQ(a.verdict.named[0].family, "friction") << a.verdict.sentence;
+  EXPECT_NEAR(a.verdict.named[0].value, 0.7, kValueTolerance * 0.7) << a.verdict.sentence;
+  const auto& fell = a.candidates.unwalkable_probes;
+  EXPECT_TRUE(std::any_of(fell.begin(), fell.end(), [](const std::string& p) { return p.rfind("floor.friction@", 0) == 0; }))
+      << "the value it fell at is listed";
+}
+
 TEST(Analysis, PlantedPayloadIsNamedWithItsMass) {
   const Analysis a = RunFake({{test::kPayloadMass, 2.0}, {test::kPayloadY, 0.1}});
   ASSERT_FALSE(a.verdict.named.empty()) << a.verdict.sentence;
