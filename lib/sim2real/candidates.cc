@@ -26,6 +26,16 @@ Recording OwnRecording(const AnalysisInputs& in, const CandidateOptions& options
   return r;
 }
 
+// The requests recorded with the sim set's own recording, counted into *recorded and *from_cache.
+RecordingBatch RecordCounted(const KnobSimulator& simulator, const AnalysisInputs& in,
+                             const std::vector<std::vector<KnobValue>>& requests, const CandidateOptions& options,
+                             int* recorded, int* from_cache) {
+  RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), requests, options.recording);
+  *recorded += batch.recorded;
+  *from_cache += batch.from_cache;
+  return batch;
+}
+
 // Records the probes of the listed knobs (and the nominal when `set` has none yet).
 std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& in, const std::vector<int>& knobs,
                                 const CandidateOptions& options, CandidateSet* set) {
@@ -39,9 +49,7 @@ std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& 
       probes.push_back({k, v, {}});
     }
   }
-  RecordingBatch batch = RecordBatch(sim, OwnRecording(in, options), requests, options.recording);
-  set->recorded += batch.recorded;
-  set->from_cache += batch.from_cache;
+  RecordingBatch batch = RecordCounted(sim, in, requests, options, &set->recorded, &set->from_cache);
   set->requests += static_cast<int>(requests.size());
   set->seconds += batch.wall_seconds;
   if (need_nominal) set->nominal = std::move(batch.sets[0]);
@@ -320,9 +328,7 @@ PairedShift RecordShift(const KnobSimulator& simulator, const AnalysisInputs& in
 std::vector<PairedShift> RecordShifts(const KnobSimulator& simulator, const AnalysisInputs& in,
                                       const CandidateSet& set, const std::vector<std::vector<KnobValue>>& requests,
                                       const CandidateOptions& options, int* recorded, int* from_cache) {
-  const RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), requests, options.recording);
-  *recorded += batch.recorded;
-  *from_cache += batch.from_cache;
+  const RecordingBatch batch = RecordCounted(simulator, in, requests, options, recorded, from_cache);
   std::vector<PairedShift> out;
   for (const SampleSet& s : batch.sets) out.push_back(PairedShift::Fit(set.nominal, s, in.sim_set, options.slope_ridge));
   return out;
@@ -333,9 +339,7 @@ std::vector<std::optional<PairedShift>> RecordWalkableShifts(const KnobSimulator
                                                              const std::vector<std::vector<KnobValue>>& requests,
                                                              const CandidateOptions& options, int* recorded,
                                                              int* from_cache) {
-  const RecordingBatch batch = RecordBatch(simulator, OwnRecording(in, options), requests, options.recording);
-  *recorded += batch.recorded;
-  *from_cache += batch.from_cache;
+  const RecordingBatch batch = RecordCounted(simulator, in, requests, options, recorded, from_cache);
   std::vector<std::optional<PairedShift>> out;
   for (const SampleSet& s : batch.sets) {
     try {

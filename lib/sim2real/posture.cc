@@ -5,7 +5,6 @@
 #include <random>
 
 #include "sim2real/sentence_format.h"
-#include "sim2real/units.h"
 #include "sim2real/verdict.h"
 #include "util/error.h"
 
@@ -28,20 +27,22 @@ std::map<std::string, Eigen::Vector2d> MeanPerCommand(const SampleSet& s, const 
   return sum;
 }
 
-// The rows of each placement (each row its own without sequence data); `first_only` keeps the
-// first execution of each.
-std::vector<std::vector<int>> Placements(const SampleSet& s, bool first_only) {
-  std::vector<int> labels(s.size());
-  for (int i = 0; i < s.size(); ++i) labels[i] = s.has_sequence() ? s.episode(i) : i;
-  std::vector<std::vector<int>> rows = RowsOfUnits(NumberUnitsAscending(labels));
-  if (!first_only) return rows;
-  std::vector<std::vector<int>> first;
-  for (const std::vector<int>& p : rows) {
-    for (int i : p) {
-      if (s.step(i) == 0) first.push_back({i});
-    }
+// The rows of each placement by its episode id (each row its own without sequence data, and then
+// every row a first execution); `first_only` keeps the first execution of each.
+std::map<int, std::vector<int>> RowsByPlacement(const SampleSet& s, bool first_only) {
+  std::map<int, std::vector<int>> rows;
+  for (int i = 0; i < s.size(); ++i) {
+    if (!s.has_sequence()) rows[i].push_back(i);
+    else if (!first_only || s.step(i) == 0) rows[s.episode(i)].push_back(i);
   }
-  return first;
+  return rows;
+}
+
+// The same as units in ascending order of episode id.
+std::vector<std::vector<int>> Placements(const SampleSet& s, bool first_only) {
+  std::vector<std::vector<int>> units;
+  for (auto& [episode, rows] : RowsByPlacement(s, first_only)) units.push_back(std::move(rows));
+  return units;
 }
 
 std::vector<int> Concatenate(const std::vector<std::vector<int>>& units, const std::vector<int>& pick) {
@@ -137,13 +138,7 @@ PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, i
   PostureShift out;
   if (!a.has_sequence() || !b.has_sequence()) return out;
   // The placements both recordings kept (a probe that topples the robot keeps fewer), by episode id.
-  std::map<int, std::vector<int>> in_a, in_b;
-  const auto group = [&](const SampleSet& s, std::map<int, std::vector<int>>* m) {
-    for (int i = 0; i < s.size(); ++i) {
-      if (!first_only || s.step(i) == 0) (*m)[s.episode(i)].push_back(i);
-    }
-  };
-  group(a, &in_a), group(b, &in_b);
+  const auto in_a = RowsByPlacement(a, first_only), in_b = RowsByPlacement(b, first_only);
   std::vector<std::vector<int>> ua, ub;
   for (const auto& [episode, rows] : in_a) {
     const auto it = in_b.find(episode);
