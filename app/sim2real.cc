@@ -55,6 +55,7 @@ struct Sim2RealArgs {
   bool payload_on_posture = sim2real::PayloadSearchOptions{}.on_posture;
   bool posture = sim2real::PostureOptions{}.enabled;
   double posture_z = sim2real::PostureOptions{}.z;
+  bool refit_without_imu = sim2real::PostureOptions{}.refit_without_imu;
   bool runoff = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
@@ -170,6 +171,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.payload.on_posture = args.payload_on_posture;
   o.posture.enabled = args.posture;
   o.posture.z = args.posture_z;
+  o.posture.refit_without_imu = args.refit_without_imu;
   o.payload.search.sag_mode = args.leg_search_score == "sag";
   o.legs.sag_mode = args.leg_search_score == "sag";
   o.legs.only_with_tails = args.leg_search_on == "tails";
@@ -402,6 +404,10 @@ void Setup(CLI::App& root) {
   cmd->add_option("--posture-z", args->posture_z,
                   "standard errors (placements resampled) a posture left out must reach to be a doubt")
       ->capture_default_str()->check(CLI::PositiveNumber);
+  cmd->add_flag("--refit-without-contradicted-imu,!--keep-contradicted-imu", args->refit_without_imu,
+                "when the torso's posture contradicts a named IMU offset (the rest of the correction gives the real "
+                "posture without it), analyse again from the candidates without an IMU offset (--posture; "
+                "docs/sim2real.md); --keep-contradicted-imu keeps it named, with the doubt");
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

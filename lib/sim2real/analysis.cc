@@ -214,6 +214,20 @@ NullShortfall MeasureNull(const KnobSimulator& simulator, const AnalysisInputs& 
   return RecordNullShortfall(simulator, in, base, o);
 }
 
+// The recordings an analysis's candidates and refinement made and read from the cache, to count
+// those of a run again beside the first run's.
+struct RecordingCounts {
+  int recorded = 0, from_cache = 0, requests = 0, refined = 0, refined_from_cache = 0;
+  static RecordingCounts Of(const Analysis& a) {
+    return {a.candidates.recorded, a.candidates.from_cache, a.candidates.requests, a.refinement.recorded,
+            a.refinement.from_cache};
+  }
+  void AddTo(Analysis* a) const {
+    a->candidates.recorded += recorded, a->candidates.from_cache += from_cache, a->candidates.requests += requests;
+    a->refinement.recorded += refined, a->refinement.from_cache += refined_from_cache;
+  }
+};
+
 // Stages 3 to 8 again with signatures of every execution (Analysis::every_execution_because), on
 // the knobs the first look screened in when options.confirm_screened_only.
 template <typename Stage>
@@ -225,17 +239,14 @@ void RunAgainWithEveryExecution(const KnobSimulator& simulator, const AnalysisOp
     every.candidates.only_knobs =
         ScreenedKnobs(a->candidates, a->refinement.selection, options.confirm_screen_z, options.confirm_screen_share);
   }
-  // The recordings of both runs are counted.
-  const int recorded = a->candidates.recorded, from_cache = a->candidates.from_cache, requests = a->candidates.requests;
-  const int refined = a->refinement.recorded, refined_from_cache = a->refinement.from_cache;
+  const RecordingCounts first = RecordingCounts::Of(*a);  // the recordings of both runs are counted
   const CandidateSet first_look = std::move(a->candidates);
   const int kept = RecordCandidates(simulator, every, stage, a, &first_look);
   SelectToVerdict(simulator, every, stage, a);
   if (every.candidates.only_knobs) {
     a->every_execution_because += ScreenedPart(simulator, *every.candidates.only_knobs, options, kept);
   }
-  a->candidates.recorded += recorded, a->candidates.from_cache += from_cache, a->candidates.requests += requests;
-  a->refinement.recorded += refined, a->refinement.from_cache += refined_from_cache;
+  first.AddTo(a);
 }
 
 // The IMU offset the verdict names (rad, pitch and roll; zero when none is named).
@@ -381,6 +392,58 @@ std::string EveryExecutionBecause(const Analysis& a, const AnalysisOptions& opti
   return look + " from signatures of " + of_real + " came near: " + key + " reached " + z;
 }
 
+namespace {
+
+// Stages 3 to 8 and the posture on the inputs, baseline and null in `a`: the candidates (a first
+// look, run again with every execution when EveryExecutionBecause says so), the posture of what
+// they name, the searches by models of their own and the final correction. A second call starts
+// afresh from the candidates and counts the recordings of both.
+template <typename Stage>
+void NameAndCheck(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
+  const RecordingCounts before = RecordingCounts::Of(*a);
+  a->runoff = Runoff{}, a->leg_search = LegSearch{}, a->payload_search = PayloadSearch{};
+  // A first look whose selections will be recorded again with every execution is a screen: the
+  // run again searches what it selects, so the first look searches nothing.
+  AnalysisOptions first = options;
+  const bool screen = FirstLookIsAScreen(a->inputs, options);
+  if (screen) first.refine.refine_iterations = 0;
+  RecordCandidates(simulator, first, stage, a);
+  SelectToVerdict(simulator, first, stage, a);
+  a->every_execution_because = EveryExecutionBecause(*a, options);
+  if (!a->every_execution_because.empty()) {
+    RunAgainWithEveryExecution(simulator, options, stage, a);
+  } else if (screen && !a->refinement.selection.selected.empty()) {
+    SelectToVerdict(simulator, options, stage, a);  // not looked at again (every_execution_from_z): searched now
+  }
+  const auto t = Clock::now();
+  stage("posture (the named physics against the real torso's)");
+  a->named_values = NamedKnobValues(a->candidates, a->refinement, a->verdict, a->naming.named);
+  a->posture = CheckNamedPosture(simulator, options, *a, a->named_values, NamedImuOffset(*a));
+  a->seconds.posture += Since(t);
+  SearchByOwnModels(simulator, options, stage, a);
+  CorrectAndCheckPosture(simulator, options, a);
+  before.AddTo(a);
+}
+
+// When the posture contradicts the named IMU offset (the rest of the correction gives the real
+// posture without it), stages 3 to 8 and the posture again without an IMU offset among the
+// candidates (Analysis::imu_contradicted).
+template <typename Stage>
+void RefitWithoutContradictedImu(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage,
+                                 Analysis* a) {
+  if (!options.posture.refit_without_imu || NamedByOwnModels(*a) || !ContradictsNamedImu(a->posture, options.posture.z)) {
+    return;
+  }
+  a->imu_contradicted = {true, NamedKnobs(*a), a->posture};
+  AnalysisOptions without = options;
+  without.candidates.imu_offset = false;
+  stage("again without an IMU offset (the torso's posture contradicts the named one)");
+  NameAndCheck(simulator, without, stage, a);
+  a->verdict.sentence += ContradictedImuSentence(a->imu_contradicted);
+}
+
+}  // namespace
+
 Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulator* simulator,
                  const AnalysisOptions& options, const std::string& no_simulator_reason) {
   std::string error;
@@ -404,26 +467,8 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   const auto null_start = Clock::now();
   a.null_shortfall = MeasureNull(*simulator, a.inputs, a.baseline, options);
   a.seconds.adequacy += Since(null_start);
-  // A first look whose selections will be recorded again with every execution is a screen: the
-  // run again searches what it selects, so the first look searches nothing.
-  AnalysisOptions first = options;
-  const bool screen = FirstLookIsAScreen(a.inputs, options);
-  if (screen) first.refine.refine_iterations = 0;
-  RecordCandidates(*simulator, first, stage, &a);
-  SelectToVerdict(*simulator, first, stage, &a);
-  a.every_execution_because = EveryExecutionBecause(a, options);
-  if (!a.every_execution_because.empty()) {
-    RunAgainWithEveryExecution(*simulator, options, stage, &a);
-  } else if (screen && !a.refinement.selection.selected.empty()) {
-    SelectToVerdict(*simulator, options, stage, &a);  // not looked at again (every_execution_from_z): searched now
-  }
-  const auto t = Clock::now();
-  stage("posture (the named physics against the real torso's)");
-  a.named_values = NamedKnobValues(a.candidates, a.refinement, a.verdict, a.naming.named);
-  a.posture = CheckNamedPosture(*simulator, options, a, a.named_values, NamedImuOffset(a));
-  a.seconds.posture = Since(t);
-  SearchByOwnModels(*simulator, options, stage, &a);
-  CorrectAndCheckPosture(*simulator, options, &a);
+  NameAndCheck(*simulator, options, stage, &a);
+  RefitWithoutContradictedImu(*simulator, options, stage, &a);
   a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, SearchedWithoutName(a),
                                options.more_data);
   a.verdict.sentence += MoreDataSentence(a.more_data);

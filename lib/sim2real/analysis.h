@@ -21,6 +21,7 @@
 //      posture     (posture.h)       on level ground: does the named physics give the real torso's
 //                                    posture (pitch, roll)? Checked before the searches (a posture
 //                                    left out lets them challenge the names) and on the final names;
+//                                    a named IMU offset it contradicts: 3-8 again without one;
 //      payload     (payload_search.h) on a plane when still nothing is named, or the posture is left
 //                                    out (else experimental): a payload's mass and position searched likewise;
 //      more data   (more_data.h)     when still nothing is named but a knob came near: how many
@@ -113,6 +114,9 @@ struct Analysis {
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
   PayloadSearch payload_search;    // ran only when enabled and still nothing was named (PayloadSearch::ran)
   PostureCheck posture;            // does the named physics give the real torso's posture (level ground)
+  // A first fit's IMU offset the posture contradicted (refitted: the stages from the candidates ran
+  // again without an IMU offset, and every result here but this is the second run's).
+  ContradictedImu imu_contradicted;
   MoreData more_data;              // how many placements would decide a near miss (MoreData::advised)
   Correction correction;           // the knob correction (empty without a simulator)
   std::vector<KnobValue> named_values;  // the named simulator knobs at their values (ConfigJson)

@@ -78,9 +78,10 @@ void AddTrackerEffects(const AnalysisInputs& in, CandidateSet* set) {
   AddMeasurement(noise, NoiseEffect(), ExternalCandidate::kShift, set);
 }
 
-// IMU pitch/roll bias (with terrain) and heading drift (with yaw): last in the library.
-void AddImuAndHeading(const AnalysisInputs& in, CandidateSet* set) {
-  if (in.real.terrain_dim() >= 2) {
+// IMU pitch/roll bias (with terrain, unless `imu_offset` is false) and heading drift (with yaw):
+// last in the library.
+void AddImuAndHeading(const AnalysisInputs& in, bool imu_offset, CandidateSet* set) {
+  if (imu_offset && in.real.terrain_dim() >= 2) {
     AddMeasurement({"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad"},
                    ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"), ExternalCandidate::kImuBias, set);
   }
@@ -147,15 +148,15 @@ void AddPayload(const KnobSimulator& sim, CandidateSet* set) {
 // Builds the library from the probes (library order: tracker bias, tracker noise, knob probes in
 // knob order, payload, IMU bias, heading drift).
 void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vector<Probe> probes,
-                  double slope_ridge, CandidateSet* set) {
+                  const CandidateOptions& options, CandidateSet* set) {
   std::stable_sort(probes.begin(), probes.end(), [](const Probe& a, const Probe& b) { return a.knob < b.knob; });
   set->candidates.clear(), set->library.clear(), set->externals.clear(), set->shifts.clear();
   set->inert_knobs.clear();
   set->unwalkable_probes.clear();
   AddTrackerEffects(in, set);
-  AddKnobCandidates(sim, in, probes, slope_ridge, set);
+  AddKnobCandidates(sim, in, probes, options.slope_ridge, set);
   AddPayload(sim, set);
-  AddImuAndHeading(in, set);
+  AddImuAndHeading(in, options.imu_offset, set);
 }
 
 // The first pass: forward selection with the backward pass over every candidate but the legs.
@@ -207,7 +208,7 @@ CandidateSet OnlyTheseKnobs(const KnobSimulator& simulator, const AnalysisInputs
                                                       Fmt(" is not below the simulator's %.0f knobs",
                                                           static_cast<double>(knobs.size())));
   }
-  BuildLibrary(simulator, in, RecordProbes(simulator, in, only, options, &set), options.slope_ridge, &set);
+  BuildLibrary(simulator, in, RecordProbes(simulator, in, only, options, &set), options, &set);
   set.legs_probed = std::any_of(only.begin(), only.end(), [&](int k) { return !knobs[k].leg.empty(); });
   set.legs_note = set.legs_probed ? "per-leg probes recorded: the legs a first look screened in"
                                   : "per-leg probes not recorded: a first look screened in no leg";
@@ -375,7 +376,7 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
     all.insert(all.end(), legs.begin(), legs.end());
     return all;
   }(), options, &set);
-  BuildLibrary(simulator, in, probes, options.slope_ridge, &set);
+  BuildLibrary(simulator, in, probes, options, &set);
   set.legs_probed = !gate && !legs.empty();
   if (!gate) {
     set.legs_note = legs.empty() ? "" : "per-leg probes recorded (the robot has no side knobs to test first)";
@@ -396,7 +397,7 @@ CandidateSet BuildCandidates(const KnobSimulator& simulator, const AnalysisInput
   }
   std::vector<Probe> leg_probes = RecordProbes(simulator, in, legs, options, &set);
   probes.insert(probes.end(), std::make_move_iterator(leg_probes.begin()), std::make_move_iterator(leg_probes.end()));
-  BuildLibrary(simulator, in, probes, options.slope_ridge, &set);
+  BuildLibrary(simulator, in, probes, options, &set);
   set.legs_probed = true;
   set.legs_note = "per-leg probes recorded: " + why;
   return set;

@@ -46,6 +46,9 @@ struct CandidateOptions {
   // gate: the confirmation with every execution records again what the first look screened in
   // (AnalysisOptions::confirm_screened_only). Unset: every knob.
   std::optional<std::vector<int>> only_knobs;
+  // The IMU's pitch/roll offset is a candidate (false: the analysis again without it, when the
+  // torso's posture contradicted the one a first fit named; PostureOptions::refit_without_imu).
+  bool imu_offset = true;
   bool IsValid(std::string* error) const;
 };
 

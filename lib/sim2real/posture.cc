@@ -209,6 +209,22 @@ void AddDoubt(const std::string& doubt, Verdict* v) {
 
 }  // namespace
 
+bool ContradictsNamedImu(const PostureCheck& c, double z) {
+  return c.ran && c.left_out && c.imu.norm() > 0 && c.z_left_without_imu < z;
+}
+
+std::string ContradictedImuSentence(const ContradictedImu& c) {
+  if (!c.refitted) return "";
+  std::vector<std::string> others;
+  for (const std::string& n : c.named) {
+    if (n != "imu.pitch_roll_offset") others.push_back(n);
+  }
+  return " A first fit named " + (others.empty() ? std::string() : JoinWords(others) + " and ") +
+         Fmt("an IMU offset of (%+.1f,", 1e3 * c.check.imu(0)) + Fmt(" %+.1f) mrad, which the torso's posture", 1e3 * c.check.imu(1)) +
+         Fmt(" contradicts (%.1f SE left with it,", c.check.z_left) + Fmt(" %.1f without):", c.check.z_left_without_imu) +
+         " the stages from the candidates ran again without an IMU offset.";
+}
+
 void AddPostureCheck(const PostureCheck& c, double z, Verdict* v) {
   if (!c.ran || !c.left_out) return;
   std::string doubt = "the torso's posture while walking differs from the simulation's by " + Mrad(c.walking.shift) +
@@ -216,7 +232,7 @@ void AddPostureCheck(const PostureCheck& c, double z, Verdict* v) {
   const bool moves = c.recorded || c.predicted.norm() > 0;
   doubt += "; " + c.correction + (moves ? " gives " + Mrad(c.predicted) + "," : " moves no posture,") +
            Fmt(" leaving %.1f SE (a doubt from %.3g)", c.z_left, z);
-  if (c.imu.norm() > 0 && c.z_left_without_imu < z) {
+  if (ContradictsNamedImu(c, z)) {
     doubt += Fmt("; without the named IMU offset (%+.1f, %+.1f mrad) it gives the real posture", 1e3 * c.imu(0),
                  1e3 * c.imu(1)) +
              Fmt(" (%.1f SE): the offset is not what the IMU reads", c.z_left_without_imu);

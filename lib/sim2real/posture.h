@@ -34,6 +34,10 @@ struct PostureOptions {
   double z = 4.0;
   int resamples = 200;  // placement resamples of both sets for the standard errors
   std::uint64_t seed = 1;
+  // When the named IMU offset is what leaves the posture out (the rest of the correction gives the
+  // real posture without it), the analysis runs again from the candidates without an IMU offset
+  // among them (ContradictedImu); false: the offset stays named, with the doubt.
+  bool refit_without_imu = true;
   bool IsValid(std::string* error) const;
 };
 
@@ -80,6 +84,23 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
                           const Recording& recording, const RecordingOptions& recording_options,
                           const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
                           const std::string& correction, const PostureOptions& options);
+
+// A named IMU offset the posture contradicted: the first fit's names and its posture check (the
+// offset, z left with and without it); the analysis's stages from the candidates then ran again
+// without an IMU offset (PostureOptions::refit_without_imu).
+struct ContradictedImu {
+  bool refitted = false;
+  std::vector<std::string> named;  // what the first fit named (knob names, the IMU offset's among them)
+  PostureCheck check;              // the first fit's posture check
+};
+
+// Does `check` contradict its named IMU offset: the posture left out with it, not without it?
+bool ContradictsNamedImu(const PostureCheck& check, double z);
+
+// " A first fit named a, b and an IMU offset of (p, r) mrad, which the torso's posture contradicts
+// (z SE left with it, z without): the stages from the candidates ran again without an IMU offset."
+// Empty when nothing was refitted.
+std::string ContradictedImuSentence(const ContradictedImu& c);
 
 // The check in the verdict: a posture left out is a doubt (explained becomes partly_explained,
 // clean becomes unexplained) and a sentence.

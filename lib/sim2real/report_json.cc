@@ -274,6 +274,13 @@ json PostureJson(const PostureCheck& c) {
           {"left_out", c.left_out}};
 }
 
+// A named IMU offset the posture contradicted (null: none, the analysis ran once).
+json ContradictedImuJson(const ContradictedImu& c) {
+  if (!c.refitted) return nullptr;
+  return {{"first_named", c.named}, {"imu_offset", Pair(c.check.imu)}, {"z_left", JsonNumber(c.check.z_left)},
+          {"z_left_without_imu", JsonNumber(c.check.z_left_without_imu)}};
+}
+
 }  // namespace
 
 std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
@@ -290,6 +297,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"leg_search", LegSearchJson(a.leg_search)},
               {"payload_search", PayloadSearchJson(a.payload_search)},
               {"posture", PostureJson(a.posture)},
+              {"imu_contradicted", ContradictedImuJson(a.imu_contradicted)},
               {"more_data", MoreDataJson(a.more_data)},
               {"fit", FitJson(a)},
               {"simulator", {{"analysed", a.knobs_analysed}, {"config_source", ctx.simulator_config_source},

@@ -169,13 +169,16 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
     for (int e = 0; e < executions; ++e) {
       const int i = executions * p + e;
       const Eigen::Vector2d tilt = level ? Posture(k, extras) : kSlopeRad * Eigen::Vector2d(std::cos(heading), std::sin(heading));
-      const double pitch = tilt(0) + 0.02 * unit(rng);
-      const double roll = tilt(1) + 0.02 * unit(rng);
+      const double z_sd = level ? level_z_sd : 0.02;
+      const double pitch = tilt(0) + z_sd * unit(rng);
+      const double roll = tilt(1) + z_sd * unit(rng);
       Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
-      s.z.row(i) << pitch, roll;
-      s.x.row(i) = (Mean(k, s.commands.row(c).transpose(), pitch, roll, e == 0, extras, friction_threshold_,
-                     payload) +
+      s.z.row(i) << pitch + extras.imu_offset(0), roll + extras.imu_offset(1);
+      const Eigen::Vector2d felt = Eigen::Vector2d(pitch, roll) + extras.motion_tilt;
+      const Eigen::Vector3d command = s.commands.row(c).transpose();
+      s.x.row(i) = (Mean(k, command, felt(0), felt(1), e == 0, extras, friction_threshold_, payload) +
+                    tilt_steers * Eigen::Vector3d(felt(0) * command(2), felt(1) * command(2), 0) +
                     k.v[kTrackerNoise] * kNoiseSd.cwiseProduct(noise) + stands).transpose();
     }
   }

@@ -56,6 +56,11 @@ struct FakeExtras {
   double geometry = 0;
   // On level ground (FakeSimulator::level): a tilt of z (pitch, roll; rad) no knob gives.
   Eigen::Vector2d posture = Eigen::Vector2d::Zero();
+  // The motion as if the ground were tilted by this (pitch, roll; rad) while the torso stays as it
+  // is: x given z reads like an IMU offset, z does not move.
+  Eigen::Vector2d motion_tilt = Eigen::Vector2d::Zero();
+  // An IMU offset: recorded z = true z + imu_offset.
+  Eigen::Vector2d imu_offset = Eigen::Vector2d::Zero();
 };
 
 class FakeSimulator : public KnobSimulator {
@@ -73,7 +78,9 @@ class FakeSimulator : public KnobSimulator {
                 ? "-payload-" + std::to_string(payload.gain) + "-" + std::to_string(payload.power) + "-" +
                       std::to_string(payload.bend)
                 : "") +
-           (payload.offset_alone ? "-offset-alone" : "") + (level ? "-level" : "");
+           (payload.offset_alone ? "-offset-alone" : "") + (level ? "-level" : "") +
+           (level_z_sd != 0.02 ? "-z-sd-" + std::to_string(level_z_sd) : "") +
+           (tilt_steers != 0 ? "-tilt-steers-" + std::to_string(tilt_steers) : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -100,6 +107,10 @@ class FakeSimulator : public KnobSimulator {
   // (pitch, roll) = (0.1 M x, 0.1 M y + 0.04 (left gain - right gain)) + extras' posture, instead
   // of the slope's tilt at the heading.
   bool level = false;
+  double level_z_sd = 0.02;  // the noise of z about that posture (rad)
+  // The tilt steers the turn: x += tilt_steers turn (pitch, roll, 0), a slope of x in z that changes
+  // sign with the command (a constant shift of z then reads as no tracker offset).
+  double tilt_steers = 0;
   // How the payload acts (FakePayload); the default is linear in its mass and moments.
   FakePayload payload;
   // Record as many executions per placement as the recording asks for (else always 5, the

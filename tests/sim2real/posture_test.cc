@@ -20,6 +20,19 @@ const FakeSimulator& LevelFake() {
   return *fake;
 }
 
+// Level ground whose z spreads 0.1 rad about the posture and whose tilt steers the walk: x's slope
+// in z, through which the probes read an IMU offset, is measurable.
+const FakeSimulator& SpreadLevelFake() {
+  static const FakeSimulator* fake = [] {
+    auto* f = new FakeSimulator();
+    f->level = true;
+    f->level_z_sd = 0.1;
+    f->tilt_steers = 0.5;
+    return f;
+  }();
+  return *fake;
+}
+
 Analysis RunLevel(const std::vector<KnobValue>& planted, const FakeExtras& extras = {}) {
   const FakePair pair = MakeFakePair(LevelFake(), planted, extras);
   return Analyse(pair.sim, pair.real, &LevelFake(), FastOptions());
@@ -88,6 +101,58 @@ TEST(Posture, ATiltNoNamedKnobGivesIsADoubt) {
   ASSERT_TRUE(SaysPosture(a.verdict)) << a.verdict.sentence;
   EXPECT_NE(a.verdict.sentence.find("IMU mounted off level"), std::string::npos)
       << "the fake's tilt moves the standing posture alike: " << a.verdict.sentence;
+}
+
+bool Names(const Verdict& v, const std::string& knob) {
+  for (const VerdictNamed& n : v.named) {
+    if (n.knob == knob) return true;
+  }
+  return false;
+}
+
+// The motion as the torso tilted by (0.1, -0.08) rad more than the recorded z says would give it: an
+// IMU offset in x given z. With `in_the_imu_too` it is one (the recorded z moved); else the recorded z
+// is what the torso does.
+FakeExtras ImuOffsetInTheMotion(bool in_the_imu_too) {
+  FakeExtras extras;
+  const Eigen::Vector2d b(0.1, -0.08);
+  (in_the_imu_too ? extras.imu_offset : extras.motion_tilt) = in_the_imu_too ? b : Eigen::Vector2d(-b);
+  return extras;
+}
+
+TEST(Posture, ANamedImuOffsetThePostureContradictsIsFittedAgainWithoutIt) {
+  const FakeSimulator& fake = SpreadLevelFake();
+  const FakePair pair = MakeFakePair(fake, {{kRightGain, 0.5}}, ImuOffsetInTheMotion(false));
+  AnalysisOptions keep = FastOptions();
+  keep.posture.refit_without_imu = false;
+  const Analysis kept = Analyse(pair.sim, pair.real, &fake, keep);
+  ASSERT_TRUE(Names(kept.verdict, "imu.pitch_roll_offset")) << "the motion reads as one: " << kept.verdict.sentence;
+  ASSERT_TRUE(kept.posture.left_out) << "the recorded z did not move: " << kept.posture.z_left;
+  EXPECT_FALSE(kept.imu_contradicted.refitted);
+  EXPECT_NE(kept.verdict.sentence.find("the offset is not what the IMU reads"), std::string::npos)
+      << kept.verdict.sentence;
+
+  const Analysis a = Analyse(pair.sim, pair.real, &fake, FastOptions());
+  ASSERT_TRUE(a.imu_contradicted.refitted) << a.verdict.sentence;
+  EXPECT_EQ(a.imu_contradicted.check.imu, kept.posture.imu) << "the first fit is the run without the refit";
+  EXPECT_FALSE(Names(a.verdict, "imu.pitch_roll_offset")) << a.verdict.sentence;
+  EXPECT_TRUE(Names(a.verdict, "actuators.side.right.gain")) << a.verdict.sentence;
+  EXPECT_EQ(a.posture.imu, Eigen::Vector2d::Zero());
+  EXPECT_FALSE(a.posture.left_out) << a.posture.z_left;
+  EXPECT_NE(a.verdict.sentence.find("ran again without an IMU offset"), std::string::npos) << a.verdict.sentence;
+  EXPECT_GT(a.candidates.requests, kept.candidates.requests) << "both runs' recordings are counted";
+}
+
+// The same motion with the recorded z moved by the offset: the posture bears the offset out (its
+// size may differ from the fit's: the fake's weak side rolls the torso too).
+TEST(Posture, AnImuOffsetThePostureBearsOutStaysNamed) {
+  const FakePair pair = MakeFakePair(SpreadLevelFake(), {{kRightGain, 0.5}}, ImuOffsetInTheMotion(true));
+  const Analysis a = Analyse(pair.sim, pair.real, &SpreadLevelFake(), FastOptions());
+  ASSERT_TRUE(a.posture.ran) << a.posture.why;
+  EXPECT_TRUE(Names(a.verdict, "imu.pitch_roll_offset")) << a.verdict.sentence;
+  EXPECT_GE(a.posture.z_left_without_imu, 4) << "the real z moved: without the offset the posture is further off";
+  EXPECT_LT(a.posture.z_left, a.posture.z_left_without_imu);
+  EXPECT_FALSE(a.imu_contradicted.refitted);
 }
 
 TEST(Posture, ANullPairOnLevelGroundStaysClean) {
