@@ -105,14 +105,16 @@ void TestResidual(const AnalysisInputs& in, const Baseline& base, const Refineme
   // step test compares the real step profile with the sim set's (cross-fitted) one. Both on every
   // ground since 2026-12-05; until then, on a plane, against the sim set's in-sample residuals
   // with the normal SE and against no step profile: three of four null pairs of the planar
-  // quadruped came out `unexplained` (tails, step).
+  // quadruped came out `unexplained` (tails, step). The command test compares the real command
+  // means with the sim set's (cross-fitted) since 2026-12-05, late: against none, every pair on
+  // record had "command" at p 0.001 (the sim model's own error per command), `explained` ones too.
   ResidualStructureOptions residual = options.residual;
   residual.tails_bootstrap = kTailsBootstrap;
   const double sim_se = ExcessKurtosisSe(base.sim_residuals, in.sim.episode, kTailsBootstrap, options.seed + 2);
   const std::vector<int> sim_step = SimSteps(in);
-  const SimStepReference sim_steps{&base.sim_residuals, &in.sim.episode, &sim_step};
+  const SimReference sim_reference{&base.sim_residuals, &in.sim.episode, &sim_step, &in.sim.command};
   out->residual = TestResidualStructure(out->residuals, in.real.command, terrain_id, in.real.episode, step,
-                                        ExcessKurtosis(base.sim_residuals), residual, options.seed, sim_se, sim_steps);
+                                        ExcessKurtosis(base.sim_residuals), residual, options.seed, sim_se, sim_reference);
 }
 
 // The held-out fit against the ceiling; the located regions that remain.

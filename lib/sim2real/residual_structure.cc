@@ -1,6 +1,7 @@
 #include "sim2real/residual_structure.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <numeric>
@@ -137,6 +138,62 @@ void GroupTest(const EpisodeUnits& e, const std::string& where, const std::vecto
   out->tests.push_back(t);
 }
 
+// The two sets' command means compared: sum_c w_c |m_real,c - m_sim,c|^2, w_c = N_r N_s / (N_r +
+// N_s), over the pooled episode units `u` whose `real` flag says which set they are of.
+double CommandContrast(const EpisodeUnits& u, const std::vector<char>& real) {
+  struct Side {
+    Eigen::VectorXd sum;
+    int n = 0;
+  };
+  std::map<int, std::array<Side, 2>> by_command;
+  for (size_t k = 0; k < u.count.size(); ++k) {
+    if (u.command[k] < 0) continue;
+    Side& side = by_command[u.command[k]][real[k] ? 0 : 1];
+    if (side.n == 0) side.sum = Eigen::VectorXd::Zero(u.sum.cols());
+    side.sum += u.sum.row(k).transpose();
+    side.n += u.count[k];
+  }
+  double t = 0;
+  for (const auto& [c, s] : by_command) {
+    if (s[0].n == 0 || s[1].n == 0) continue;
+    const double w = static_cast<double>(s[0].n) * s[1].n / (s[0].n + s[1].n);
+    t += w * (s[0].sum / s[0].n - s[1].sum / s[1].n).squaredNorm();
+  }
+  return t;
+}
+
+// Command against the sim set's own residuals: are the real command means the sim set's? The
+// set labels are permuted over each command's episodes of both sets.
+void CommandTestAgainstSim(const EpisodeUnits& real, const EpisodeUnits& sim, int permutations, std::mt19937_64& rng,
+                           ResidualStructure* out) {
+  EpisodeUnits pooled;
+  pooled.sum.resize(real.sum.rows() + sim.sum.rows(), real.sum.cols());
+  pooled.sum << real.sum, sim.sum;
+  pooled.count = real.count, pooled.command = real.command;
+  pooled.count.insert(pooled.count.end(), sim.count.begin(), sim.count.end());
+  pooled.command.insert(pooled.command.end(), sim.command.begin(), sim.command.end());
+  std::vector<char> is_real(pooled.count.size(), 0);
+  std::fill(is_real.begin(), is_real.begin() + real.count.size(), 1);
+  std::map<int, std::vector<int>> units_of;
+  for (size_t k = 0; k < pooled.command.size(); ++k) units_of[pooled.command[k]].push_back(static_cast<int>(k));
+  ResidualTest t;
+  t.where = "command";
+  t.statistic = CommandContrast(pooled, is_real);
+  std::vector<double> null;
+  std::vector<char> perm = is_real, labels;
+  for (int p = 0; p < permutations; ++p) {
+    for (const auto& [c, units] : units_of) {
+      labels.clear();
+      for (int k : units) labels.push_back(is_real[k]);
+      std::shuffle(labels.begin(), labels.end(), rng);
+      for (size_t j = 0; j < units.size(); ++j) perm[units[j]] = labels[j];
+    }
+    null.push_back(CommandContrast(pooled, perm));
+  }
+  t.p_value = PermutationP(t.statistic, null);
+  out->tests.push_back(t);
+}
+
 // Residuals minus their episode's mean, their step labels and each episode's rows.
 struct StepRows {
   Eigen::MatrixXd centred;
@@ -212,7 +269,7 @@ double StepStatistic(const StepRows& real, const std::vector<int>& real_step, co
 // differs from the sim set's, which the model's own shortcomings shape as much); then the
 // periodicity of the step-mean profile (its main direction's lag-1 autocorrelation).
 void StepTest(const Eigen::MatrixXd& r, const std::vector<int>& episode, const std::vector<int>& step,
-              const SimStepReference& sim_ref, int permutations, std::mt19937_64& rng, ResidualStructure* out) {
+              const SimReference& sim_ref, int permutations, std::mt19937_64& rng, ResidualStructure* out) {
   const StepRows real = CentreByEpisode(r, episode, step);
   // A sim set without execution indices (no sequence data) has no profile to compare with.
   const bool two = sim_ref.residuals && sim_ref.episode && sim_ref.step && sim_ref.residuals->rows() > 0 &&
@@ -252,15 +309,21 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vec
                                         const std::vector<int>& terrain, const std::vector<int>& episode,
                                         const std::vector<int>& step, double sim_kurtosis,
                                         const ResidualStructureOptions& options, std::uint64_t seed,
-                                        double sim_kurtosis_se, const SimStepReference& sim_steps) {
+                                        double sim_kurtosis_se, const SimReference& sim_ref) {
   ResidualStructure out;
   const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
   std::mt19937_64 rng(seed);
   const EpisodeUnits e = Units(r, command, terrain, episode);
-  GroupTest(e, "command", e.command, options.permutations, rng, &out);
+  if (sim_ref.residuals && sim_ref.episode && sim_ref.command && sim_ref.residuals->rows() > 0) {
+    const std::vector<int> no_terrain(sim_ref.residuals->rows(), -1);
+    const EpisodeUnits sim = Units(*sim_ref.residuals, *sim_ref.command, no_terrain, *sim_ref.episode);
+    CommandTestAgainstSim(e, sim, options.permutations, rng, &out);
+  } else {
+    GroupTest(e, "command", e.command, options.permutations, rng, &out);
+  }
   GroupTest(e, "terrain", e.terrain, options.permutations, rng, &out);
   const bool has_steps = std::any_of(step.begin(), step.end(), [](int s) { return s > 0; });
-  if (has_steps && static_cast<int>(e.count.size()) < n) StepTest(r, episode, step, sim_steps, options.permutations, rng, &out);
+  if (has_steps && static_cast<int>(e.count.size()) < n) StepTest(r, episode, step, sim_ref, options.permutations, rng, &out);
   if (std::isfinite(sim_kurtosis)) {
     ResidualTest t;
     t.where = "tails";
