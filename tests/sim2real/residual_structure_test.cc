@@ -140,13 +140,10 @@ TEST(ResidualStructure, AStepProfileTheSimSetSharesIsNotStructure) {
 // offset on column 0 by `offset` times the command's id mod 3 minus 1 (the model's misfit per command).
 Eigen::MatrixXd CommandOffsets(int episodes, double offset, std::mt19937_64& rng, std::vector<int>* episode,
                                std::vector<int>* command) {
-  std::normal_distribution<double> unit(0, 1);
-  Eigen::MatrixXd r(5 * episodes, 3);
-  episode->resize(r.rows());
+  std::vector<int> step;
+  Eigen::MatrixXd r = StepProfiled(episodes, {0, 0, 0, 0, 0}, rng, episode, &step);
   command->resize(r.rows());
   for (int i = 0; i < r.rows(); ++i) {
-    for (int j = 0; j < 3; ++j) r(i, j) = unit(rng);
-    (*episode)[i] = i / 5;
     (*command)[i] = (i / 5) % 12;
     r(i, 0) += offset * ((*command)[i] % 3 - 1);
   }
