@@ -82,7 +82,7 @@ void AddTrackerEffects(const AnalysisInputs& in, CandidateSet* set) {
 // last in the library.
 void AddImuAndHeading(const AnalysisInputs& in, bool imu_offset, CandidateSet* set) {
   if (imu_offset && in.real.terrain_dim() >= 2) {
-    AddMeasurement({"imu_bias", "imu_bias", "imu.pitch_roll_offset", "rad"},
+    AddMeasurement({"imu_bias", "imu_bias", kImuOffsetKnob, "rad"},
                    ExternalSpec("imu_bias", "IMU (terrain) pitch/roll offset", 2, "rad"), ExternalCandidate::kImuBias, set);
   }
   if (in.layout.dyaw >= 0) {

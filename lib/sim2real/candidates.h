@@ -52,6 +52,9 @@ struct CandidateOptions {
   bool IsValid(std::string* error) const;
 };
 
+// The knob name under which the IMU's pitch/roll offset (a measurement effect) is named.
+inline constexpr char kImuOffsetKnob[] = "imu.pitch_roll_offset";
+
 struct KnobCandidate {
   std::string key;      // e.g. "floor.friction.sliding@0.6", "payload", "tracker_bias"
   std::string family;

@@ -4,6 +4,7 @@
 #include <map>
 #include <random>
 
+#include "sim2real/candidates.h"
 #include "sim2real/sentence_format.h"
 #include "sim2real/verdict.h"
 #include "util/error.h"
@@ -217,7 +218,7 @@ std::string ContradictedImuSentence(const ContradictedImu& c) {
   if (!c.refitted) return "";
   std::vector<std::string> others;
   for (const std::string& n : c.named) {
-    if (n != "imu.pitch_roll_offset") others.push_back(n);
+    if (n != kImuOffsetKnob) others.push_back(n);
   }
   return " A first fit named " + (others.empty() ? std::string() : JoinWords(others) + " and ") +
          Fmt("an IMU offset of (%+.1f,", 1e3 * c.check.imu(0)) + Fmt(" %+.1f) mrad, which the torso's posture", 1e3 * c.check.imu(1)) +

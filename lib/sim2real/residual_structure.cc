@@ -272,7 +272,7 @@ void StepTest(const Eigen::MatrixXd& r, const std::vector<int>& episode, const s
               const SimReference& sim_ref, int permutations, std::mt19937_64& rng, ResidualStructure* out) {
   const StepRows real = CentreByEpisode(r, episode, step);
   // A sim set without execution indices (no sequence data) has no profile to compare with.
-  const bool two = sim_ref.residuals && sim_ref.episode && sim_ref.step && sim_ref.residuals->rows() > 0 &&
+  const bool two = sim_ref.has_residuals() && sim_ref.step &&
                    std::any_of(sim_ref.step->begin(), sim_ref.step->end(), [](int s) { return s > 0; });
   StepRows sim;
   if (two) sim = CentreByEpisode(*sim_ref.residuals, *sim_ref.episode, *sim_ref.step);
@@ -314,7 +314,7 @@ ResidualStructure TestResidualStructure(const Eigen::MatrixXd& r, const std::vec
   const int n = static_cast<int>(r.rows()), dx = static_cast<int>(r.cols());
   std::mt19937_64 rng(seed);
   const EpisodeUnits e = Units(r, command, terrain, episode);
-  if (sim_ref.residuals && sim_ref.episode && sim_ref.command && sim_ref.residuals->rows() > 0) {
+  if (sim_ref.has_residuals() && sim_ref.command) {
     const std::vector<int> no_terrain(sim_ref.residuals->rows(), -1);
     const EpisodeUnits sim = Units(*sim_ref.residuals, *sim_ref.command, no_terrain, *sim_ref.episode);
     CommandTestAgainstSim(e, sim, options.permutations, rng, &out);

@@ -55,6 +55,8 @@ struct SimReference {
   const std::vector<int>* episode = nullptr;
   const std::vector<int>* step = nullptr;
   const std::vector<int>* command = nullptr;
+  // Residuals and placements given, with at least one row (what every two-set test needs).
+  bool has_residuals() const { return residuals && episode && residuals->rows() > 0; }
 };
 
 // `residuals` n x dx; `command`, `terrain` (region id, -1: none), `episode`, `step` per sample
