@@ -398,8 +398,9 @@ void Setup(CLI::App& root) {
                 "run the payload search also when the named physics leaves the torso's posture out (--posture; on "
                 "by default)");
   cmd->add_flag("--posture,!--no-posture", args->posture,
-                "on level ground, check that the named physics gives the real torso's mean pitch and roll (its "
-                "recording at the sim set's places); a posture it leaves out is a doubt and lets the leg and payload "
+                "on a plane (level, or a slope: the radial part of pitch and roll), check that the named physics "
+                "gives the real torso's mean pitch and roll (its recording at the sim set's places); a posture it "
+                "leaves out is a doubt and lets the leg and payload "
                 "searches challenge the names (on by default; docs/sim2real.md)");
   cmd->add_option("--posture-z", args->posture_z,
                   "standard errors (placements resampled) a posture left out must reach to be a doubt")

@@ -85,6 +85,7 @@ MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_
   total_mass_kg_ = robot.total_mass_kg();
   leg_reach_m_ = robot.leg_reach_m();
   level_ground_ = robot.LevelGround();
+  plane_ground_ = robot.PlaneGround();
 }
 
 std::vector<sim::KnobValue> MujocoKnobSimulator::ToSim(const std::vector<sim2real::KnobValue>& values) const {

@@ -28,6 +28,7 @@ class MujocoKnobSimulator : public sim2real::KnobSimulator {
   double total_mass_kg() const override { return total_mass_kg_; }
   double leg_reach_m() const override { return leg_reach_m_; }
   bool level_ground() const override { return level_ground_; }
+  bool plane_ground() const override { return plane_ground_; }
 
   const sim::SimConfig& config() const { return config_; }
 
@@ -40,6 +41,7 @@ class MujocoKnobSimulator : public sim2real::KnobSimulator {
   std::string fingerprint_;
   double total_mass_kg_ = 0, leg_reach_m_ = 0;
   bool level_ground_ = false;
+  bool plane_ground_ = false;
 };
 
 }  // namespace dgmm::app

@@ -271,8 +271,10 @@ std::string Simulator::SelfContactPair() const {
 
 double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->ground->HeightAt(x_m, y_m); }
 
-bool Simulator::LevelGround() const {
-  if (impl_->config.slope_deg != 0 || impl_->config.terrain) return false;
+bool Simulator::LevelGround() const { return impl_->config.slope_deg == 0 && PlaneGround(); }
+
+bool Simulator::PlaneGround() const {
+  if (impl_->config.terrain) return false;
   const mjModel* m = impl_->walker ? impl_->walker->model() : impl_->model.get();
   for (int g = 0; g < m->ngeom; ++g) {
     if (m->geom_bodyid[g] != 0 || (m->geom_contype[g] == 0 && m->geom_conaffinity[g] == 0)) continue;

@@ -75,6 +75,9 @@ class Simulator {
   // Is the ground level: no slope, no height field, and every geom of the world that the robot can
   // touch a plane facing up (a model's own ramps, boxes or height fields make it uneven)?
   bool LevelGround() const;
+  // Is the ground a plane facing up under gravity tilted by the slope (no height field, every geom
+  // of the world the robot can touch a plane facing up)? A slope of 0 makes it level.
+  bool PlaneGround() const;
   Eigen::Vector2d TruePitchRoll() const; // <pitch, roll> relative to gravity (rad)
   Eigen::Vector3d Up() const;            // unit vector against gravity, slope frame
   double time_s() const;                 // simulated time since construction

@@ -148,7 +148,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     runoff.search = OwnModels(runoff.search, options);
     a->runoff = RunRunoff(simulator, a->inputs, a->candidates, a->refinement, options.candidates, runoff);
     AddRunoff(simulator, &a->runoff, &a->verdict);
-    a->seconds.runoff = Since(t);
+    a->seconds.runoff += Since(t);
   }
   if (!a->runoff.search.named && WantLegSearch(*a, options.legs)) {
     const auto t = Clock::now();
@@ -159,7 +159,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
       LegSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, legs, &a->leg_search);
     }
     AddLegSearch(a->leg_search, &a->verdict);
-    a->seconds.legs = Since(t);
+    a->seconds.legs += Since(t);
   }
   if (WantPayloadSearch(*a, options.payload, challenge)) {
     const auto t = Clock::now();
@@ -171,7 +171,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
       PayloadSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, payload, &a->payload_search);
     }
     AddPayloadSearch(a->payload_search, &a->verdict);
-    a->seconds.payload = Since(t);
+    a->seconds.payload += Since(t);
   }
 }
 

@@ -18,8 +18,8 @@
 //                                    recorded again, each recording scored by its own model;
 //      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
 //                                    searched, each recording scored by its own model;
-//      posture     (posture.h)       on level ground: does the named physics give the real torso's
-//                                    posture (pitch, roll)? Checked before the searches (a posture
+//      posture     (posture.h)       on a plane, level or a slope: does the named physics give the
+//                                    real torso's posture (pitch, roll)? Checked before the searches (a posture
 //                                    left out lets them challenge the names) and on the final names;
 //                                    a named IMU offset it contradicts: 3-8 again without one;
 //      payload     (payload_search.h) on a plane when still nothing is named, or the posture is left
@@ -55,7 +55,7 @@ struct AnalysisOptions {
   LegSearchOptions legs;   // its model options are the baseline's (locate.model)
   RunoffOptions runoff;    // likewise
   PayloadSearchOptions payload;  // likewise; off by default
-  PostureOptions posture;        // the torso's posture beside the motion (level ground; seed: the analysis's)
+  PostureOptions posture;        // the torso's posture beside the motion (a plane, level or a slope; seed: the analysis's)
   // When an effect fits on average but its size varies with the execution index and the
   // signatures recorded fewer executions per placement than the real set has, stages 3-8 run
   // again with signatures of every execution (Analysis::every_execution_because).
@@ -89,6 +89,7 @@ struct AnalysisOptions {
   bool IsValid(std::string* error) const;
 };
 
+// Wall seconds per stage, summed over every run of it (a run again with every execution, a refit).
 struct StageTimes {
   double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, payload = 0,
          posture = 0, total = 0;
@@ -113,7 +114,7 @@ struct Analysis {
   Runoff runoff;                   // ran only on uneven ground with a mismatch left (Runoff::ran)
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
   PayloadSearch payload_search;    // ran only when enabled and still nothing was named (PayloadSearch::ran)
-  PostureCheck posture;            // does the named physics give the real torso's posture (level ground)
+  PostureCheck posture;            // does the named physics give the real torso's posture (a plane, level or a slope)
   // A first fit's IMU offset the posture contradicted (refitted: the stages from the candidates ran
   // again without an IMU offset, and every result here but this is the second run's).
   ContradictedImu imu_contradicted;

@@ -103,6 +103,9 @@ class KnobSimulator {
   // Is the ground level (a plane facing up, no slope, no height field)? Then the torso's posture
   // compares between sets of other placements (posture.h); false by default.
   virtual bool level_ground() const { return false; }
+  // Is the ground a plane (level, or tilted by gravity to a slope; no height field)? On a slope the
+  // posture compares by the radial part of z (posture.h, SlopeGeometry); level_ground() by default.
+  virtual bool plane_ground() const { return level_ground(); }
 
   // Scales for constants relative to the robot: its total mass (kg), leg reach (m).
   virtual double total_mass_kg() const = 0;

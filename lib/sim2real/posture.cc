@@ -28,6 +28,63 @@ std::map<std::string, Eigen::Vector2d> MeanPerCommand(const SampleSet& s, const 
   return sum;
 }
 
+// h(theta) of SlopeGeometry::radius.
+Eigen::Matrix<double, 5, 1> Harmonics(double theta) {
+  Eigen::Matrix<double, 5, 1> h;
+  h << 1, std::cos(theta), std::sin(theta), std::cos(2 * theta), std::sin(2 * theta);
+  return h;
+}
+
+// A row's z relative to the slope's centre: its direction theta and radial part rho~ = |z - c| - R(theta).
+struct Radial {
+  double theta = 0, rho = 0;
+};
+Radial RadialPart(const SampleSet& s, int i, int pitch_col, int roll_col, const SlopeGeometry& g) {
+  const Eigen::Vector2d d = Eigen::Vector2d(s.z(i, pitch_col), s.z(i, roll_col)) - g.centre;
+  const double theta = std::atan2(d(1), d(0));
+  return {theta, d.norm() - Harmonics(theta).dot(g.radius)};
+}
+
+// Mean rho~ and mean unit direction per (command label, direction bin) over `rows`.
+struct RadialCell {
+  double rho = 0;
+  Eigen::Vector2d u = Eigen::Vector2d::Zero();
+  int n = 0;
+};
+std::map<std::pair<std::string, int>, RadialCell> RadialCells(const SampleSet& s, const std::vector<int>& rows,
+                                                             int pitch_col, int roll_col, const SlopeGeometry& g) {
+  std::map<std::pair<std::string, int>, RadialCell> cells;
+  const double width = 2 * M_PI / g.directions;
+  for (int i : rows) {
+    const Radial r = RadialPart(s, i, pitch_col, roll_col, g);
+    const int bin = ((static_cast<int>(std::lround(r.theta / width)) % g.directions) + g.directions) % g.directions;
+    RadialCell& c = cells[{s.command_labels[s.command(i)], bin}];
+    c.rho += r.rho, c.u += Eigen::Vector2d(std::cos(r.theta), std::sin(r.theta)), ++c.n;
+  }
+  for (auto& [key, c] : cells) c.rho /= c.n, c.u /= c.n;
+  return cells;
+}
+
+// d minimising sum over the cells both have of (rho~_a - rho~_b - u . d)^2, u the cells' mean direction.
+Eigen::Vector2d RadialDifference(const SampleSet& a, const std::vector<int>& rows_a, const SampleSet& b,
+                                 const std::vector<int>& rows_b, int pitch_col, int roll_col, const SlopeGeometry& g) {
+  const auto ca = RadialCells(a, rows_a, pitch_col, roll_col, g), cb = RadialCells(b, rows_b, pitch_col, roll_col, g);
+  Eigen::Matrix2d normal = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d rhs = Eigen::Vector2d::Zero();
+  int n = 0;
+  for (const auto& [key, cell] : ca) {
+    const auto it = cb.find(key);
+    if (it == cb.end()) continue;
+    const Eigen::Vector2d u = (cell.u + it->second.u) / 2;
+    normal += u * u.transpose(), rhs += u * (cell.rho - it->second.rho), ++n;
+  }
+  // Both directions spanned: the weaker of the two at least a tenth of an average cell's.
+  if (n < 3 || !(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(normal).eigenvalues()(0) >= 0.1 * n / 2)) {
+    return Eigen::Vector2d::Constant(NAN);
+  }
+  return normal.ldlt().solve(rhs);
+}
+
 // The rows of each placement by its episode id (each row its own without sequence data, and then
 // every row a first execution); `first_only` keeps the first execution of each.
 std::map<int, std::vector<int>> RowsByPlacement(const SampleSet& s, bool first_only) {
@@ -91,7 +148,7 @@ double MaxZ(const Eigen::Vector2d& v, const Eigen::Vector2d& se) {
 std::string WhyNot(const KnobSimulator& simulator, const AnalysisInputs& in, const PostureOptions& options) {
   if (!options.enabled) return "turned off (--no-posture)";
   if (in.pitch_col < 0 || in.roll_col < 0) return "the sets' z has no pitch and roll";
-  if (!simulator.level_ground()) return "the simulator's ground is not level (a slope or a height field)";
+  if (!simulator.plane_ground()) return "the simulator's ground is not a plane (a height field)";
   if (!in.sim_set.has_sequence() || !in.real_set.has_sequence()) return "a set has no placements (episodes)";
   return "";
 }
@@ -106,8 +163,45 @@ bool PostureOptions::IsValid(std::string* error) const {
   return true;
 }
 
+SlopeGeometry FitSlopeGeometry(const SampleSet& reference, int pitch_col, int roll_col) {
+  SlopeGeometry g;
+  const int n = reference.size();
+  if (n < 3) {
+    g.why = "fewer than three samples";
+    return g;
+  }
+  // Circle: |z|^2 = 2 c . z + k, k = r^2 - |c|^2 (algebraic least squares).
+  Eigen::MatrixXd a(n, 3);
+  Eigen::VectorXd b(n);
+  for (int i = 0; i < n; ++i) {
+    const double p = reference.z(i, pitch_col), r = reference.z(i, roll_col);
+    a.row(i) << 2 * p, 2 * r, 1;
+    b(i) = p * p + r * r;
+  }
+  const Eigen::Vector3d circle = a.colPivHouseholderQr().solve(b);
+  g.centre = circle.head<2>();
+  Eigen::MatrixXd h(n, 5);
+  Eigen::VectorXd rho(n);
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d d = Eigen::Vector2d(reference.z(i, pitch_col), reference.z(i, roll_col)) - g.centre;
+    h.row(i) = Harmonics(std::atan2(d(1), d(0))).transpose();
+    rho(i) = d.norm();
+  }
+  g.radius = h.completeOrthogonalDecomposition().solve(rho);
+  const double rms = std::sqrt((rho - h * g.radius).squaredNorm() / n), radius = g.radius(0);
+  if (!g.centre.allFinite() || !g.radius.allFinite() || !(radius >= 4 * rms)) {
+    g.why = Fmt("z does not trace the slope's circle clearly (radius %.3g rad,", radius) +
+            Fmt(" radial residuals %.3g rad RMS)", rms);
+    return g;
+  }
+  g.valid = true;
+  return g;
+}
+
 Eigen::Vector2d PostureDifference(const SampleSet& a, const std::vector<int>& rows_a, const SampleSet& b,
-                                  const std::vector<int>& rows_b, int pitch_col, int roll_col) {
+                                  const std::vector<int>& rows_b, int pitch_col, int roll_col,
+                                  const SlopeGeometry* slope) {
+  if (slope) return RadialDifference(a, rows_a, b, rows_b, pitch_col, roll_col, *slope);
   const auto ma = MeanPerCommand(a, rows_a, pitch_col, roll_col), mb = MeanPerCommand(b, rows_b, pitch_col, roll_col);
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   int n = 0;
@@ -121,21 +215,22 @@ Eigen::Vector2d PostureDifference(const SampleSet& a, const std::vector<int>& ro
 }
 
 PostureShift MeasurePostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col, bool first_only,
-                                 int resamples, std::uint64_t seed) {
+                                 int resamples, std::uint64_t seed, const SlopeGeometry* slope) {
   const auto ua = Placements(a, first_only), ub = Placements(b, first_only);
   PostureShift out;
   if (ua.empty() || ub.empty()) return out;
   const int na = static_cast<int>(ua.size()), nb = static_cast<int>(ub.size());
-  out.shift = PostureDifference(a, Concatenate(ua, All(na)), b, Concatenate(ub, All(nb)), pitch_col, roll_col);
+  out.shift = PostureDifference(a, Concatenate(ua, All(na)), b, Concatenate(ub, All(nb)), pitch_col, roll_col, slope);
   out.se = SpreadOfDraws(resamples, seed, [&](std::mt19937_64* rng) {
     const std::vector<int> pick_a = Resample(na, rng), pick_b = Resample(nb, rng);
-    return PostureDifference(a, Concatenate(ua, pick_a), b, Concatenate(ub, pick_b), pitch_col, roll_col);
+    return PostureDifference(a, Concatenate(ua, pick_a), b, Concatenate(ub, pick_b), pitch_col, roll_col, slope);
   });
   return out;
 }
 
 PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col,
-                                       bool first_only, int resamples, std::uint64_t seed) {
+                                       bool first_only, int resamples, std::uint64_t seed,
+                                       const SlopeGeometry* slope) {
   PostureShift out;
   if (!a.has_sequence() || !b.has_sequence()) return out;
   // The placements both recordings kept (a probe that topples the robot keeps fewer), by episode id.
@@ -148,10 +243,10 @@ PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, i
   }
   const int n = static_cast<int>(ua.size());
   if (n == 0) return out;
-  out.shift = PostureDifference(a, Concatenate(ua, All(n)), b, Concatenate(ub, All(n)), pitch_col, roll_col);
+  out.shift = PostureDifference(a, Concatenate(ua, All(n)), b, Concatenate(ub, All(n)), pitch_col, roll_col, slope);
   out.se = SpreadOfDraws(resamples, seed, [&](std::mt19937_64* rng) {
     const std::vector<int> pick = Resample(n, rng);
-    return PostureDifference(a, Concatenate(ua, pick), b, Concatenate(ub, pick), pitch_col, roll_col);
+    return PostureDifference(a, Concatenate(ua, pick), b, Concatenate(ub, pick), pitch_col, roll_col, slope);
   });
   return out;
 }
@@ -167,10 +262,22 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
   c.why = WhyNot(simulator, in, options);
   if (!c.why.empty()) return c;
   const int p = in.pitch_col, r = in.roll_col;
-  c.walking = MeasurePostureShift(in.real_set, in.sim_set, p, r, false, options.resamples, options.seed);
-  c.standing = MeasurePostureShift(in.real_set, in.sim_set, p, r, true, options.resamples, options.seed + 1);
+  c.on_slope = !simulator.level_ground();
+  SlopeGeometry sim_slope, nominal_slope;  // on a slope: where the sim set's and the nominal's z lie
+  if (c.on_slope) {
+    sim_slope = FitSlopeGeometry(in.sim_set, p, r), nominal_slope = FitSlopeGeometry(nominal, p, r);
+    if (!sim_slope.valid || !nominal_slope.valid) {
+      c.why = "on the slope " + (sim_slope.valid ? nominal_slope.why + " in the nominal recording"
+                                                 : sim_slope.why + " in the sim set");
+      return c;
+    }
+  }
+  const SlopeGeometry* slope = c.on_slope ? &sim_slope : nullptr;
+  c.walking = MeasurePostureShift(in.real_set, in.sim_set, p, r, false, options.resamples, options.seed, slope);
+  c.standing = MeasurePostureShift(in.real_set, in.sim_set, p, r, true, options.resamples, options.seed + 1, slope);
   if (!c.walking.shift.allFinite() || !(c.walking.se.minCoeff() > 0)) {
-    c.why = "the sets share no command with a measurable spread of z";
+    c.why = c.on_slope ? "the sets share no command in two directions on the slope with a measurable spread of z"
+                       : "the sets share no command with a measurable spread of z";
     return c;
   }
   c.ran = true;
@@ -178,10 +285,11 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
   if (!values.empty()) {
     const SampleSet corrected = RecordBatch(simulator, recording, {values}, recording_options).sets.at(0);
     c.recorded = true;
+    const SlopeGeometry* at_nominal = c.on_slope ? &nominal_slope : nullptr;
     const PostureShift walking = MeasurePairedPostureShift(corrected, nominal, p, r, false, options.resamples,
-                                                           options.seed + 2);
+                                                           options.seed + 2, at_nominal);
     const PostureShift standing = MeasurePairedPostureShift(corrected, nominal, p, r, true, options.resamples,
-                                                            options.seed + 3);
+                                                            options.seed + 3, at_nominal);
     if (walking.shift.allFinite() && walking.se.allFinite()) c.predicted += walking.shift, c.predicted_se = walking.se;
     if (standing.shift.allFinite()) c.predicted_standing += standing.shift;
   }

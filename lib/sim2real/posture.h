@@ -13,8 +13,13 @@
 // A component of l at >= z standard errors is a posture the named physics does not give. The same
 // for the first execution of each placement (the robot standing after it was placed) tells the
 // two apart: an IMU mounted off level moves both alike, a payload or a weak leg the walking
-// posture far more than the standing one. On a slope z lies on a circle around the posture and on
-// a height field it depends on where the robot stands: the check does not run there.
+// posture far more than the standing one. On a slope tilted by gravity z lies on a closed curve
+// around the posture (radius the slope), and where on it depends on the heading, which a turn
+// changes between executions: there only the radial part of z compares (SlopeGeometry),
+//   rho~ = |z - c| - R(theta),   mean rho~_a - mean rho~_b = u . d   per (command, direction) cell,
+// with c the sim set's circle centre, R its radius per direction theta (harmonics up to the
+// second), u the cell's unit direction, d the posture shift (least squares over the cells both sets
+// have). On a height field z depends on where the robot stands: the check does not run there.
 #include <Eigen/Dense>
 #include <cstdint>
 #include <string>
@@ -41,10 +46,27 @@ struct PostureOptions {
   bool IsValid(std::string* error) const;
 };
 
+// Where z lies on a slope tilted by gravity, fitted to a reference set: the circle's centre c
+// (algebraic least squares) and its radius per direction, R(theta) = h(theta) . radius with
+// h = (1, cos, sin, cos 2theta, sin 2theta) (minimum-norm least squares: three headings suffice).
+struct SlopeGeometry {
+  bool valid = false;
+  std::string why;  // why not valid
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  Eigen::Matrix<double, 5, 1> radius = Eigen::Matrix<double, 5, 1>::Zero();
+  int directions = 12;  // cells per command by the direction of z - c (bins centred on multiples of 30 deg)
+};
+// Fitted to every row of `reference`; not valid when z does not trace a circle clearly (its radius
+// under 4 times the RMS of the radial residuals, or fewer than three distinct directions).
+SlopeGeometry FitSlopeGeometry(const SampleSet& reference, int pitch_col, int roll_col);
+
 // Per command mean z (pitch, roll columns) of `a` minus that of `b`, averaged over the commands
 // both have (matched by label), on the rows `rows_a` and `rows_b`; NaN without a shared command.
+// With `slope`, the posture shift d from the radial parts per (command, direction) cell (above);
+// NaN when the cells both have do not span two directions.
 Eigen::Vector2d PostureDifference(const SampleSet& a, const std::vector<int>& rows_a, const SampleSet& b,
-                                  const std::vector<int>& rows_b, int pitch_col, int roll_col);
+                                  const std::vector<int>& rows_b, int pitch_col, int roll_col,
+                                  const SlopeGeometry* slope = nullptr);
 
 // d(a, b) on every row (`first_only`: the first execution of each placement) and its standard
 // error from `resamples` draws of each set's placements with replacement.
@@ -52,12 +74,13 @@ struct PostureShift {
   Eigen::Vector2d shift = Eigen::Vector2d::Constant(NAN), se = Eigen::Vector2d::Constant(NAN);
 };
 PostureShift MeasurePostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col, bool first_only,
-                                 int resamples, std::uint64_t seed);
+                                 int resamples, std::uint64_t seed, const SlopeGeometry* slope = nullptr);
 
 // d(a, b) of two recordings at the same places (`a` a knob's, `b` the nominal's), its standard
 // error from resampling the placements both have, jointly (a paired difference).
 PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col,
-                                       bool first_only, int resamples, std::uint64_t seed);
+                                       bool first_only, int resamples, std::uint64_t seed,
+                                       const SlopeGeometry* slope = nullptr);
 
 struct PostureCheck {
   bool ran = false;
@@ -75,10 +98,12 @@ struct PostureCheck {
   double z_left_without_imu = 0;  // the same without it (a named IMU offset the posture contradicts)
   bool recorded = false;       // the correction was recorded (false: it holds no simulator knob)
   std::string correction;      // what was checked, in words ("nothing named", "the named correction")
+  bool on_slope = false;       // compared by the radial part of z on the slope's circle (SlopeGeometry)
 };
 
 // The check for a correction of simulator knobs `values` (may be empty) and an IMU offset `imu`
-// (rad, pitch and roll; zero when none is named). `level_ground` from the simulator; `nominal` the
+// (rad, pitch and roll; zero when none is named). The ground from the simulator (level_ground,
+// plane_ground: on a slope the sets compare by SlopeGeometry, fitted to the sim set); `nominal` the
 // nominal re-recording at the sim set's places the correction's recording pairs with.
 PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& in, const SampleSet& nominal,
                           const Recording& recording, const RecordingOptions& recording_options,

@@ -316,7 +316,8 @@ std::string PayloadSearchTables(const PayloadSearch& p) {
 std::string PostureParagraph(const PostureCheck& c) {
   if (!c.ran) return c.why.empty() ? "" : "<p>The torso's posture was not checked: " + Escape(c.why) + ".</p>\n";
   const auto mrad = [](const Eigen::Vector2d& v) { return F("%+.1f", 1e3 * v(0)) + ", " + F("%+.1f", 1e3 * v(1)); };
-  return "<p>The torso's posture (mrad, pitch, roll): real minus sim " + mrad(c.walking.shift) + " while walking (SE " +
+  return "<p>The torso's posture (mrad, pitch, roll" + std::string(c.on_slope ? "; on the slope from z's radial part" : "") +
+         "): real minus sim " + mrad(c.walking.shift) + " while walking (SE " +
          mrad(c.walking.se) + "), " + mrad(c.standing.shift) + " standing after a placement (SE " +
          mrad(c.standing.se) + "); " + Escape(c.correction) + " gives " + mrad(c.predicted) + ", leaving " +
          F("%.1f", c.z_left) + " SE" + (c.left_out ? " (a doubt)" : "") + ".</p>\n";

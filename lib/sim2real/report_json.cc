@@ -263,7 +263,7 @@ json Pair(const Eigen::Vector2d& v) { return json::array({JsonNumber(v(0)), Json
 // The posture check (rad, pitch and roll); null when it did not run for want of a simulator.
 json PostureJson(const PostureCheck& c) {
   if (!c.ran) return c.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", c.why}});
-  return {{"ran", true},
+  return {{"ran", true}, {"on_slope", c.on_slope},
           {"walking", {{"shift", Pair(c.walking.shift)}, {"se", Pair(c.walking.se)}}},
           {"standing", {{"shift", Pair(c.standing.shift)}, {"se", Pair(c.standing.se)}}},
           {"correction", c.correction}, {"recorded", c.recorded},

@@ -127,15 +127,19 @@ TEST_F(GroundTest, AnyRobotFromItsOwnFolderWalksOnRoughGround) {
   EXPECT_GT(DeltaPoseBody(start, sim.TorsoPose())[0], 0.05);
 }
 
-// Level ground is a plane facing up: no slope, no height field (the posture check of
-// lib/sim2real/posture.h runs only there).
+// Level ground is a plane facing up: no slope, no height field; plane ground allows the slope (the
+// posture check of lib/sim2real/posture.h compares z directly on the first, radially on the second,
+// and not at all on a height field).
 TEST_F(GroundTest, LevelGroundIsAPlaneWithoutSlopeOrHeights) {
   SimConfig c = LoadSimConfig((fs::path(DGMM_SOURCE_DIR) / "datasets" / "robots" / "hexapod.json").string());
   EXPECT_FALSE(Simulator(c).LevelGround()) << "the hexapod's 10 degree slope";
+  EXPECT_TRUE(Simulator(c).PlaneGround()) << "the hexapod's 10 degree slope";
   c.slope_deg = 0;
   EXPECT_TRUE(Simulator(c).LevelGround());
+  EXPECT_TRUE(Simulator(c).PlaneGround());
   c.terrain = Stony();
   EXPECT_FALSE(Simulator(c).LevelGround()) << "a height field";
+  EXPECT_FALSE(Simulator(c).PlaneGround()) << "a height field";
 }
 
 TEST_F(GroundTest, MissingRobotFileIsNamed) {

@@ -87,7 +87,7 @@ Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, do
   return x;
 }
 
-// The torso's tilt on level ground (FakeSimulator::level).
+// The torso's tilt on level ground (FakeSimulator::level), and about the slope's (sloped_plane).
 Eigen::Vector2d Posture(const Values& k, const FakeExtras& extras) {
   const double m = k.v[kPayloadMass];
   return Eigen::Vector2d(0.1 * m * k.v[kPayloadX], 0.1 * m * k.v[kPayloadY] + 0.04 * (k.v[kLeftGain] - k.v[kRightGain])) +
@@ -168,7 +168,8 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
     }
     for (int e = 0; e < executions; ++e) {
       const int i = executions * p + e;
-      const Eigen::Vector2d tilt = level ? Posture(k, extras) : kSlopeRad * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      const Eigen::Vector2d slope = kSlopeRad * Eigen::Vector2d(std::cos(heading), std::sin(heading));
+      const Eigen::Vector2d tilt = level ? Posture(k, extras) : sloped_plane ? slope + Posture(k, extras) : slope;
       const double z_sd = level ? level_z_sd : 0.02;
       const double pitch = tilt(0) + z_sd * unit(rng);
       const double roll = tilt(1) + z_sd * unit(rng);

@@ -79,6 +79,7 @@ class FakeSimulator : public KnobSimulator {
                       std::to_string(payload.bend)
                 : "") +
            (payload.offset_alone ? "-offset-alone" : "") + (level ? "-level" : "") +
+           (sloped_plane ? "-sloped-plane" : "") +
            (level_z_sd != 0.02 ? "-z-sd-" + std::to_string(level_z_sd) : "") +
            (tilt_steers != 0 ? "-tilt-steers-" + std::to_string(tilt_steers) : "");
   }
@@ -88,6 +89,7 @@ class FakeSimulator : public KnobSimulator {
   double total_mass_kg() const override { return 10.0; }
   double leg_reach_m() const override { return 0.3; }
   bool level_ground() const override { return level; }
+  bool plane_ground() const override { return level || sloped_plane; }
 
   // A recording with extras (the planted real set), `seed` its common random numbers.
   SampleSet RecordWith(const Recording& recording, const std::vector<KnobValue>& values, const FakeExtras& extras) const;
@@ -108,6 +110,9 @@ class FakeSimulator : public KnobSimulator {
   // of the slope's tilt at the heading.
   bool level = false;
   double level_z_sd = 0.02;  // the noise of z about that posture (rad)
+  // A slope that is a plane (else the fake's slope counts as uneven ground, where the posture is not
+  // checked): z is the slope's tilt at the heading plus the posture above.
+  bool sloped_plane = false;
   // The tilt steers the turn: x += tilt_steers turn (pitch, roll, 0), a slope of x in z that changes
   // sign with the command (a constant shift of z then reads as no tracker offset).
   double tilt_steers = 0;

@@ -1,6 +1,7 @@
 // The torso's posture beside the motion (posture.h): the shift of mean z between two sets, and in
 // the whole analysis on the fake's level ground a named correction that gives the real posture
-// (a weak side tilts the fake's roll) against one that leaves a tilt out; on a slope no check.
+// (a weak side tilts the fake's roll) against one that leaves a tilt out; on a sloped plane the
+// radial part of z; on uneven ground no check.
 #include "sim2real/posture.h"
 
 #include <gtest/gtest.h>
@@ -163,12 +164,97 @@ TEST(Posture, ANullPairOnLevelGroundStaysClean) {
   EXPECT_EQ(a.verdict.status, "clean") << a.verdict.sentence;
 }
 
-TEST(Posture, NoCheckOnASlopeOrWhenTurnedOff) {
-  FakeSimulator sloped;
-  const FakePair pair = MakeFakePair(sloped, {{kRightGain, 0.5}});
-  const Analysis a = Analyse(pair.sim, pair.real, &sloped, FastOptions());
+const FakeSimulator& SlopedPlaneFake() {
+  static const FakeSimulator* fake = [] {
+    auto* f = new FakeSimulator();
+    f->sloped_plane = true;
+    return f;
+  }();
+  return *fake;
+}
+
+// The fake's 0.3 rad slope: z on a circle around the posture, the heading's place on it.
+TEST(Posture, OnASlopeTheShiftComesFromTheRadialPartOfZ) {
+  const FakeSimulator& fake = SlopedPlaneFake();
+  Recording r;
+  r.protocol = "paper";
+  r.seed = 3;
+  const SampleSet sim = fake.Record(r, {}, 1);
+  const SlopeGeometry g = FitSlopeGeometry(sim, 0, 1);
+  ASSERT_TRUE(g.valid) << g.why;
+  EXPECT_NEAR(g.radius(0), 0.3, 0.01);
+  EXPECT_LT(g.centre.norm(), 0.01);
+  r.seed = 4;
+  FakeExtras tilt;
+  tilt.posture = Eigen::Vector2d(0.01, -0.02);
+  const SampleSet real = fake.RecordWith(r, {}, tilt), null = fake.Record(r, {}, 1);
+  const PostureShift d = MeasurePostureShift(real, sim, 0, 1, false, 100, 5, &g);
+  ASSERT_TRUE(d.se.allFinite());
+  EXPECT_LT(d.se.maxCoeff(), 0.005);
+  EXPECT_NEAR(d.shift(0), 0.01, 4 * d.se(0));
+  EXPECT_NEAR(d.shift(1), -0.02, 4 * d.se(1));
+  const PostureShift zero = MeasurePostureShift(null, sim, 0, 1, false, 100, 5, &g);
+  EXPECT_LT(std::abs(zero.shift(0)), 4 * zero.se(0));
+  EXPECT_LT(std::abs(zero.shift(1)), 4 * zero.se(1));
+}
+
+// A robot that ends its executions at other headings (a turn that went further) reads z further
+// along the circle: no posture. Plain means per command are no measure there: they spread with the
+// placements' headings.
+TEST(Posture, MovingAlongTheSlopesCircleIsNoPostureShift) {
+  const FakeSimulator& fake = SlopedPlaneFake();
+  Recording r;
+  r.protocol = "paper";
+  r.seed = 3;
+  const SampleSet sim = fake.Record(r, {}, 1);
+  r.seed = 4;
+  SampleSet turned = fake.Record(r, {}, 1);
+  const Eigen::Rotation2Dd along(0.15);  // the executions at headings on one side of the slope
+  for (int i = 0; i < turned.size(); ++i) {
+    if (turned.z(i, 1) > 0) turned.z.row(i) = (along * Eigen::Vector2d(turned.z.row(i).transpose())).transpose();
+  }
+  const SlopeGeometry g = FitSlopeGeometry(sim, 0, 1);
+  const PostureShift radial = MeasurePostureShift(turned, sim, 0, 1, false, 100, 5, &g);
+  EXPECT_LT(std::abs(radial.shift(0)), 4 * radial.se(0)) << radial.shift.transpose();
+  EXPECT_LT(std::abs(radial.shift(1)), 4 * radial.se(1)) << radial.shift.transpose();
+  EXPECT_LT(radial.shift.norm(), 0.005) << "those executions moved 0.045 rad along the circle";
+  const PostureShift means = MeasurePostureShift(turned, sim, 0, 1, false, 100, 5);
+  EXPECT_LT(radial.se.maxCoeff(), 0.2 * means.se.minCoeff()) << "plain means spread with the placements' headings";
+}
+
+TEST(Posture, ZOffTheSlopesCircleHasNoGeometry) {
+  const FakeSimulator& fake = LevelFake();
+  Recording r;
+  r.protocol = "paper";
+  r.seed = 3;
+  const SlopeGeometry g = FitSlopeGeometry(fake.Record(r, {}, 1), 0, 1);
+  EXPECT_FALSE(g.valid);
+  EXPECT_NE(g.why.find("circle"), std::string::npos) << g.why;
+}
+
+TEST(Posture, OnASlopedPlaneATiltNoNamedKnobGivesIsADoubt) {
+  const FakeSimulator& fake = SlopedPlaneFake();
+  const FakePair weak = MakeFakePair(fake, {{kRightGain, 0.5}});
+  const Analysis a = Analyse(weak.sim, weak.real, &fake, FastOptions());
+  ASSERT_TRUE(a.posture.ran) << a.posture.why;
+  EXPECT_TRUE(a.posture.on_slope);
+  EXPECT_FALSE(a.posture.left_out) << "the weak side's roll is the correction's: z " << a.posture.z_left;
+  FakeExtras extras;
+  extras.posture = Eigen::Vector2d(0.02, 0);
+  const FakePair tilted = MakeFakePair(fake, {{kRightGain, 0.5}}, extras);
+  const Analysis b = Analyse(tilted.sim, tilted.real, &fake, FastOptions());
+  ASSERT_TRUE(b.posture.ran) << b.posture.why;
+  EXPECT_TRUE(b.posture.left_out) << "left " << b.posture.left.transpose() << " z " << b.posture.z_left;
+  EXPECT_NEAR(b.posture.left(0), 0.02, 0.006);
+  EXPECT_TRUE(SaysPosture(b.verdict)) << b.verdict.sentence;
+}
+
+TEST(Posture, NoCheckOnUnevenGroundOrWhenTurnedOff) {
+  FakeSimulator uneven;  // the fake's slope, not declared a plane
+  const FakePair pair = MakeFakePair(uneven, {{kRightGain, 0.5}});
+  const Analysis a = Analyse(pair.sim, pair.real, &uneven, FastOptions());
   EXPECT_FALSE(a.posture.ran);
-  EXPECT_NE(a.posture.why.find("not level"), std::string::npos) << a.posture.why;
+  EXPECT_NE(a.posture.why.find("not a plane"), std::string::npos) << a.posture.why;
   AnalysisOptions off = FastOptions();
   off.posture.enabled = false;
   const FakePair level = MakeFakePair(LevelFake(), {{kRightGain, 0.5}});
