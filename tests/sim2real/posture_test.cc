@@ -12,26 +12,29 @@
 namespace dgmm::sim2real::test {
 namespace {
 
-const FakeSimulator& LevelFake() {
-  static const FakeSimulator* fake = [] {
+// One fake per call site, configured once (a test's recordings stay cached by its fingerprint).
+template <typename Configure>
+const FakeSimulator& StaticFake(Configure configure) {
+  static const FakeSimulator* fake = [&] {
     auto* f = new FakeSimulator();
-    f->level = true;
+    configure(f);
     return f;
   }();
   return *fake;
 }
 
+const FakeSimulator& LevelFake() {
+  return StaticFake([](FakeSimulator* f) { f->level = true; });
+}
+
 // Level ground whose z spreads 0.1 rad about the posture and whose tilt steers the walk: x's slope
 // in z, through which the probes read an IMU offset, is measurable.
 const FakeSimulator& SpreadLevelFake() {
-  static const FakeSimulator* fake = [] {
-    auto* f = new FakeSimulator();
+  return StaticFake([](FakeSimulator* f) {
     f->level = true;
     f->level_z_sd = 0.1;
     f->tilt_steers = 0.5;
-    return f;
-  }();
-  return *fake;
+  });
 }
 
 Analysis RunLevel(const std::vector<KnobValue>& planted, const FakeExtras& extras = {}) {
@@ -165,12 +168,7 @@ TEST(Posture, ANullPairOnLevelGroundStaysClean) {
 }
 
 const FakeSimulator& SlopedPlaneFake() {
-  static const FakeSimulator* fake = [] {
-    auto* f = new FakeSimulator();
-    f->sloped_plane = true;
-    return f;
-  }();
-  return *fake;
+  return StaticFake([](FakeSimulator* f) { f->sloped_plane = true; });
 }
 
 // The fake's 0.3 rad slope: z on a circle around the posture, the heading's place on it.
