@@ -8,6 +8,7 @@
 #include "sim2real/sentence_format.h"
 #include "sim2real/verdict.h"
 #include "util/error.h"
+#include "util/median.h"
 
 namespace dgmm::sim2real {
 
@@ -27,6 +28,8 @@ std::map<std::string, Eigen::Vector2d> MeanPerCommand(const SampleSet& s, const 
   for (auto& [label, v] : sum) v /= n[label];
   return sum;
 }
+
+constexpr double kMadToSd = 1.4826;  // a normal's SD over its median absolute deviation
 
 // h(theta) of SlopeGeometry::radius.
 Eigen::Matrix<double, 5, 1> Harmonics(double theta) {
@@ -57,6 +60,7 @@ std::map<std::pair<std::string, int>, RadialCell> RadialCells(const SampleSet& s
   const double width = 2 * M_PI / g.directions;
   for (int i : rows) {
     const Radial r = RadialPart(s, i, pitch_col, roll_col, g);
+    if (!(std::abs(r.rho) <= g.outlier_rad)) continue;
     const int bin = ((static_cast<int>(std::lround(r.theta / width)) % g.directions) + g.directions) % g.directions;
     RadialCell& c = cells[{s.command_labels[s.command(i)], bin}];
     c.rho += r.rho, c.u += Eigen::Vector2d(std::cos(r.theta), std::sin(r.theta)), ++c.n;
@@ -188,10 +192,13 @@ SlopeGeometry FitSlopeGeometry(const SampleSet& reference, int pitch_col, int ro
     rho(i) = d.norm();
   }
   g.radius = h.completeOrthogonalDecomposition().solve(rho);
-  const double rms = std::sqrt((rho - h * g.radius).squaredNorm() / n), radius = g.radius(0);
-  if (!g.centre.allFinite() || !g.radius.allFinite() || !(radius >= 4 * rms)) {
+  const Eigen::VectorXd residual = rho - h * g.radius;
+  const Eigen::VectorXd deviation = residual.cwiseAbs();
+  const double sd = kMadToSd * Median(std::vector<double>(deviation.data(), deviation.data() + n)), radius = g.radius(0);
+  g.outlier_rad = 6 * sd;
+  if (!g.centre.allFinite() || !g.radius.allFinite() || !(radius >= 4 * sd)) {
     g.why = Fmt("z does not trace the slope's circle clearly (radius %.3g rad,", radius) +
-            Fmt(" radial residuals %.3g rad RMS)", rms);
+            Fmt(" radial residuals %.3g rad robust SD)", sd);
     return g;
   }
   g.valid = true;

@@ -55,9 +55,13 @@ struct SlopeGeometry {
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   Eigen::Matrix<double, 5, 1> radius = Eigen::Matrix<double, 5, 1>::Zero();
   int directions = 12;  // cells per command by the direction of z - c (bins centred on multiples of 30 deg)
+  // Rows whose |rho~| exceeds this are left out: an execution that ended with the robot tipped
+  // or wedged (on the hexapod 0.6 rad off the circle) is no posture. 6 robust SDs (1.4826 MAD)
+  // of the reference's rho~.
+  double outlier_rad = 0;
 };
 // Fitted to every row of `reference`; not valid when z does not trace a circle clearly (its radius
-// under 4 times the RMS of the radial residuals, or fewer than three distinct directions).
+// under 4 times the robust SD of the radial residuals).
 SlopeGeometry FitSlopeGeometry(const SampleSet& reference, int pitch_col, int roll_col);
 
 // Per command mean z (pitch, roll columns) of `a` minus that of `b`, averaged over the commands

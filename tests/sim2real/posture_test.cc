@@ -220,6 +220,23 @@ TEST(Posture, MovingAlongTheSlopesCircleIsNoPostureShift) {
   EXPECT_LT(radial.se.maxCoeff(), 0.2 * means.se.minCoeff()) << "plain means spread with the placements' headings";
 }
 
+// A placement whose robot tipped over reads z far off the circle: left out, no posture.
+TEST(Posture, OnASlopeATippedExecutionIsNoPosture) {
+  const FakeSimulator& fake = SlopedPlaneFake();
+  Recording r;
+  r.protocol = "paper";
+  r.seed = 3;
+  const SampleSet sim = fake.Record(r, {}, 1);
+  r.seed = 4;
+  SampleSet tipped = fake.Record(r, {}, 1);
+  for (int i = 1; i < 5; ++i) tipped.z.row(i) *= 3;  // 0.6 rad further out after its first execution
+  const SlopeGeometry g = FitSlopeGeometry(sim, 0, 1);
+  EXPECT_LT(g.outlier_rad, 0.2);
+  const PostureShift d = MeasurePostureShift(tipped, sim, 0, 1, false, 100, 5, &g);
+  EXPECT_LT(d.shift.norm(), 0.005) << d.shift.transpose();
+  EXPECT_LT(d.se.maxCoeff(), 0.005);
+}
+
 TEST(Posture, ZOffTheSlopesCircleHasNoGeometry) {
   const FakeSimulator& fake = LevelFake();
   Recording r;
