@@ -171,6 +171,14 @@ const FakeSimulator& SlopedPlaneFake() {
   return StaticFake([](FakeSimulator* f) { f->sloped_plane = true; });
 }
 
+// The fake's recording at seed `seed`, nothing planted.
+SampleSet RecordAt(const FakeSimulator& fake, std::uint64_t seed) {
+  Recording r;
+  r.protocol = "paper";
+  r.seed = seed;
+  return fake.Record(r, {}, 1);
+}
+
 // The fake's 0.3 rad slope: z on a circle around the posture, the heading's place on it.
 TEST(Posture, OnASlopeTheShiftComesFromTheRadialPartOfZ) {
   const FakeSimulator& fake = SlopedPlaneFake();
@@ -200,13 +208,8 @@ TEST(Posture, OnASlopeTheShiftComesFromTheRadialPartOfZ) {
 // along the circle: no posture. Plain means per command are no measure there: they spread with the
 // placements' headings.
 TEST(Posture, MovingAlongTheSlopesCircleIsNoPostureShift) {
-  const FakeSimulator& fake = SlopedPlaneFake();
-  Recording r;
-  r.protocol = "paper";
-  r.seed = 3;
-  const SampleSet sim = fake.Record(r, {}, 1);
-  r.seed = 4;
-  SampleSet turned = fake.Record(r, {}, 1);
+  const SampleSet sim = RecordAt(SlopedPlaneFake(), 3);
+  SampleSet turned = RecordAt(SlopedPlaneFake(), 4);
   const Eigen::Rotation2Dd along(0.15);  // the executions at headings on one side of the slope
   for (int i = 0; i < turned.size(); ++i) {
     if (turned.z(i, 1) > 0) turned.z.row(i) = (along * Eigen::Vector2d(turned.z.row(i).transpose())).transpose();
@@ -222,13 +225,8 @@ TEST(Posture, MovingAlongTheSlopesCircleIsNoPostureShift) {
 
 // A placement whose robot tipped over reads z far off the circle: left out, no posture.
 TEST(Posture, OnASlopeATippedExecutionIsNoPosture) {
-  const FakeSimulator& fake = SlopedPlaneFake();
-  Recording r;
-  r.protocol = "paper";
-  r.seed = 3;
-  const SampleSet sim = fake.Record(r, {}, 1);
-  r.seed = 4;
-  SampleSet tipped = fake.Record(r, {}, 1);
+  const SampleSet sim = RecordAt(SlopedPlaneFake(), 3);
+  SampleSet tipped = RecordAt(SlopedPlaneFake(), 4);
   for (int i = 1; i < 5; ++i) tipped.z.row(i) *= 3;  // 0.6 rad further out after its first execution
   const SlopeGeometry g = FitSlopeGeometry(sim, 0, 1);
   EXPECT_LT(g.outlier_rad, 0.2);
@@ -238,11 +236,7 @@ TEST(Posture, OnASlopeATippedExecutionIsNoPosture) {
 }
 
 TEST(Posture, ZOffTheSlopesCircleHasNoGeometry) {
-  const FakeSimulator& fake = LevelFake();
-  Recording r;
-  r.protocol = "paper";
-  r.seed = 3;
-  const SlopeGeometry g = FitSlopeGeometry(fake.Record(r, {}, 1), 0, 1);
+  const SlopeGeometry g = FitSlopeGeometry(RecordAt(LevelFake(), 3), 0, 1);
   EXPECT_FALSE(g.valid);
   EXPECT_NE(g.why.find("circle"), std::string::npos) << g.why;
 }
