@@ -42,6 +42,17 @@ Analysis RunLevel(const std::vector<KnobValue>& planted, const FakeExtras& extra
   return Analyse(pair.sim, pair.real, &LevelFake(), FastOptions());
 }
 
+// The paper protocol's recording with common random numbers `seed`.
+Recording PaperAt(std::uint64_t seed) {
+  Recording r;
+  r.protocol = "paper";
+  r.seed = seed;
+  return r;
+}
+
+// The fake's recording at seed `seed`, nothing planted.
+SampleSet RecordAt(const FakeSimulator& fake, std::uint64_t seed) { return fake.Record(PaperAt(seed), {}, 1); }
+
 bool SaysPosture(const Verdict& v) {
   for (const std::string& d : v.doubts) {
     if (d.find("posture") != std::string::npos) return true;
@@ -51,14 +62,10 @@ bool SaysPosture(const Verdict& v) {
 
 TEST(Posture, TheShiftOfMeanZIsMeasuredWithItsError) {
   const FakeSimulator& fake = LevelFake();
-  Recording r;
-  r.protocol = "paper";
-  r.seed = 3;
-  const SampleSet sim = fake.Record(r, {}, 1);
-  r.seed = 4;
+  const SampleSet sim = RecordAt(fake, 3);
   FakeExtras tilt;
   tilt.posture = Eigen::Vector2d(0.01, -0.02);
-  const SampleSet real = fake.RecordWith(r, {}, tilt);
+  const SampleSet real = fake.RecordWith(PaperAt(4), {}, tilt);
   const PostureShift d = MeasurePostureShift(real, sim, 0, 1, false, 100, 5);
   ASSERT_TRUE(d.se.allFinite());
   EXPECT_GT(d.se.minCoeff(), 0);
@@ -72,10 +79,7 @@ TEST(Posture, TheShiftOfMeanZIsMeasuredWithItsError) {
 
 TEST(Posture, ARecordingAtTheSamePlacesIsComparedPairwise) {
   const FakeSimulator& fake = LevelFake();
-  Recording r;
-  r.protocol = "paper";
-  r.seed = 3;
-  const SampleSet nominal = fake.Record(r, {}, 1), weak = fake.Record(r, {{kRightGain, 0.5}}, 1);
+  const SampleSet nominal = RecordAt(fake, 3), weak = fake.Record(PaperAt(3), {{kRightGain, 0.5}}, 1);
   const PostureShift paired = MeasurePairedPostureShift(weak, nominal, 0, 1, false, 100, 5);
   const PostureShift unpaired = MeasurePostureShift(weak, nominal, 0, 1, false, 100, 5);
   EXPECT_NEAR(paired.shift(1), 0.02, 0.002) << "0.04 (1 - 0.5) of roll";
@@ -171,29 +175,17 @@ const FakeSimulator& SlopedPlaneFake() {
   return StaticFake([](FakeSimulator* f) { f->sloped_plane = true; });
 }
 
-// The fake's recording at seed `seed`, nothing planted.
-SampleSet RecordAt(const FakeSimulator& fake, std::uint64_t seed) {
-  Recording r;
-  r.protocol = "paper";
-  r.seed = seed;
-  return fake.Record(r, {}, 1);
-}
-
 // The fake's 0.3 rad slope: z on a circle around the posture, the heading's place on it.
 TEST(Posture, OnASlopeTheShiftComesFromTheRadialPartOfZ) {
   const FakeSimulator& fake = SlopedPlaneFake();
-  Recording r;
-  r.protocol = "paper";
-  r.seed = 3;
-  const SampleSet sim = fake.Record(r, {}, 1);
+  const SampleSet sim = RecordAt(fake, 3);
   const SlopeGeometry g = FitSlopeGeometry(sim, 0, 1);
   ASSERT_TRUE(g.valid) << g.why;
   EXPECT_NEAR(g.radius(0), 0.3, 0.01);
   EXPECT_LT(g.centre.norm(), 0.01);
-  r.seed = 4;
   FakeExtras tilt;
   tilt.posture = Eigen::Vector2d(0.01, -0.02);
-  const SampleSet real = fake.RecordWith(r, {}, tilt), null = fake.Record(r, {}, 1);
+  const SampleSet real = fake.RecordWith(PaperAt(4), {}, tilt), null = RecordAt(fake, 4);
   const PostureShift d = MeasurePostureShift(real, sim, 0, 1, false, 100, 5, &g);
   ASSERT_TRUE(d.se.allFinite());
   EXPECT_LT(d.se.maxCoeff(), 0.005);
