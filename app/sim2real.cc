@@ -18,6 +18,7 @@
 #include "io/model_io.h"
 #include "io/sample_set_io.h"
 #include "sim/sim_config.h"
+#include "sim/simulator.h"
 #include "sim2real/analysis.h"
 #include "sim2real/corrected_model.h"
 #include "sim2real/figures.h"
@@ -224,11 +225,29 @@ void WriteOutputs(const Sim2RealArgs& args, const sim2real::Analysis& a, const s
 
 // The analysis; when the simulator cannot re-record the sim set's recording (e.g. a protocol it
 // does not know), the report says why and the analysis only locates.
-sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, const Sim2RealArgs& args, bool uneven,
+// The ground as the posture comparison needs it where no simulator analyses (located only): the
+// config's (unknown without one, or when its robot does not load: a note says why).
+sim2real::PostureGround GroundOfConfig(const std::optional<sim::SimConfig>& config, sim2real::ReportContext* ctx) {
+  if (!config) return {};
+  try {
+    const sim::Simulator robot(*config);
+    return {true, robot.PlaneGround(), robot.LevelGround()};
+  } catch (const InputError& e) {
+    ctx->notes.push_back(std::string("the torso's posture was not compared: the simulator config's robot did not "
+                                     "load (") + e.what() + ")");
+    return {};
+  }
+}
+
+sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, const Sim2RealArgs& args,
+                                   const std::optional<sim::SimConfig>& config,
                                    std::unique_ptr<MujocoKnobSimulator>* simulator, std::string* why,
                                    sim2real::ReportContext* ctx) {
-  const sim2real::AnalysisOptions options = MakeOptions(args, uneven);
-  if (!*simulator) return sim2real::Analyse(sim, real, nullptr, options, *why);
+  sim2real::AnalysisOptions options = MakeOptions(args, config && config->terrain.has_value());
+  if (!*simulator) {
+    options.posture.ground = GroundOfConfig(config, ctx);
+    return sim2real::Analyse(sim, real, nullptr, options, *why);
+  }
   try {
     sim2real::Analysis a = sim2real::Analyse(sim, real, simulator->get(), options, *why);
     if (!a.candidates.unwalkable_probes.empty()) {
@@ -246,6 +265,7 @@ sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, 
     *why = std::string("the simulator could not re-record the sim set (") + e.what() + "): located only";
     Warn(*why);
     ctx->notes.push_back(*why);
+    options.posture.ground = sim2real::GroundOf(**simulator);
     simulator->reset();
     return sim2real::Analyse(sim, real, nullptr, options, *why);  // set errors throw again here
   }
@@ -276,7 +296,7 @@ void Run(const Sim2RealArgs& args) {
   ReportStage("sim2real: analysing " + std::to_string(real.size()) + " real vs " + std::to_string(sim.size()) +
               " sim samples");
   const sim2real::Analysis a =
-      AnalyseOrLocate(sim, real, args, config && config->terrain.has_value(), &simulator, &why, &ctx);
+      AnalyseOrLocate(sim, real, args, config, &simulator, &why, &ctx);
   if (const std::string note = sim2real::SmallSimSetNote(a.inputs, args.sim); !note.empty()) {
     Warn(note);
     ctx.notes.push_back(note);
@@ -330,7 +350,9 @@ void Setup(CLI::App& root) {
   cmd->add_option("--sim-config", args->sim_config,
                   "simulation config (JSON) to re-simulate with; default: the one the sim set records (a different "
                   "one is reported)");
-  cmd->add_flag("--locate-only", args->locate_only, "only locate the mismatch (no re-simulation, no physics named)");
+  cmd->add_flag("--locate-only", args->locate_only,
+                "only locate the mismatch (no re-simulation, no physics named; the torso's posture against the sim "
+                "set's where the simulator config tells the ground is a plane)");
   cmd->add_option("--threads", args->threads, "threads for the recordings and the experiment check (0: all cores)")
       ->capture_default_str()->check(CLI::Range(0, 1024));
   cmd->add_option("--cache", args->cache,
@@ -400,8 +422,8 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--posture,!--no-posture", args->posture,
                 "on a plane (level, or a slope: the radial part of pitch and roll), check that the named physics "
                 "gives the real torso's mean pitch and roll (its recording at the sim set's places); a posture it "
-                "leaves out is a doubt and lets the leg and payload "
-                "searches challenge the names (on by default; docs/sim2real.md)");
+                "leaves out is a doubt and lets the leg and payload searches challenge the names; located only, "
+                "the real posture against the sim set's (on by default; docs/sim2real.md)");
   cmd->add_option("--posture-z", args->posture_z,
                   "standard errors (placements resampled) a posture left out must reach to be a doubt")
       ->capture_default_str()->check(CLI::PositiveNumber);

@@ -460,6 +460,11 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   if (!simulator) {
     a.locate_only_because = no_simulator_reason;
     a.verdict = LocateOnlyVerdict(a.baseline, no_simulator_reason);
+    stage("posture (the real torso's against the sim set's)");
+    const auto posture_start = Clock::now();
+    a.posture = ComparePosture(a.inputs, options.posture.ground, options.posture);
+    AddPostureCheck(a.posture, options.posture.z, &a.verdict);
+    a.seconds.posture = Since(posture_start);
     a.seconds.total = Since(start);
     return a;
   }

@@ -149,10 +149,11 @@ double MaxZ(const Eigen::Vector2d& v, const Eigen::Vector2d& se) {
 }
 
 // Where the check cannot run (empty: it can).
-std::string WhyNot(const KnobSimulator& simulator, const AnalysisInputs& in, const PostureOptions& options) {
+std::string WhyNot(const PostureGround& ground, const AnalysisInputs& in, const PostureOptions& options) {
   if (!options.enabled) return "turned off (--no-posture)";
   if (in.pitch_col < 0 || in.roll_col < 0) return "the sets' z has no pitch and roll";
-  if (!simulator.plane_ground()) return "the simulator's ground is not a plane (a height field)";
+  if (!ground.known) return "the ground is not known without a simulator config";
+  if (!ground.plane) return "the simulator's ground is not a plane (a height field)";
   if (!in.sim_set.has_sequence() || !in.real_set.has_sequence()) return "a set has no placements (episodes)";
   return "";
 }
@@ -258,24 +259,25 @@ PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, i
   return out;
 }
 
-PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& in, const SampleSet& nominal,
-                          const Recording& recording, const RecordingOptions& recording_options,
-                          const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
-                          const std::string& correction, const PostureOptions& options) {
+PostureGround GroundOf(const KnobSimulator& simulator) {
+  return {true, simulator.plane_ground(), simulator.level_ground()};
+}
+
+PostureCheck ComparePosture(const AnalysisInputs& in, const PostureGround& ground, const PostureOptions& options) {
   std::string error;
   if (!options.IsValid(&error)) throw MakeInputError("", "posture options", error);
   PostureCheck c;
-  c.correction = correction;
-  c.why = WhyNot(simulator, in, options);
+  c.compared_only = true;
+  c.correction = "nothing (the real set against the sim set alone)";
+  c.why = WhyNot(ground, in, options);
   if (!c.why.empty()) return c;
   const int p = in.pitch_col, r = in.roll_col;
-  c.on_slope = !simulator.level_ground();
-  SlopeGeometry sim_slope, nominal_slope;  // on a slope: where the sim set's and the nominal's z lie
+  c.on_slope = !ground.level;
+  SlopeGeometry sim_slope;  // on a slope: where the sim set's z lies
   if (c.on_slope) {
-    sim_slope = FitSlopeGeometry(in.sim_set, p, r), nominal_slope = FitSlopeGeometry(nominal, p, r);
-    if (!sim_slope.valid || !nominal_slope.valid) {
-      c.why = "on the slope " + (sim_slope.valid ? nominal_slope.why + " in the nominal recording"
-                                                 : sim_slope.why + " in the sim set");
+    sim_slope = FitSlopeGeometry(in.sim_set, p, r);
+    if (!sim_slope.valid) {
+      c.why = "on the slope " + sim_slope.why + " in the sim set";
       return c;
     }
   }
@@ -288,11 +290,34 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
     return c;
   }
   c.ran = true;
+  c.left = c.walking.shift;
+  c.z_left = c.z_left_without_imu = c.z_moved = MaxZ(c.walking.shift, c.walking.se);
+  c.left_out = c.z_left >= options.z;
+  return c;
+}
+
+PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& in, const SampleSet& nominal,
+                          const Recording& recording, const RecordingOptions& recording_options,
+                          const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
+                          const std::string& correction, const PostureOptions& options) {
+  PostureCheck c = ComparePosture(in, GroundOf(simulator), options);
+  c.compared_only = false;
+  c.correction = correction;
+  if (!c.ran) return c;
   c.predicted = c.predicted_standing = imu;
   if (!values.empty()) {
+    // On a slope the correction's recording compares with the nominal's on the nominal's circle.
+    const SlopeGeometry nominal_slope =
+        c.on_slope ? FitSlopeGeometry(nominal, in.pitch_col, in.roll_col) : SlopeGeometry();
+    if (c.on_slope && !nominal_slope.valid) {
+      c.ran = false, c.left_out = false;
+      c.why = "on the slope " + nominal_slope.why + " in the nominal recording";
+      return c;
+    }
     const SampleSet corrected = RecordBatch(simulator, recording, {values}, recording_options).sets.at(0);
     c.recorded = true;
     const SlopeGeometry* at_nominal = c.on_slope ? &nominal_slope : nullptr;
+    const int p = in.pitch_col, r = in.roll_col;
     const PostureShift walking = MeasurePairedPostureShift(corrected, nominal, p, r, false, options.resamples,
                                                            options.seed + 2, at_nominal);
     const PostureShift standing = MeasurePairedPostureShift(corrected, nominal, p, r, true, options.resamples,
@@ -305,7 +330,6 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
   const Eigen::Vector2d se = (c.walking.se.cwiseAbs2() + c.predicted_se.cwiseAbs2()).cwiseSqrt();
   c.z_left = MaxZ(c.left, se);
   c.z_left_without_imu = MaxZ(c.left + imu, se);
-  c.z_moved = MaxZ(c.walking.shift, c.walking.se);
   c.left_out = c.z_left >= options.z;
   return c;
 }
@@ -321,6 +345,32 @@ void AddDoubt(const std::string& doubt, Verdict* v) {
   v->unexplained_present = true;
   AddUnique(&v->structured_in, "posture");
   v->sentence += " The posture: " + doubt + ".";
+}
+
+// Standing after a placement, did the posture move as it did walking (with what the correction gives
+// taken off both)? An IMU mounted off level reads alike; a payload or a weak leg tilts the walk more.
+bool StandingAlike(const PostureCheck& c) {
+  return c.standing.shift.allFinite() && c.standing.se.allFinite() &&
+         MaxZ(c.standing.shift - c.predicted_standing - c.left, c.standing.se) < 2 &&
+         MaxZ(c.standing.shift - c.predicted_standing, c.standing.se) >= 2;
+}
+
+std::string WalkingSaid(const PostureCheck& c) {
+  return "the torso's posture while walking differs from the simulation's by " + Mrad(c.walking.shift) +
+         Fmt(" (SE %.1f, %.1f mrad)", 1e3 * c.walking.se(0), 1e3 * c.walking.se(1));
+}
+
+// ComparePosture's answer where the analysis only locates: a moved posture is a located mismatch.
+void AddComparedPosture(const PostureCheck& c, Verdict* v) {
+  if (v->status == "clean") v->status = "located";
+  v->unexplained_present = true;
+  AddUnique(&v->structured_in, "posture");
+  std::string said = WalkingSaid(c) + Fmt(", %.1f SE", c.z_moved);
+  said += StandingAlike(c) ? "; standing after a placement alike, as an IMU mounted off level reads"
+                           : "; standing after a placement " + Mrad(c.standing.shift) +
+                                 ", unlike walking: not an IMU mounted off level (it moves both alike) but something "
+                                 "that tilts the robot (a payload, a weak leg?)";
+  v->sentence += " The posture: " + said + ".";
 }
 
 }  // namespace
@@ -343,8 +393,8 @@ std::string ContradictedImuSentence(const ContradictedImu& c) {
 
 void AddPostureCheck(const PostureCheck& c, double z, Verdict* v) {
   if (!c.ran || !c.left_out) return;
-  std::string doubt = "the torso's posture while walking differs from the simulation's by " + Mrad(c.walking.shift) +
-                      Fmt(" (SE %.1f, %.1f mrad)", 1e3 * c.walking.se(0), 1e3 * c.walking.se(1));
+  if (c.compared_only) return AddComparedPosture(c, v);
+  std::string doubt = WalkingSaid(c);
   const bool moves = c.recorded || c.predicted.norm() > 0;
   doubt += "; " + c.correction + (moves ? " gives " + Mrad(c.predicted) + "," : " moves no posture,") +
            Fmt(" leaving %.1f SE (a doubt from %.3g)", c.z_left, z);
@@ -355,10 +405,7 @@ void AddPostureCheck(const PostureCheck& c, double z, Verdict* v) {
     AddDoubt(doubt, v);
     return;
   }
-  const bool standing_alike = c.standing.shift.allFinite() && c.standing.se.allFinite() &&
-                              MaxZ(c.standing.shift - c.predicted_standing - c.left, c.standing.se) < 2 &&
-                              MaxZ(c.standing.shift - c.predicted_standing, c.standing.se) >= 2;
-  doubt += standing_alike ? "; the standing posture moved alike, as an IMU mounted off level reads"
+  doubt += StandingAlike(c) ? "; the standing posture moved alike, as an IMU mounted off level reads"
                           : "; standing after a placement " + Mrad(c.standing.shift) +
                                 ": something that tilts the walking robot (a payload, a weak leg) is not named";
   AddDoubt(doubt, v);

@@ -20,6 +20,8 @@
 // with c the sim set's circle centre, R its radius per direction theta (harmonics up to the
 // second), u the cell's unit direction, d the posture shift (least squares over the cells both sets
 // have). On a height field z depends on where the robot stands: the check does not run there.
+// Where the analysis only locates (no simulator), the real posture is compared with the sim set's
+// alone (ComparePosture): a posture that moved is a located mismatch.
 #include <Eigen/Dense>
 #include <cstdint>
 #include <string>
@@ -32,8 +34,18 @@
 
 namespace dgmm::sim2real {
 
+// What the check needs to know of the ground: a plane (no height field: z follows the heading
+// alone) and a level one (else a slope: SlopeGeometry). From the simulator where there is one
+// (GroundOf); else from the sim set's config (the app); unknown without either.
+struct PostureGround {
+  bool known = false;
+  bool plane = false;
+  bool level = false;
+};
+
 struct PostureOptions {
   bool enabled = true;  // `dgmm sim2real --no-posture` turns it off
+  PostureGround ground;  // used only where the analysis has no simulator (it only locates)
   // Standard errors a component of the posture left must reach (two components, pitch and roll;
   // the nulls of the planar and sprawled quadrupeds reached at most 2.8, docs/sim2real.md).
   double z = 4.0;
@@ -103,7 +115,15 @@ struct PostureCheck {
   bool recorded = false;       // the correction was recorded (false: it holds no simulator knob)
   std::string correction;      // what was checked, in words ("nothing named", "the named correction")
   bool on_slope = false;       // compared by the radial part of z on the slope's circle (SlopeGeometry)
+  bool compared_only = false;  // real against sim alone (ComparePosture): no correction checked
 };
+
+PostureGround GroundOf(const KnobSimulator& simulator);
+
+// The real set's posture against the sim set's alone, walking and standing (`predicted` zero): the
+// first half of CheckPosture, and all of the check where the analysis only locates. `left_out`
+// when it moved by options.z standard errors.
+PostureCheck ComparePosture(const AnalysisInputs& in, const PostureGround& ground, const PostureOptions& options);
 
 // The check for a correction of simulator knobs `values` (may be empty) and an IMU offset `imu`
 // (rad, pitch and roll; zero when none is named). The ground from the simulator (level_ground,
@@ -132,7 +152,8 @@ bool ContradictsNamedImu(const PostureCheck& check, double z);
 std::string ContradictedImuSentence(const ContradictedImu& c);
 
 // The check in the verdict: a posture left out is a doubt (explained becomes partly_explained,
-// clean becomes unexplained) and a sentence.
+// clean becomes unexplained) and a sentence; after ComparePosture alone a posture that moved is a
+// located mismatch (clean becomes located) and a sentence.
 struct Verdict;
 void AddPostureCheck(const PostureCheck& check, double z, Verdict* v);
 

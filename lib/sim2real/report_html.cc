@@ -319,8 +319,12 @@ std::string PostureParagraph(const PostureCheck& c) {
   return "<p>The torso's posture (mrad, pitch, roll" + std::string(c.on_slope ? "; on the slope from z's radial part" : "") +
          "): real minus sim " + mrad(c.walking.shift) + " while walking (SE " +
          mrad(c.walking.se) + "), " + mrad(c.standing.shift) + " standing after a placement (SE " +
-         mrad(c.standing.se) + "); " + Escape(c.correction) + " gives " + mrad(c.predicted) + ", leaving " +
-         F("%.1f", c.z_left) + " SE" + (c.left_out ? " (a doubt)" : "") + ".</p>\n";
+         mrad(c.standing.se) + "); " +
+         (c.compared_only ? "nothing named (located only): " + F("%.1f", c.z_moved) + " SE" +
+                                (c.left_out ? " (a located mismatch)" : "")
+                          : Escape(c.correction) + " gives " + mrad(c.predicted) + ", leaving " + F("%.1f", c.z_left) +
+                                " SE" + (c.left_out ? " (a doubt)" : "")) +
+         ".</p>\n";
 }
 
 std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const std::filesystem::path& dir) {

@@ -260,13 +260,13 @@ json MoreDataJson(const MoreData& m) {
 
 json Pair(const Eigen::Vector2d& v) { return json::array({JsonNumber(v(0)), JsonNumber(v(1))}); }
 
-// The posture check (rad, pitch and roll); null when it did not run for want of a simulator.
+// The posture check (rad, pitch and roll); null when it was not tried.
 json PostureJson(const PostureCheck& c) {
   if (!c.ran) return c.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", c.why}});
   return {{"ran", true}, {"on_slope", c.on_slope},
           {"walking", {{"shift", Pair(c.walking.shift)}, {"se", Pair(c.walking.se)}}},
           {"standing", {{"shift", Pair(c.standing.shift)}, {"se", Pair(c.standing.se)}}},
-          {"correction", c.correction}, {"recorded", c.recorded},
+          {"correction", c.correction}, {"recorded", c.recorded}, {"compared_only", c.compared_only},
           {"predicted", Pair(c.predicted)}, {"predicted_se", Pair(c.predicted_se)},
           {"predicted_standing", Pair(c.predicted_standing)},
           {"imu_offset", Pair(c.imu)}, {"left", Pair(c.left)}, {"z_left", JsonNumber(c.z_left)},

@@ -111,6 +111,12 @@ TEST(Sim2RealApp, LocateOnlyLocatesTheSlipPairAndKeepsTheNullClean) {
                                    dir / "null");
   EXPECT_EQ(null.report["verdict"]["status"], "clean");
   ExpectOneStory(null);
+  // The sim set's config tells the ground (the octopod's slope): the posture against the sim set's.
+  const auto& posture = null.report["posture"];
+  ASSERT_TRUE(posture["ran"].get<bool>()) << posture.dump();
+  EXPECT_TRUE(posture["compared_only"].get<bool>());
+  EXPECT_TRUE(posture["on_slope"].get<bool>());
+  EXPECT_FALSE(posture["left_out"].get<bool>()) << posture.dump();
 }
 
 // A --sim-config other than the sim set's own is reported, naming what differs.
@@ -138,6 +144,8 @@ TEST(Sim2RealApp, WithoutAnyConfigItSaysItCanOnlyLocate) {
   EXPECT_EQ(o.report["verdict"]["status"], "located");
   EXPECT_NE(o.report["verdict"]["sentence"].get<std::string>().find("can only locate"), std::string::npos);
   EXPECT_FALSE(o.report["simulator"]["analysed"].get<bool>());
+  EXPECT_NE(o.report["posture"]["why_not"].get<std::string>().find("ground is not known"), std::string::npos)
+      << o.report["posture"].dump();
 }
 
 // A sim set whose recording the simulator cannot repeat (a protocol it does not know): the report

@@ -1,8 +1,11 @@
 // The torso's posture beside the motion (posture.h): the shift of mean z between two sets, and in
 // the whole analysis on the fake's level ground a named correction that gives the real posture
 // (a weak side tilts the fake's roll) against one that leaves a tilt out; on a sloped plane the
-// radial part of z; on uneven ground no check.
+// radial part of z; on uneven ground no check; where the analysis only locates, the real posture
+// against the sim set's alone.
 #include "sim2real/posture.h"
+
+#include <algorithm>
 
 #include <gtest/gtest.h>
 
@@ -260,6 +263,79 @@ TEST(Posture, NoCheckOnUnevenGroundOrWhenTurnedOff) {
   off.posture.enabled = false;
   const FakePair level = MakeFakePair(LevelFake(), {{kRightGain, 0.5}});
   EXPECT_FALSE(Analyse(level.sim, level.real, &LevelFake(), off).posture.ran);
+}
+
+// Located only (no simulator): the real posture against the sim set's, the ground as the config
+// gives it.
+AnalysisOptions LocatedOn(PostureGround ground) {
+  AnalysisOptions o = FastOptions();
+  o.posture.ground = ground;
+  return o;
+}
+constexpr PostureGround kLevel{true, true, true}, kSlope{true, true, false};
+
+// A pair on `fake` whose real robot sits 0.02 rad nose down, located only on `ground`.
+Analysis LocateTilted(const FakeSimulator& fake, PostureGround ground) {
+  FakeExtras tilt;
+  tilt.posture = Eigen::Vector2d(0.02, 0);
+  const FakePair pair = MakeFakePair(fake, {}, tilt);
+  return Analyse(pair.sim, pair.real, nullptr, LocatedOn(ground), "no simulator config");
+}
+
+TEST(Posture, WhereTheAnalysisOnlyLocatesATiltedRealRobotIsALocatedMismatch) {
+  const Analysis a = LocateTilted(LevelFake(), kLevel);
+  ASSERT_TRUE(a.posture.ran) << a.posture.why;
+  EXPECT_TRUE(a.posture.compared_only);
+  EXPECT_FALSE(a.posture.recorded);
+  EXPECT_TRUE(a.posture.left_out) << a.posture.z_moved;
+  EXPECT_NEAR(a.posture.walking.shift(0), 0.02, 0.006);
+  EXPECT_EQ(a.verdict.status, "located") << a.verdict.sentence;
+  EXPECT_NE(std::find(a.verdict.structured_in.begin(), a.verdict.structured_in.end(), "posture"),
+            a.verdict.structured_in.end());
+  EXPECT_NE(a.verdict.sentence.find("The posture: "), std::string::npos) << a.verdict.sentence;
+  EXPECT_TRUE(a.verdict.named.empty());
+  const FakePair null = MakeFakePair(LevelFake(), {});
+  const Analysis b = Analyse(null.sim, null.real, nullptr, LocatedOn(kLevel), "no simulator config");
+  ASSERT_TRUE(b.posture.ran) << b.posture.why;
+  EXPECT_FALSE(b.posture.left_out) << b.posture.z_moved;
+  EXPECT_EQ(b.verdict.sentence.find("The posture: "), std::string::npos) << b.verdict.sentence;
+}
+
+TEST(Posture, LocatedOnlyOnASlopeTheRadialPartCompares) {
+  const Analysis a = LocateTilted(SlopedPlaneFake(), kSlope);
+  ASSERT_TRUE(a.posture.ran) << a.posture.why;
+  EXPECT_TRUE(a.posture.on_slope);
+  EXPECT_NEAR(a.posture.walking.shift(0), 0.02, 0.006);
+  EXPECT_TRUE(a.posture.left_out);
+  const Analysis flat = LocateTilted(SlopedPlaneFake(), kLevel);
+  EXPECT_GT(flat.posture.walking.se(0), 5 * a.posture.walking.se(0))
+      << "a slope taken for level ground: plain means spread with the headings";
+}
+
+TEST(Posture, LocatedOnlyWithoutAGroundThePostureIsNotCompared) {
+  const FakePair pair = MakeFakePair(LevelFake(), {});
+  const Analysis a = Analyse(pair.sim, pair.real, nullptr, FastOptions(), "no simulator config");
+  EXPECT_FALSE(a.posture.ran);
+  EXPECT_NE(a.posture.why.find("not known"), std::string::npos) << a.posture.why;
+  const Analysis b = Analyse(pair.sim, pair.real, nullptr, LocatedOn({true, false, false}), "no simulator config");
+  EXPECT_NE(b.posture.why.find("not a plane"), std::string::npos) << b.posture.why;
+}
+
+// On a slope the correction's recording compares with the nominal's on the nominal's own circle:
+// needed only when something is recorded.
+TEST(Posture, TheNominalsCircleIsNeededOnlyForARecordedCorrection) {
+  const FakeSimulator& fake = SlopedPlaneFake();
+  const FakePair pair = MakeFakePair(fake, {});
+  const AnalysisInputs in = PrepareInputs(pair.sim, pair.real, 1);
+  const SampleSet off_circle = RecordAt(LevelFake(), 3);
+  const RecordingOptions recording = FastOptions().candidates.recording;
+  const PostureCheck nothing = CheckPosture(fake, in, off_circle, PaperAt(3), recording, {}, Eigen::Vector2d::Zero(),
+                                            "nothing named", PostureOptions());
+  EXPECT_TRUE(nothing.ran) << nothing.why;
+  const PostureCheck weak = CheckPosture(fake, in, off_circle, PaperAt(3), recording, {{kRightGain, 0.5}},
+                                         Eigen::Vector2d::Zero(), "weak", PostureOptions());
+  EXPECT_FALSE(weak.ran);
+  EXPECT_NE(weak.why.find("nominal recording"), std::string::npos) << weak.why;
 }
 
 }  // namespace
