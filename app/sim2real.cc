@@ -54,6 +54,7 @@ struct Sim2RealArgs {
   bool leg_search = true;
   bool payload_search = sim2real::PayloadSearchOptions{}.enabled;
   bool payload_on_posture = sim2real::PayloadSearchOptions{}.on_posture;
+  bool payload_posture_chooses = sim2real::PayloadSearchOptions{}.posture_chooses;
   bool posture = sim2real::PostureOptions{}.enabled;
   double posture_z = sim2real::PostureOptions{}.z;
   bool refit_without_imu = sim2real::PostureOptions{}.refit_without_imu;
@@ -170,6 +171,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.runoff.enabled = args.runoff;
   o.payload.enabled = args.payload_search;
   o.payload.on_posture = args.payload_on_posture;
+  o.payload.posture_chooses = args.payload_posture_chooses;
   o.posture.enabled = args.posture;
   o.posture.z = args.posture_z;
   o.posture.refit_without_imu = args.refit_without_imu;
@@ -419,6 +421,9 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--payload-on-posture,!--no-payload-on-posture", args->payload_on_posture,
                 "run the payload search also when the named physics leaves the torso's posture out (--posture; on "
                 "by default)");
+  cmd->add_flag("--payload-posture-chooses,!--no-payload-posture-chooses", args->payload_posture_chooses,
+                "where several of the payload search's positions fit the real samples as well, name the one whose "
+                "payload leaves the least of the real torso's posture (--posture; on by default; docs/sim2real.md)");
   cmd->add_flag("--posture,!--no-posture", args->posture,
                 "on a plane (level, or a slope: the radial part of pitch and roll), check that the named physics "
                 "gives the real torso's mean pitch and roll (its recording at the sim set's places); a posture it "

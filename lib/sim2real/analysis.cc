@@ -135,6 +135,22 @@ std::vector<std::string> NamedKnobs(const Analysis& a) {
   return named;
 }
 
+// "the named correction (floor.friction.sliding 0.708, tracker_bias)" or "nothing named".
+std::string CorrectionWords(const Verdict& v) {
+  std::vector<std::string> words;
+  for (const VerdictNamed& n : v.named) words.push_back(n.knob + (std::isfinite(n.lo) ? Fmt(" %.3g", n.value) : ""));
+  return words.empty() ? "nothing named" : "the named correction (" + JoinWords(words) + ")";
+}
+
+// The posture check (posture.h) of the simulator knobs `values` and the IMU offset `imu`.
+PostureCheck CheckNamedPosture(const KnobSimulator& simulator, const AnalysisOptions& options, const Analysis& a,
+                               const std::vector<KnobValue>& values, const Eigen::Vector2d& imu) {
+  PostureOptions o = options.posture;
+  o.seed = options.seed + 19;
+  return CheckPosture(simulator, a.inputs, a.candidates.nominal, a.candidates.recording, options.candidates.recording,
+                      values, imu, CorrectionWords(a.verdict), o);
+}
+
 // Stages 8a to 8c: the runoff on uneven ground, then the leg search when still nothing is named,
 // then the payload search.
 template <typename Stage>
@@ -166,7 +182,11 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     stage("payload search (its mass and position)");
     PayloadSearchOptions payload = options.payload;
     payload.search = OwnModels(payload.search, options);
-    a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload);
+    const PostureLeft posture_left = [&](const std::vector<KnobValue>& values) {
+      const PostureCheck c = CheckNamedPosture(simulator, options, *a, values, Eigen::Vector2d::Zero());
+      return c.ran ? c.z_left : NAN;
+    };
+    a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload, posture_left);
     if (!a->naming.named.empty()) {
       PayloadSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, payload, &a->payload_search);
     }
@@ -259,22 +279,6 @@ Eigen::Vector2d NamedImuOffset(const Analysis& a) {
     if (theta.size() >= 2) return theta.head<2>();
   }
   return Eigen::Vector2d::Zero();
-}
-
-// "the named correction (floor.friction.sliding 0.708, tracker_bias)" or "nothing named".
-std::string CorrectionWords(const Verdict& v) {
-  std::vector<std::string> words;
-  for (const VerdictNamed& n : v.named) words.push_back(n.knob + (std::isfinite(n.lo) ? Fmt(" %.3g", n.value) : ""));
-  return words.empty() ? "nothing named" : "the named correction (" + JoinWords(words) + ")";
-}
-
-// The posture check (posture.h) of the simulator knobs `values` and the IMU offset `imu`.
-PostureCheck CheckNamedPosture(const KnobSimulator& simulator, const AnalysisOptions& options, const Analysis& a,
-                               const std::vector<KnobValue>& values, const Eigen::Vector2d& imu) {
-  PostureOptions o = options.posture;
-  o.seed = options.seed + 19;
-  return CheckPosture(simulator, a.inputs, a.candidates.nominal, a.candidates.recording, options.candidates.recording,
-                      values, imu, CorrectionWords(a.verdict), o);
 }
 
 // The correction of what is named at the end (a search's recording when a search named it, else the

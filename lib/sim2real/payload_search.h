@@ -22,7 +22,10 @@
 // the leg search challenged and did not replace (short of the ceiling, or seldom agreed on: a
 // payload off the middle read as a small payload and a tracker offset on the planar quadruped,
 // pair 59000), and names its payload only when it beats their correction as a leg would
-// (PayloadSearchChallenge).
+// (PayloadSearchChallenge). The likelihood fixes the moment only so far: where several columns fit
+// as well, the torso's posture (posture.h), which a payload's moment tilts, chooses among them
+// when the analysis gives it (PostureLeft): the column whose best point leaves the least posture.
+#include <functional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -42,6 +45,10 @@ struct PayloadSearchOptions {
   std::vector<double> sideways = {-1.0, 1.0};                 // of the y probe's offset, forward 0
   // Rounds of half-steps of the position around the best column, along its line (two columns each).
   int position_steps = 1;
+  // Among the columns that fit as well as the best, name the one whose best point leaves the least
+  // of the real torso's posture (PostureLeft), where the analysis can check the posture; one that,
+  // refined, fits no better than the nominal gives way to the next, the likelihood's best last.
+  bool posture_chooses = true;
   LegSearchOptions search;  // the scoring and naming rules (its factors unused; the analysis's model)
   PayloadSearchOptions() { search.refine_steps = 2; }  // the best column's mass, to a quarter of a step
   bool IsValid(std::string* error) const;
@@ -53,13 +60,19 @@ struct PayloadColumn {
   double best_x = 0, best_y = 0;  // ... and where the column places that mass (its moment kept)
   double score = -INFINITY;     // that point's mean log-likelihood per real sample
   bool fits_as_well = false;    // within z SE of the best column's best (placements as units)
+  double posture_z = NAN;       // the posture its best point leaves (PostureLeft; NaN: not checked)
 };
+
+// The real torso's posture a correction of simulator knobs leaves, in standard errors
+// (PostureCheck::z_left; NaN where it cannot be checked).
+using PostureLeft = std::function<double(const std::vector<KnobValue>& values)>;
 
 struct PayloadSearch {
   bool ran = false;
   std::string why;                     // why it did not run or names nothing
   std::vector<PayloadColumn> columns;  // every position searched
   int best_column = -1;
+  int likelihood_best = -1;            // the best column by likelihood alone (best_column unless the posture chose)
   LegSearch search;                    // the best column's search (its `also`: the position)
   double x = NAN, y = NAN;             // where the named mass sits
   double x_nominal = 0, y_nominal = 0; // the knobs' nominal position (the middle)
@@ -77,7 +90,8 @@ struct PayloadKnobs {
 PayloadKnobs FindPayloadKnobs(const KnobSimulator& simulator);
 
 PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
-                            const CandidateOptions& recording, const PayloadSearchOptions& options);
+                            const CandidateOptions& recording, const PayloadSearchOptions& options,
+                            const PostureLeft& posture_left = nullptr);
 
 // The search as a challenger of the knobs `named` before it (LegSearchChallenge): its payload keeps
 // its name only when it fits the real samples better than their correction `corrected` by the

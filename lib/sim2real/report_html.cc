@@ -300,12 +300,13 @@ std::string PayloadSearchTables(const PayloadSearch& p) {
   o << "<h3>Search of a payload's mass and position</h3><p>Each column keeps a moment: a payload of mass m sits at "
        "its position at the mass probe times probe / m.</p><table><tr><th>column: forward, left at the mass probe (m)"
     << "</th><th>best mass (kg)</th><th>where it sits: forward, left (m)</th>"
-    << "<th>log-likelihood per real sample (own model)</th><th>fits as well as the best</th></tr>";
+    << "<th>log-likelihood per real sample (own model)</th><th>fits as well as the best</th>"
+    << "<th>posture left (SE)</th></tr>";
   for (const PayloadColumn& c : p.columns) {
     o << "<tr><td>" << F("%.4g", c.x) << ", " << F("%.4g", c.y) << "</td><td>" << F("%.4g", c.mass) << "</td><td>"
       << F("%.4g", c.best_x) << ", " << F("%.4g", c.best_y) << "</td><td>"
       << (std::isfinite(c.score) ? F("%.4f", c.score) : std::string("fell")) << "</td><td>" << (c.fits_as_well ? "yes" : "")
-      << "</td></tr>";
+      << "</td><td>" << (std::isfinite(c.posture_z) ? F("%.1f", c.posture_z) : std::string("-")) << "</td></tr>";
   }
   o << "</table>\n" << LegSearchTable(p.search, "The payload's mass at the best position", false);
   return o.str();

@@ -234,7 +234,8 @@ json PayloadSearchJson(const PayloadSearch& p) {
   for (const PayloadColumn& c : p.columns) {
     columns.push_back({{"forward_m", c.x}, {"left_m", c.y}, {"best_mass_kg", JsonNumber(c.mass)},
                        {"best_forward_m", c.best_x}, {"best_left_m", c.best_y},
-                       {"score", JsonNumber(c.score)}, {"fits_as_well", c.fits_as_well}});
+                       {"score", JsonNumber(c.score)}, {"fits_as_well", c.fits_as_well},
+                       {"posture_z", JsonNumber(c.posture_z)}});
   }
   out["ran"] = true;
   out["why"] = p.why;
@@ -243,6 +244,8 @@ json PayloadSearchJson(const PayloadSearch& p) {
   const auto [forward, left] = PayloadMoment(p);
   out["moment_kg_m"] = {JsonNumber(forward), JsonNumber(left)};
   out["positions"] = columns;
+  out["likelihood_best_position"] = p.likelihood_best;  // index into positions: the best by likelihood alone
+  out["named_position"] = p.best_column;  // the position named (the posture's choice where it differs)
   out["seconds"] = p.seconds;
   return out;
 }

@@ -4,6 +4,8 @@
 // and nothing else was named.
 #include "sim2real/payload_search.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "sim2real/analysis.h"
@@ -133,6 +135,70 @@ TEST(PayloadSearch, AChallengedNameGivesWayOnlyToAPayloadThatFitsBetter) {
   ASSERT_EQ(kept.doubts.size(), 1u);
   EXPECT_NE(kept.doubts[0].find("behind the middle fits the real samples as well as the named knobs"), std::string::npos)
       << kept.doubts[0];
+}
+
+// Where several columns fit as well, the torso's posture (PostureLeft) chooses among them; a
+// column that fits worse, or a posture that cannot be checked, changes nothing.
+TEST(PayloadSearch, ThePostureChoosesAmongTheColumnsThatFitAsWell) {
+  const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
+  const PayloadSearch alone = Search(s);
+  std::vector<int> as_well, worse;
+  for (int j = 0; j < static_cast<int>(alone.columns.size()); ++j) {
+    if (j == alone.best_column) continue;
+    (alone.columns[j].fits_as_well ? as_well : worse).push_back(j);
+  }
+  ASSERT_FALSE(as_well.empty()) << "the fake's payload acts by its moment: columns near the best fit as well";
+  ASSERT_FALSE(worse.empty());
+  // A posture that only the column `pick` gives (columns told apart by where they place the mass).
+  auto search_with = [&](int pick, double at_pick) {
+    PayloadSearchOptions o;
+    o.search.model = s.options.locate.model;
+    const PayloadColumn& c = alone.columns[pick];
+    const PostureLeft posture = [&c, at_pick](const std::vector<KnobValue>& values) {
+      for (const KnobValue& v : values) {
+        if (v.knob == kPayloadX && v.value == c.best_x) return at_pick;
+      }
+      return 3.0;
+    };
+    return SearchPayload(SharedFake(), s.in, s.set, s.options.candidates, o, posture);
+  };
+  const PayloadSearch chosen = search_with(as_well[0], 0.5);
+  EXPECT_EQ(chosen.likelihood_best, alone.best_column);
+  EXPECT_EQ(chosen.best_column, as_well[0]);
+  EXPECT_DOUBLE_EQ(chosen.columns[as_well[0]].posture_z, 0.5);
+  EXPECT_DOUBLE_EQ(chosen.columns[alone.best_column].posture_z, 3.0);
+  EXPECT_TRUE(std::isnan(chosen.columns[worse[0]].posture_z)) << "only the columns that fit as well are checked";
+  Verdict v = UnexplainedInRegions();
+  AddPayloadSearch(chosen, &v);
+  EXPECT_NE(v.sentence.find("the torso's posture chose"), std::string::npos) << v.sentence;
+  EXPECT_EQ(search_with(worse[0], 0.5).best_column, alone.best_column) << "a column that fits worse";
+  EXPECT_EQ(search_with(as_well[0], NAN).best_column, alone.best_column) << "a posture not checked";
+  Verdict plain = UnexplainedInRegions();
+  AddPayloadSearch(alone, &plain);
+  EXPECT_EQ(plain.sentence.find("posture chose"), std::string::npos) << plain.sentence;
+}
+
+// A column the posture chose that, refined, fits no better than the nominal gives way to the
+// likelihood's best (on a nominal robot nothing is named either way).
+TEST(PayloadSearch, APostureChoiceThatNamesNothingGivesWayToTheLikelihoodsBest) {
+  const Stages s = RunStages({}, 3);
+  const PayloadSearch alone = Search(s);
+  int other = -1;
+  for (int j = 0; j < static_cast<int>(alone.columns.size()); ++j) {
+    if (j != alone.best_column && alone.columns[j].fits_as_well) other = j;
+  }
+  ASSERT_GE(other, 0);
+  PayloadSearchOptions o;
+  o.search.model = s.options.locate.model;
+  const double x = alone.columns[other].best_x, y = alone.columns[other].best_y;
+  const PayloadSearch p = SearchPayload(SharedFake(), s.in, s.set, s.options.candidates, o,
+                                        [x, y](const std::vector<KnobValue>& values) {
+                                          return values.at(1).value == x && values.at(2).value == y ? 0.1 : 3.0;
+                                        });
+  EXPECT_DOUBLE_EQ(p.columns[other].posture_z, 0.1);
+  EXPECT_FALSE(p.search.named);
+  EXPECT_EQ(p.best_column, alone.best_column);
+  EXPECT_EQ(p.search.value, alone.search.value);
 }
 
 // In the analysis: off by default; when enabled it runs on physics no knob describes (nothing named
