@@ -142,13 +142,31 @@ std::string CorrectionWords(const Verdict& v) {
   return words.empty() ? "nothing named" : "the named correction (" + JoinWords(words) + ")";
 }
 
+// The posture options of the analysis's checks (their own seed).
+PostureOptions NamedPostureOptions(const AnalysisOptions& options) {
+  PostureOptions o = options.posture;
+  o.seed = options.seed + 19;
+  return o;
+}
+
 // The posture check (posture.h) of the simulator knobs `values` and the IMU offset `imu`.
 PostureCheck CheckNamedPosture(const KnobSimulator& simulator, const AnalysisOptions& options, const Analysis& a,
                                const std::vector<KnobValue>& values, const Eigen::Vector2d& imu) {
-  PostureOptions o = options.posture;
-  o.seed = options.seed + 19;
   return CheckPosture(simulator, a.inputs, a.candidates.nominal, a.candidates.recording, options.candidates.recording,
-                      values, imu, CorrectionWords(a.verdict), o);
+                      values, imu, CorrectionWords(a.verdict), NamedPostureOptions(options));
+}
+
+// The posture each payload column's best point leaves (PostureLeft), against one comparison of the
+// real set with the sim set (the same as CheckNamedPosture's, measured once for every column).
+PostureLeft PayloadPostureLeft(const KnobSimulator& simulator, const AnalysisOptions& options, const Analysis& a) {
+  const PostureOptions o = NamedPostureOptions(options);
+  const PostureCheck compared = ComparePosture(a.inputs, GroundOf(simulator), o);
+  return [&simulator, &options, &a, compared, o](const std::vector<KnobValue>& values) {
+    const PostureCheck c = CheckCorrectionPosture(compared, simulator, a.inputs, a.candidates.nominal,
+                                                  a.candidates.recording, options.candidates.recording, values,
+                                                  Eigen::Vector2d::Zero(), CorrectionWords(a.verdict), o);
+    return c.ran ? c.z_left : NAN;
+  };
 }
 
 // Stages 8a to 8c: the runoff on uneven ground, then the leg search when still nothing is named,
@@ -182,11 +200,8 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     stage("payload search (its mass and position)");
     PayloadSearchOptions payload = options.payload;
     payload.search = OwnModels(payload.search, options);
-    const PostureLeft posture_left = [&](const std::vector<KnobValue>& values) {
-      const PostureCheck c = CheckNamedPosture(simulator, options, *a, values, Eigen::Vector2d::Zero());
-      return c.ran ? c.z_left : NAN;
-    };
-    a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload, posture_left);
+    a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload,
+                                      PayloadPostureLeft(simulator, options, *a));
     if (!a->naming.named.empty()) {
       PayloadSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, payload, &a->payload_search);
     }

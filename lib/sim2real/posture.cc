@@ -300,7 +300,16 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
                           const Recording& recording, const RecordingOptions& recording_options,
                           const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
                           const std::string& correction, const PostureOptions& options) {
-  PostureCheck c = ComparePosture(in, GroundOf(simulator), options);
+  return CheckCorrectionPosture(ComparePosture(in, GroundOf(simulator), options), simulator, in, nominal, recording,
+                                recording_options, values, imu, correction, options);
+}
+
+PostureCheck CheckCorrectionPosture(const PostureCheck& compared, const KnobSimulator& simulator,
+                                    const AnalysisInputs& in, const SampleSet& nominal, const Recording& recording,
+                                    const RecordingOptions& recording_options, const std::vector<KnobValue>& values,
+                                    const Eigen::Vector2d& imu, const std::string& correction,
+                                    const PostureOptions& options) {
+  PostureCheck c = compared;
   c.compared_only = false;
   c.correction = correction;
   if (!c.ran) return c;

@@ -134,6 +134,15 @@ PostureCheck CheckPosture(const KnobSimulator& simulator, const AnalysisInputs& 
                           const std::vector<KnobValue>& values, const Eigen::Vector2d& imu,
                           const std::string& correction, const PostureOptions& options);
 
+// CheckPosture's second half: the correction set against `compared` (ComparePosture's real set
+// against the sim set, kept as it is), so that several corrections checked against one comparison
+// share its resampling (the payload search's columns).
+PostureCheck CheckCorrectionPosture(const PostureCheck& compared, const KnobSimulator& simulator,
+                                    const AnalysisInputs& in, const SampleSet& nominal, const Recording& recording,
+                                    const RecordingOptions& recording_options, const std::vector<KnobValue>& values,
+                                    const Eigen::Vector2d& imu, const std::string& correction,
+                                    const PostureOptions& options);
+
 // A named IMU offset the posture contradicted: the first fit's names and its posture check (the
 // offset, z left with and without it); the analysis's stages from the candidates then ran again
 // without an IMU offset (PostureOptions::refit_without_imu).
