@@ -59,6 +59,7 @@ struct Sim2RealArgs {
   double posture_z = sim2real::PostureOptions{}.z;
   bool refit_without_imu = sim2real::PostureOptions{}.refit_without_imu;
   bool runoff = true;
+  bool ground_search = true;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
@@ -169,6 +170,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.candidates.legs_only_when_implicated = !args.every_leg;
   o.legs.enabled = args.leg_search;
   o.runoff.enabled = args.runoff;
+  o.ground.enabled = args.ground_search;
   o.payload.enabled = args.payload_search;
   o.payload.on_posture = args.payload_on_posture;
   o.payload.posture_chooses = args.payload_posture_chooses;
@@ -436,6 +438,10 @@ void Setup(CLI::App& root) {
                 "when the torso's posture contradicts a named IMU offset (the rest of the correction gives the real "
                 "posture without it), analyse again from the candidates without an IMU offset (--posture; "
                 "docs/sim2real.md); --keep-contradicted-imu keeps it named, with the doubt");
+  cmd->add_flag("--ground-search,!--no-ground-search", args->ground_search,
+                "on a height field with ground knobs: compare the spread of the real robot's standing tilt with the "
+                "simulated one's and, where it moved, record the ground's knobs until one gives it (on by default; "
+                "docs/sim2real.md, \"The ground's own knobs\")");
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

@@ -11,12 +11,15 @@ null,stones,payload,leg: s mod 4), the values from random.Random(s):
      terrain.stones.height_scale: the same places, higher stones);
   payload: a payload of 1.5-3 kg on the torso, forward by up to 0.1 m (payload.mass_kg);
   leg: one leg's servo gain in [0.25, 0.5] (actuators.legN.gain, N drawn among the 8 legs);
-  friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1).
+  friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1);
+  rough: the ground's small-scale roughness, a factor in [1.7, 2.6] on terrain.rough.rms_height_m
+     (the knob terrain.rough.rms_scale).
 The real set is the planted config, protocol paper, the same placements count, seed s. Then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
-what was named, the value, which stage named it (`knobs`: the mean shifts; `runoff`; `leg_search`)
+what was named, the value, which stage named it (`knobs`: the mean shifts; `ground_search`; `runoff`; `leg_search`)
 and whether it lies within 25% of the truth, the status, the excess shortfall (shortfall − null, nats
-per real sample) with its SE and the null's source and value, whether the
+per real sample) with its SE and the null's source and value, the real standing tilt's spread over
+the sim set's (ratio, z: the ground stage), whether the
 located tests permuted whole placements, and the wall time.
 
 Usage: scripts/sim2real_rough_ground.py [--build build] [--config datasets/robots/rough_ground.json]
@@ -28,7 +31,7 @@ config is the same) and the cache, and writes its reports beside the first (repo
 """
 import argparse, copy, json, os, random, subprocess, sys, tempfile, time
 
-KINDS = ["null", "stones", "payload", "leg", "friction"]
+KINDS = ["null", "stones", "payload", "leg", "friction", "rough"]
 
 
 def planted(seed, cfg, kinds=KINDS[:4]):
@@ -47,6 +50,10 @@ def planted(seed, cfg, kinds=KINDS[:4]):
         leg, gain = r.randrange(8), r.uniform(0.25, 0.5)
         cfg.setdefault("actuators", {})["leg_gain"] = [gain if i == leg else 1.0 for i in range(8)]
         return f"actuators.leg{leg}.gain", gain
+    if kind == "rough":
+        factor = r.uniform(1.7, 2.6)
+        cfg["terrain"]["rough"]["rms_height_m"] *= factor
+        return "terrain.rough.rms_scale", factor
     if kind == "friction":
         mu = r.uniform(0.3, 0.6)
         cfg.setdefault("friction", {})["sliding"] = mu
@@ -76,8 +83,10 @@ def row(seed, knob, truth, report, wall):
     excess = (f"{ad['excess_shortfall_nats_per_sample']:.2f} ± {ad['excess_shortfall_se']:.2f} "
               f"({ad['null_shortfall_source']} {ad['null_shortfall_nats_per_sample']:.2f})"
               if ad.get("excess_shortfall_nats_per_sample") is not None else "-")
+    g = j.get("ground") or {}
+    ground = f"{g['ratio']:.2f} ({g['z_moved']:+.1f})" if g.get("ran") else "-"
     return (f"| {seed} | {knob or 'null'} | {truth:.3g} | {names} | {value:.3g} | {by} | {'yes' if ok else 'no'} | "
-            f"{v['status']} | {excess} | {permuted} | {wall:.0f} |")
+            f"{v['status']} | {excess} | {ground} | {permuted} | {wall:.0f} |")
 
 
 def main():
@@ -108,9 +117,9 @@ def main():
              "--seed", str(a.sim_seed), "-o", sim)
     print(f"Rough ground {a.config}, sim set seed {a.sim_seed} ({a.sim_placements} placements), real seeds "
           f"{lo}-{hi} (kinds {a.kinds}), sim2real with --threads {a.threads}\n")
-    print("| seed | planted | truth | named | value | named by | right | status | excess ± SE (null) | tests permute "
-          "| wall s |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("| seed | planted | truth | named | value | named by | right | status | excess ± SE (null) "
+          "| standing tilt ratio (z) | tests permute | wall s |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)

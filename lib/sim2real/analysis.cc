@@ -104,7 +104,7 @@ void SelectToVerdict(const KnobSimulator& simulator, const AnalysisOptions& opti
 // The runoff runs on uneven ground when the stages before left a mismatch: something named but
 // not explained, or nothing named for a located mismatch.
 bool WantRunoff(const Analysis& a, const RunoffOptions& options) {
-  if (!options.enabled || (options.only_on_uneven_ground && !a.baseline.permute_placements)) return false;
+  if (!options.enabled || a.ground.search.named || (options.only_on_uneven_ground && !a.baseline.permute_placements)) return false;
   return a.verdict.status == "partly_explained" || a.verdict.status == "unexplained";
 }
 
@@ -123,7 +123,9 @@ LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
 // (`challenge`, WantChallenge before it ran).
 bool WantPayloadSearch(const Analysis& a, const PayloadSearchOptions& options, bool challenge) {
   const bool on = options.enabled || (options.on_posture && a.posture.left_out);
-  if (!on || a.baseline.permute_placements || a.runoff.search.named || a.leg_search.named) return false;
+  if (!on || a.baseline.permute_placements || a.ground.search.named || a.runoff.search.named || a.leg_search.named) {
+    return false;
+  }
   if (!a.naming.named.empty()) return options.challenge_named && challenge;
   return a.verdict.status == "unexplained" && a.verdict.named.empty();
 }
@@ -169,12 +171,27 @@ PostureLeft PayloadPostureLeft(const KnobSimulator& simulator, const AnalysisOpt
   };
 }
 
-// Stages 8a to 8c: the runoff on uneven ground, then the leg search when still nothing is named,
-// then the payload search.
+// The ground's standing tilt (stage 8a) on a height field.
+void SearchTheGround(const KnobSimulator& simulator, const AnalysisOptions& options, Analysis* a) {
+  const auto t = Clock::now();
+  GroundSearchOptions ground = options.ground;
+  ground.search = OwnModels(ground.search, options);
+  ground.seed = options.seed + 23;
+  a->ground = SearchGround(simulator, a->inputs, a->candidates, options.candidates, ground);
+  AddGroundSearch(simulator, a->ground, &a->verdict);
+  a->seconds.ground += Since(t);
+}
+
+// Stages 8a to 8d: the ground on a height field, the runoff on uneven ground, then the leg search
+// when still nothing is named, then the payload search.
 template <typename Stage>
 void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
   const bool challenge = !a->naming.named.empty() && WantChallenge(*a, options.legs);
   const std::vector<std::string> named = NamedKnobs(*a);
+  if (options.ground.enabled && !simulator.plane_ground()) {
+    stage("ground (the standing tilt's spread)");
+    SearchTheGround(simulator, options, a);
+  }
   if (WantRunoff(*a, options.runoff)) {
     const auto t = Clock::now();
     stage("runoff (contenders scored by models of their own)");
@@ -184,7 +201,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     AddRunoff(simulator, &a->runoff, &a->verdict);
     a->seconds.runoff += Since(t);
   }
-  if (!a->runoff.search.named && WantLegSearch(*a, options.legs)) {
+  if (!a->ground.search.named && !a->runoff.search.named && WantLegSearch(*a, options.legs)) {
     const auto t = Clock::now();
     stage("leg search (every leg's gain)");
     const LegSearchOptions legs = OwnModels(options.legs, options);
@@ -213,7 +230,7 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
 // The knobs the runoff, the leg search or the payload search recorded without naming them.
 std::vector<std::string> SearchedWithoutName(const Analysis& a) {
   std::vector<std::string> knobs;
-  for (const LegSearch* s : {&a.runoff.search, &a.leg_search, &a.payload_search.search}) {
+  for (const LegSearch* s : {&a.ground.search, &a.runoff.search, &a.leg_search, &a.payload_search.search}) {
     if (!s->ran || s->named) continue;
     for (const LegSearchPoint& p : s->points) AddUnique(&knobs, p.knob);
   }
@@ -327,10 +344,11 @@ bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
          recorded_null.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
-         runoff.IsValid(error) && payload.IsValid(error) && posture.IsValid(error) && more_data.IsValid(error);
+         ground.IsValid(error) && runoff.IsValid(error) && payload.IsValid(error) && posture.IsValid(error) && more_data.IsValid(error);
 }
 
 const LegSearch* NamedByOwnModels(const Analysis& a) {
+  if (a.ground.search.named) return &a.ground.search;
   if (a.runoff.search.named) return &a.runoff.search;
   if (a.leg_search.named) return &a.leg_search;
   return a.payload_search.search.named ? &a.payload_search.search : nullptr;
@@ -420,7 +438,7 @@ namespace {
 template <typename Stage>
 void NameAndCheck(const KnobSimulator& simulator, const AnalysisOptions& options, const Stage& stage, Analysis* a) {
   const RecordingCounts before = RecordingCounts::Of(*a);
-  a->runoff = Runoff{}, a->leg_search = LegSearch{}, a->payload_search = PayloadSearch{};
+  a->ground = GroundSearch{}, a->runoff = Runoff{}, a->leg_search = LegSearch{}, a->payload_search = PayloadSearch{};
   // A first look whose selections will be recorded again with every execution is a screen: the
   // run again searches what it selects, so the first look searches nothing.
   AnalysisOptions first = options;

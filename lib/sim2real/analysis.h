@@ -14,6 +14,9 @@
 //   8. verdict     (verdict_stage.h) named knobs, status, doubts and the sentence; 3-8 once more
 //                                    with every execution's signatures when an effect's size
 //                                    varied with the execution index;
+//      ground      (ground_search.h) on a height field: does the real robot stand tilted as variously as
+//                                    the simulated one? If not, the ground knobs recorded until one
+//                                    gives the real spread, its recording scored by its own model;
 //      runoff      (runoff.h)        on uneven ground with a mismatch left: the first step's contenders
 //                                    recorded again, each recording scored by its own model;
 //      legs        (leg_search.h)    when nothing is named for a located mismatch: every leg's gain
@@ -34,6 +37,7 @@
 #include <vector>
 
 #include "sim2real/correction.h"
+#include "sim2real/ground_search.h"
 #include "sim2real/leg_search.h"
 #include "sim2real/more_data.h"
 #include "sim2real/payload_search.h"
@@ -54,6 +58,7 @@ struct AnalysisOptions {
   VerdictOptions verdict;
   LegSearchOptions legs;   // its model options are the baseline's (locate.model)
   RunoffOptions runoff;    // likewise
+  GroundSearchOptions ground;  // likewise (seed: the analysis's)
   PayloadSearchOptions payload;  // likewise; off by default
   PostureOptions posture;        // the torso's posture beside the motion (a plane, level or a slope; seed: the analysis's)
   // When an effect fits on average but its size varies with the execution index and the
@@ -91,8 +96,8 @@ struct AnalysisOptions {
 
 // Wall seconds per stage, summed over every run of it (a run again with every execution, a refit).
 struct StageTimes {
-  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, runoff = 0, legs = 0, payload = 0,
-         posture = 0, total = 0;
+  double locate = 0, candidates = 0, refine = 0, confidence = 0, adequacy = 0, ties = 0, ground = 0, runoff = 0, legs = 0,
+         payload = 0, posture = 0, total = 0;
 };
 
 struct Analysis {
@@ -111,6 +116,7 @@ struct Analysis {
   Naming naming;
   TieResult ties;
   Verdict verdict;
+  GroundSearch ground;             // compared on a height field with ground knobs (GroundSearch::ran)
   Runoff runoff;                   // ran only on uneven ground with a mismatch left (Runoff::ran)
   LegSearch leg_search;            // ran only when nothing was named (LegSearch::ran)
   PayloadSearch payload_search;    // ran only when enabled and still nothing was named (PayloadSearch::ran)
@@ -126,8 +132,9 @@ struct Analysis {
 
 // `simulator` null: locate only, `no_simulator_reason` saying why. Throws InputError for sets
 // that cannot be compared and for a simulator that cannot record the sim set's protocol.
-// The search that named the verdict's knob by recordings scored with their own models (the runoff,
-// else the leg search, else the payload search), or nullptr when the knob path's correction stands.
+// The search that named the verdict's knob by recordings scored with their own models (the ground
+// search, else the runoff, else the leg search, else the payload search), or nullptr when the knob
+// path's correction stands.
 const LegSearch* NamedByOwnModels(const Analysis& a);
 
 // Does the leg search run (stage 8b)? When the stages before named nothing for a located mismatch

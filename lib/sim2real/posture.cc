@@ -168,6 +168,11 @@ bool PostureOptions::IsValid(std::string* error) const {
   return true;
 }
 
+double RadialResidual(const SlopeGeometry& g, const Eigen::Vector2d& z) {
+  const Eigen::Vector2d d = z - g.centre;
+  return d.norm() - Harmonics(std::atan2(d(1), d(0))).dot(g.radius);
+}
+
 SlopeGeometry FitSlopeGeometry(const SampleSet& reference, int pitch_col, int roll_col) {
   SlopeGeometry g;
   const int n = reference.size();

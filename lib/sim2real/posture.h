@@ -76,6 +76,9 @@ struct SlopeGeometry {
 // under 4 times the robust SD of the radial residuals).
 SlopeGeometry FitSlopeGeometry(const SampleSet& reference, int pitch_col, int roll_col);
 
+// z's radial part on the slope's circle, rho~ = |z - c| - R(theta) (z: pitch, roll in rad).
+double RadialResidual(const SlopeGeometry& g, const Eigen::Vector2d& z);
+
 // Per command mean z (pitch, roll columns) of `a` minus that of `b`, averaged over the commands
 // both have (matched by label), on the rows `rows_a` and `rows_b`; NaN without a shared command.
 // With `slope`, the posture shift d from the radial parts per (command, direction) cell (above);

@@ -175,15 +175,18 @@ std::string PhysicsSection(const Analysis& a) {
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
   if (const LegSearch* own = NamedByOwnModels(a)) {
-    const bool runoff = own->by == "runoff", payload = own->by == "payload_search";
-    o << (runoff    ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
+    const bool runoff = own->by == "runoff", payload = own->by == "payload_search", ground = own->by == "ground_search";
+    o << (ground    ? "<p>On this uneven ground the real robot stands tilted otherwise than the simulated one; the search "
+                      "of the ground's knobs (section 5), each recorded until it gives the real standing tilt's spread "
+                      "and scored by a model of its own, named "
+          : runoff  ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
                       "each recorded again and scored by a model of its own (section 5), named "
           : payload ? "<p>The forward selection below and the search of every leg's gain named nothing; the search of "
                       "a payload's mass and position (section 5) named "
                     : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
       << Escape(own->knob) << F(" = %.4g", own->value) << ": its recording fits the real samples "
       << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, "
-      << (payload ? "" : runoff ? "no other contender's as well, " : "no other leg's as well, ") << "and "
+      << (payload ? "" : runoff || ground ? "no other contender's as well, " : "no other leg's as well, ") << "and "
       << MisfitSaid(*own) << ". It has no bootstrap: inclusion is not computed.</p>\n";
   }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
@@ -225,7 +228,8 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
     o << "<tr><td>(b) corrected ("
-      << (own->by == "runoff"           ? "the runoff's named knob"
+      << (own->by == "ground_search"    ? "the ground knob of the ground search"
+          : own->by == "runoff"         ? "the runoff's named knob"
           : own->by == "payload_search" ? "the payload of the payload search"
                                         : "the weak leg of the leg search")
       << ", its recording's own model under the search's score: sags and a broad floor included)</td><td>"
@@ -328,6 +332,35 @@ std::string PostureParagraph(const PostureCheck& c) {
          ".</p>\n";
 }
 
+// The ground's standing tilt, real against sim, and every ground knob's curve (ground_search.h).
+std::string GroundParagraph(const GroundSearch& g) {
+  if (!g.ran) return g.why.empty() ? "" : "<p>The ground's standing tilt was not compared: " + Escape(g.why) + ".</p>\n";
+  std::ostringstream o;
+  o << "<h3>The ground: the standing tilt's spread</h3><p>Spread of the torso's tilt at the first execution of each "
+    << "placement" << (g.on_slope ? " (z's radial part on the slope's circle)" : "") << ": real "
+    << F("%.1f", 1e3 * g.real.value) << " mrad (SE " << F("%.1f", 1e3 * g.real.se) << ", " << g.real.placements
+    << " placements), sim " << F("%.1f", 1e3 * g.sim.value) << " (SE " << F("%.1f", 1e3 * g.sim.se) << ", "
+    << g.sim.placements << "); ratio " << F("%.3f", g.ratio) << " (SE " << F("%.3f", g.ratio_se) << ", z "
+    << F("%.1f", g.z_moved) << ")" << (g.moved ? "" : ": alike") << ".</p>\n";
+  if (g.curves.empty()) return o.str();
+  o << "<table><tr><th>ground knob</th><th>values recorded: ratio to the nominal's spread</th><th>meets the real "
+       "ratio at</th><th>its recording's ratio (SE from the real)</th><th>the real standing tilts' log density under "
+       "its recording's (SE below the best)</th></tr>";
+  for (const GroundCurve& c : g.curves) {
+    o << "<tr><td>" << Escape(c.knob) << "</td><td>";
+    for (size_t j = 0; j < c.values.size(); ++j) o << (j ? "; " : "") << F("%.3g", c.values[j]) << ": " << F("%.3f", c.ratios[j]);
+    o << "</td><td>" << (std::isfinite(c.matched) ? F("%.3g", c.matched) : std::string("not in range")) << "</td><td>"
+      << (std::isfinite(c.matched_ratio) ? F("%.3f", c.matched_ratio) + " (" + F("%.1f", c.match_z) + ")" : std::string("-"))
+      << "</td><td>"
+      << (std::isfinite(c.tilt_score) ? F("%.3f", c.tilt_score) + " (" + F("%.1f", c.tilt_z) + ")" : std::string("-"))
+      << "</td></tr>";
+  }
+  o << "</table>\n";
+  if (g.search.ran) o << LegSearchTable(g.search, "The ground knobs' values that meet it, each scored by a model of its own", false);
+  else o << "<p>" << Escape(g.why) << ".</p>\n";
+  return o.str();
+}
+
 std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const std::filesystem::path& dir) {
   std::ostringstream o;
   o << "<h2>5. Details</h2>\n";
@@ -348,6 +381,7 @@ std::string DetailsSection(const Analysis& a, const ReportContext& ctx, const st
         << Escape(a.every_execution_because) << ".</p>\n";
     }
   }
+  o << GroundParagraph(a.ground);
   if (a.runoff.ran) {
     o << LegSearchTable(a.runoff.search, "Runoff of the first step's contenders on uneven ground (each recording scored "
                                          "by a model of its own)", false);
@@ -398,7 +432,9 @@ std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std
   o << "fit: held-out nats per real sample: sim " << F("%.3f", a.baseline.ll_sim);
   const LegSearch* own = NamedByOwnModels(a);
   if (own) {
-    const std::string named = own->by == "runoff" ? own->knob : own->by == "payload_search" ? "payload" : "weak " + own->leg;
+    const std::string named = own->by == "runoff" || own->by == "ground_search" ? own->knob
+                              : own->by == "payload_search"                      ? "payload"
+                                                                                 : "weak " + own->leg;
     o << ", corrected (" << named << ") " << F("%.3f", BestScore(*own));
   } else if (a.knobs_analysed) {
     o << ", corrected " << F("%.3f", a.adequacy.ll_corrected);

@@ -223,6 +223,33 @@ json RunoffJson(const Runoff& r) {
   return out;
 }
 
+// The ground's standing tilt compared, every ground knob's curve, and the search of the values that
+// met the real spread (its points are knobs: `leg` goes); null where it could not run.
+json GroundJson(const GroundSearch& g) {
+  if (!g.ran) return g.why.empty() ? json(nullptr) : json({{"ran", false}, {"why_not", g.why}});
+  json curves = json::array();
+  for (const GroundCurve& c : g.curves) {
+    curves.push_back({{"knob", c.knob}, {"values", c.values}, {"ratios", c.ratios}, {"matched", JsonNumber(c.matched)},
+                      {"matched_ratio", JsonNumber(c.matched_ratio)}, {"matched_ratio_se", JsonNumber(c.matched_se)},
+                      {"match_z", JsonNumber(c.match_z)}, {"meets", c.meets},
+                      {"tilt_log_density", JsonNumber(c.tilt_score)}, {"tilt_z_below_best", JsonNumber(c.tilt_z)},
+                      {"tilt_shaped_as_well", c.tilt_as_well}});
+  }
+  json search = LegSearchJson(g.search);
+  if (!search.is_null()) {
+    EraseLegOnlyFields(&search);
+    search.erase("leg");
+    for (json& p : search["points"]) p.erase("leg");
+  }
+  return {{"ran", true}, {"why", g.why}, {"on_slope", g.on_slope},
+          {"standing_spread_rad", {{"real", g.real.value}, {"real_se", g.real.se}, {"sim", g.sim.value},
+                                   {"sim_se", g.sim.se}, {"real_placements", g.real.placements},
+                                   {"sim_placements", g.sim.placements}}},
+          {"ratio", g.ratio}, {"ratio_se", g.ratio_se}, {"z_moved", g.z_moved}, {"moved", g.moved},
+          {"curves", curves}, {"search", search}, {"named", g.search.named},
+          {"recorded", g.recorded}, {"from_cache", g.from_cache}, {"seconds", g.seconds}};
+}
+
 // The payload search's best column as a search (its points: masses at that position) with every
 // position searched; null when it did not run.
 json PayloadSearchJson(const PayloadSearch& p) {
@@ -296,6 +323,7 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"locate", LocateJson(a)},
               {"knobs", a.knobs_analysed ? KnobsJson(a) : json(nullptr)},
               {"adequacy", a.knobs_analysed ? AdequacyJson(a) : json(nullptr)},
+              {"ground", GroundJson(a.ground)},
               {"runoff", RunoffJson(a.runoff)},
               {"leg_search", LegSearchJson(a.leg_search)},
               {"payload_search", PayloadSearchJson(a.payload_search)},
@@ -315,7 +343,8 @@ std::string ReportJson(const Analysis& a, const ReportContext& ctx) {
               {"dropped_real_commands", in.dropped_commands}, {"dropped_real_samples", in.dropped_samples},
               {"seconds", {{"locate", a.seconds.locate}, {"candidates", a.seconds.candidates},
                            {"refine", a.seconds.refine}, {"confidence", a.seconds.confidence},
-                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"runoff", a.seconds.runoff},
+                           {"adequacy", a.seconds.adequacy}, {"ties", a.seconds.ties}, {"ground", a.seconds.ground},
+                           {"runoff", a.seconds.runoff},
                            {"leg_search", a.seconds.legs}, {"payload_search", a.seconds.payload},
                            {"posture", a.seconds.posture}, {"total", a.seconds.total}}}};
   for (const auto& f : ctx.figures) out["figures"].push_back({{"file", f.file}, {"caption", f.caption}});

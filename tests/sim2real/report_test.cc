@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "sim2real/ground_search.h"
 #include "sim2real/leg_search.h"
 #include "tests/sim2real/fake_simulator.h"
 #include "tests/sim2real/stage_fixture.h"
@@ -159,6 +160,36 @@ TEST(Report, TheRunoffsJsonNamesKnobsNotLegs) {
   EXPECT_EQ(j["knobs_as_well"], nlohmann::json::array({"actuators.leg1.gain"}));
   for (const char* leg_only : {"legs_as_well", "challenged", "z_vs_named", "rivals_named"}) EXPECT_FALSE(j.contains(leg_only)) << leg_only;
   EXPECT_EQ(j["contenders"].size(), 2u);
+}
+
+// A ground knob the ground stage named is one story: the JSON's ground block and fit say the
+// search, the stdout summary names the knob, the HTML shows its curve.
+TEST(Report, AGroundKnobNamedByTheGroundStageIsOneStory) {
+  const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
+  EXPECT_FALSE(a.ground.ran) << "the fake has no ground knobs";
+  GroundSearch& g = a.ground;
+  g.ran = g.moved = true;
+  g.real = {0.0176, 0.0012, 166}, g.sim = {0.0129, 0.0006, 166};
+  g.ratio = 1.36, g.ratio_se = 0.11, g.z_moved = 3.2;
+  GroundCurve c;
+  c.knob = "terrain.rough.rms_scale", c.knob_index = 0, c.values = {1, 1.5, 2}, c.ratios = {1, 1.27, 1.56};
+  c.matched = 1.66, c.matched_ratio = 1.36, c.matched_se = 0.05, c.match_z = 0.02, c.meets = c.tilt_as_well = true;
+  g.curves = {c};
+  LegSearch& s = g.search;
+  s.ran = s.named = true, s.by = "ground_search";
+  s.points = {{"terrain.rough.rms_scale", "terrain.rough.rms_scale", 0, 1.66, 11.2, true}};
+  s.best = 0, s.leg = s.knob = "terrain.rough.rms_scale", s.knob_index = 0, s.value = 1.66, s.nominal_score = 10.6;
+  const auto j = nlohmann::json::parse(ReportJson(a, ReportContext{}));
+  EXPECT_EQ(j["ground"]["named"], true) << j["ground"].dump();
+  EXPECT_EQ(j["ground"]["curves"][0]["knob"], "terrain.rough.rms_scale");
+  EXPECT_FALSE(j["ground"]["search"].contains("leg"));
+  EXPECT_EQ(j["fit"]["corrected_by"], "ground_search");
+  const std::string summary = ReportSummary(a, ReportContext{}, "report.html");
+  EXPECT_NE(summary.find("corrected (terrain.rough.rms_scale)"), std::string::npos) << summary;
+  const std::string html = ReportHtml(a, ReportContext{}, ".");
+  EXPECT_NE(html.find("The ground: the standing tilt"), std::string::npos);
+  EXPECT_NE(html.find("the ground knob of the ground search"), std::string::npos);
 }
 
 // The null's source is said where its value is: the JSON's source and count, the HTML's words.
