@@ -104,7 +104,8 @@ void SelectToVerdict(const KnobSimulator& simulator, const AnalysisOptions& opti
 // The runoff runs on uneven ground when the stages before left a mismatch: something named but
 // not explained, or nothing named for a located mismatch.
 bool WantRunoff(const Analysis& a, const RunoffOptions& options) {
-  if (!options.enabled || a.ground.search.named || (options.only_on_uneven_ground && !a.baseline.permute_placements)) return false;
+  if (!options.enabled || a.ground.search.named) return false;
+  if (options.only_on_uneven_ground && !a.baseline.permute_placements) return false;
   return a.verdict.status == "partly_explained" || a.verdict.status == "unexplained";
 }
 
@@ -344,7 +345,8 @@ bool AnalysisOptions::IsValid(std::string* error) const {
   return locate.IsValid(error) && candidates.IsValid(error) && refine.IsValid(error) && adequacy.IsValid(error) &&
          recorded_null.IsValid(error) &&
          ties.IsValid(error) && verdict.IsValid(error) && legs.IsValid(error) &&
-         ground.IsValid(error) && runoff.IsValid(error) && payload.IsValid(error) && posture.IsValid(error) && more_data.IsValid(error);
+         ground.IsValid(error) && runoff.IsValid(error) && payload.IsValid(error) && posture.IsValid(error) &&
+         more_data.IsValid(error);
 }
 
 const LegSearch* NamedByOwnModels(const Analysis& a) {

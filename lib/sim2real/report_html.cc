@@ -162,6 +162,24 @@ std::string NamedTable(const Verdict& v) {
   return o.str();
 }
 
+// How the search that named the verdict's knob came to run, for section 2 ("... named ").
+std::string SearchIntro(const std::string& by) {
+  if (by == "ground_search") {
+    return "<p>On this uneven ground the real robot stands tilted otherwise than the simulated one; the search of "
+           "the ground's knobs (section 5), each recorded until it gives the real standing tilt's spread and scored "
+           "by a model of its own, named ";
+  }
+  if (by == "runoff") {
+    return "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, each "
+           "recorded again and scored by a model of its own (section 5), named ";
+  }
+  if (by == "payload_search") {
+    return "<p>The forward selection below and the search of every leg's gain named nothing; the search of a "
+           "payload's mass and position (section 5) named ";
+  }
+  return "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ";
+}
+
 std::string PhysicsSection(const Analysis& a) {
   std::ostringstream o;
   o << "<h2>2. What physics explains it (simulator knobs and measurement effects)</h2>\n";
@@ -175,18 +193,11 @@ std::string PhysicsSection(const Analysis& a) {
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
   if (const LegSearch* own = NamedByOwnModels(a)) {
-    const bool runoff = own->by == "runoff", payload = own->by == "payload_search", ground = own->by == "ground_search";
-    o << (ground    ? "<p>On this uneven ground the real robot stands tilted otherwise than the simulated one; the search "
-                      "of the ground's knobs (section 5), each recorded until it gives the real standing tilt's spread "
-                      "and scored by a model of its own, named "
-          : runoff  ? "<p>On this uneven ground the forward selection below left a mismatch; a runoff of its contenders, "
-                      "each recorded again and scored by a model of its own (section 5), named "
-          : payload ? "<p>The forward selection below and the search of every leg's gain named nothing; the search of "
-                      "a payload's mass and position (section 5) named "
-                    : "<p>The forward selection below named nothing; the search of every leg's gain (section 5) named ")
+    const bool payload = own->by == "payload_search", leg = own->by == "leg_search";
+    o << SearchIntro(own->by)
       << Escape(own->knob) << F(" = %.4g", own->value) << ": its recording fits the real samples "
       << F("%.1f", own->z_vs_nominal) << " standard errors better than the nominal's, "
-      << (payload ? "" : runoff || ground ? "no other contender's as well, " : "no other leg's as well, ") << "and "
+      << (payload ? "" : leg ? "no other leg's as well, " : "no other contender's as well, ") << "and "
       << MisfitSaid(*own) << ". It has no bootstrap: inclusion is not computed.</p>\n";
   }
   if (a.verdict.named.empty()) o << "<p>Nothing named.</p>\n";
