@@ -60,6 +60,7 @@ struct Sim2RealArgs {
   bool refit_without_imu = sim2real::PostureOptions{}.refit_without_imu;
   bool runoff = true;
   bool ground_search = true;
+  bool null_corrected_gain = false;
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
@@ -171,6 +172,9 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.legs.enabled = args.leg_search;
   o.runoff.enabled = args.runoff;
   o.ground.enabled = args.ground_search;
+  for (sim2real::LegSearchOptions* search : {&o.legs, &o.runoff.search, &o.payload.search, &o.ground.search}) {
+    search->null_corrected_gain = args.null_corrected_gain;
+  }
   o.payload.enabled = args.payload_search;
   o.payload.on_posture = args.payload_on_posture;
   o.payload.posture_chooses = args.payload_posture_chooses;
@@ -442,6 +446,10 @@ void Setup(CLI::App& root) {
                 "on a height field with ground knobs: compare the spread of the real robot's standing tilt with the "
                 "simulated one's and, where it moved, record the ground's knobs until one gives it (on by default; "
                 "docs/sim2real.md, \"The ground's own knobs\")");
+  cmd->add_flag("--null-corrected-gain", args->null_corrected_gain,
+                "experimental: on uneven ground a search's best point must also fit the real samples better than "
+                "the nominal by more than its model fits the nominal's own recording at other places (docs/sim2real.md, "
+                "\"The ground's own knobs\")");
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

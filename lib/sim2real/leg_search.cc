@@ -283,6 +283,27 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
       (ResidualVariance(state->scored[out->best]).array() / ResidualVariance(state->nominal).array()).log().matrix();
 }
 
+// The mean of a - b per sample and its SE, placements as units.
+std::pair<double, double> MeanGain(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement) {
+  const PairedSum d = PairedDifference(a, b, NumberUnits(placement));
+  return {d.sum / a.size(), d.se / a.size()};
+}
+
+// LegSearch::real_gain, null_gain and z_null_corrected (LegSearchOptions::null_corrected_gain):
+// the best point's and the nominal's own models on the real samples and on `null`, the nominal's
+// recording at other places.
+void NullCorrectedGain(const AnalysisInputs& in, const SearchState& state, const Samples& null,
+                       const LegSearchOptions& options, LegSearch* out) {
+  if (null.size() == 0) return;
+  const OwnModel best = FitOwnModel(state.scored[out->best].samples, {}, options, state.Ref());
+  const OwnModel nominal = FitOwnModel(state.nominal.samples, {}, options, state.Ref());
+  const auto [real, real_se] = MeanGain(state.scored[out->best].rows, state.nominal.rows, in.real.episode);
+  const auto [gain, gain_se] = MeanGain(OwnLogLikelihood(best, null, options, state.Ref()),
+                                        OwnLogLikelihood(nominal, null, options, state.Ref()), null.episode);
+  out->real_gain = real, out->null_gain = gain;
+  out->z_null_corrected = (real - gain) / std::hypot(real_se, gain_se);
+}
+
 // The nominal's and the best point's misfits against second recordings at other places.
 void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
                       const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
@@ -298,6 +319,7 @@ void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, 
       MisfitElsewhere(state.nominal.samples, RealCommandsOf(b.sets[0], in), in, options, state.Ref(), &se);
   out->best_misfit = MisfitElsewhere(state.scored[out->best].samples, RealCommandsOf(b.sets[1], in), in, options,
                                      state.Ref(), &out->best_misfit_se);
+  NullCorrectedGain(in, state, RealCommandsOf(b.sets[0], in), options, out);
 }
 
 // The gate at other places: the real samples fit the best point's model no worse than its own
@@ -306,7 +328,17 @@ void GateElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, con
                    const SearchState& state, const LegSearchOptions& options, const Knob& knob, LegSearch* out) {
   MisfitsElsewhere(simulator, in, recording, state, options, out);
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
-  if (out->best_misfit <= options.z * out->best_misfit_se) return;
+  if (out->best_misfit <= options.z * out->best_misfit_se) {
+    if (!options.null_corrected_gain || !(out->z_null_corrected < options.z)) return;
+    out->named = false;
+    out->why = "the best point (" + PointName(knob, out->value) +
+               Fmt(") fits the real samples %.3g nats per sample better than the nominal, but the nominal's own ",
+                   out->real_gain) +
+               Fmt("recording at other places %.3g better too (z %.2f): a broader model's gain on new places, ",
+                   out->null_gain, out->z_null_corrected) +
+               "not evidence of this knob";
+    return;
+  }
   out->named = false;
   out->why = "the real samples fit the model of the best point (" + PointName(knob, out->value) +
              Fmt(") worse than its own recording at other places does (by %.3g nats per sample, ", out->best_misfit) +

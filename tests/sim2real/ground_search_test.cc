@@ -138,6 +138,22 @@ TEST(GroundSearch, ARougherRealGroundIsNamedWithItsValue) {
   EXPECT_NE(v.sentence.find("tilts more variously"), std::string::npos) << v.sentence;
 }
 
+// With the null-corrected gain (LegSearchOptions::null_corrected_gain) the rougher ground keeps its
+// name: its recording's model fits the real samples better than the nominal's, and the nominal's
+// own recording at other places worse (a broader model there is no gain).
+TEST(GroundSearch, TheNullCorrectedGainKeepsARightName) {
+  const GroundFake fake;
+  const GroundPair pair = MakePair(fake, {{kRough, 2.0}});
+  GroundSearchOptions o = Options();
+  o.search.null_corrected_gain = true;
+  const GroundSearch g = SearchGround(fake, pair.in, pair.set, CandidateOptions{}, o);
+  ASSERT_TRUE(g.search.named) << g.why;
+  EXPECT_EQ(g.search.knob_index, kRough);
+  EXPECT_GT(g.search.real_gain, 0);
+  EXPECT_LT(g.search.null_gain, g.search.real_gain);
+  EXPECT_GE(g.search.z_null_corrected, o.search.z);
+}
+
 TEST(GroundSearch, ANullMovesNothingAndRecordsNothing) {
   const GroundFake fake;
   const GroundPair pair = MakePair(fake, {});
