@@ -149,9 +149,10 @@ std::string WhyNot(const KnobSimulator& simulator, const AnalysisInputs& in) {
 }
 
 // The curve of every ground knob: its recordings at the factors on q's side, their ratios.
+// `nominal` receives the nominal re-recording's tilts.
 std::vector<GroundCurve> RecordCurves(const KnobSimulator& simulator, const Recording& rec, const RecordingOptions& ro,
                                       const SlopeGeometry* slope, const GroundSearchOptions& options, int p, int r,
-                                      double q, GroundSearch* out) {
+                                      double q, GroundSearch* out, std::map<int, double>* nominal) {
   const auto& knobs = simulator.knobs();
   std::vector<std::vector<KnobValue>> requests = {{}};
   std::vector<GroundCurve> curves;
@@ -168,13 +169,13 @@ std::vector<GroundCurve> RecordCurves(const KnobSimulator& simulator, const Reco
   }
   const RecordingBatch batch = RecordBatch(simulator, rec, requests, ro);
   out->recorded += batch.recorded, out->from_cache += batch.from_cache;
-  const auto nominal = StandingTilts(batch.sets[0], p, r, slope);
+  *nominal = StandingTilts(batch.sets[0], p, r, slope);
   size_t j = 1;
   for (GroundCurve& c : curves) {
     std::vector<std::pair<double, double>> points = {{knobs[c.knob_index].nominal, 1.0}};
     for (double v : c.values) {
       const auto tilts = StandingTilts(batch.sets[j++], p, r, slope);
-      points.push_back({v, PairedRatio(tilts, nominal, slope != nullptr, 2, 0).first});  // its SE unused
+      points.push_back({v, PairedRatio(tilts, *nominal, slope != nullptr, 0, 0).first});  // no resamples: no SE
     }
     std::sort(points.begin(), points.end());
     c.values.clear(), c.ratios.clear();
@@ -184,25 +185,25 @@ std::vector<GroundCurve> RecordCurves(const KnobSimulator& simulator, const Reco
   return curves;
 }
 
-// Records each curve's matched value and checks that its ratio meets q.
+// Records each curve's matched value and checks that its ratio meets q (against `nominal`, the
+// nominal re-recording's tilts).
 void CheckMatches(const KnobSimulator& simulator, const Recording& rec, const RecordingOptions& ro,
-                  const SlopeGeometry* slope, const GroundSearchOptions& options, int p, int r, GroundSearch* out) {
-  std::vector<std::vector<KnobValue>> requests = {{}};
+                  const SlopeGeometry* slope, const GroundSearchOptions& options, int p, int r,
+                  const std::map<int, double>& nominal, GroundSearch* out) {
+  std::vector<std::vector<KnobValue>> requests;
   for (const GroundCurve& c : out->curves) {
     if (std::isfinite(c.matched)) requests.push_back({{c.knob_index, c.matched}});
   }
-  if (requests.size() == 1) return;
+  if (requests.empty()) return;
   const RecordingBatch batch = RecordBatch(simulator, rec, requests, ro);
   out->recorded += batch.recorded, out->from_cache += batch.from_cache;
-  const auto nominal = StandingTilts(batch.sets[0], p, r, slope);
-  size_t j = 1;
+  size_t j = 0;
   for (GroundCurve& c : out->curves) {
     if (!std::isfinite(c.matched)) continue;
-    const auto [ratio, se] =
-        PairedRatio(StandingTilts(batch.sets[j++], p, r, slope), nominal, slope != nullptr, options.resamples,
-                    options.seed + 2);
+    const auto tilts = StandingTilts(batch.sets[j++], p, r, slope);
+    const auto [ratio, se] = PairedRatio(tilts, nominal, slope != nullptr, options.resamples, options.seed + 2);
     c.matched_ratio = ratio, c.matched_se = se;
-    c.matched_tilts = Values(StandingTilts(batch.sets[j - 1], p, r, slope));
+    c.matched_tilts = Values(tilts);
     c.match_z = std::abs(ratio - out->ratio) / std::hypot(se, out->ratio_se);
     c.meets = c.match_z <= options.match_z;
   }
@@ -321,8 +322,9 @@ GroundSearch SearchGround(const KnobSimulator& simulator, const AnalysisInputs& 
   Recording rec = in.recording;
   rec.placements = out.sim.placements;
   rec.executions_per_placement = 1;
-  out.curves = RecordCurves(simulator, rec, recording.recording, slope, options, p, r, out.ratio, &out);
-  CheckMatches(simulator, rec, recording.recording, slope, options, p, r, &out);
+  std::map<int, double> nominal;
+  out.curves = RecordCurves(simulator, rec, recording.recording, slope, options, p, r, out.ratio, &out, &nominal);
+  CheckMatches(simulator, rec, recording.recording, slope, options, p, r, nominal, &out);
   CompareShapes(Values(StandingTilts(in.real_set, p, r, slope)), options, &out.curves);
   std::vector<std::pair<int, double>> grid;
   for (const GroundCurve& c : out.curves) {

@@ -87,15 +87,14 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
          OwnLogLikelihood(m, in.real, options, ref).mean();
 }
 
-// The same with a recording of the point at other places, `elsewhere`, as its unseen samples (the
-// own model fitted on all of `recording`, as the score's is):
+// The same with a recording of the point at other places, `elsewhere`, as its unseen samples (`m`
+// the own model fitted on all of the point's recording, as the score's is):
 //   misfit = mean robust l(elsewhere) - mean robust l(real).
 // Its SE from the two sets' placement-clustered SEs (independent recordings).
-double MisfitElsewhere(const Samples& recording, const Samples& elsewhere, const AnalysisInputs& in,
+double MisfitElsewhere(const OwnModel& m, const Samples& elsewhere, const AnalysisInputs& in,
                        const LegSearchOptions& options, const SagReference* ref, double* se) {
   *se = NAN;
-  if (recording.size() == 0 || elsewhere.size() == 0) return NAN;
-  const OwnModel m = FitOwnModel(recording, {}, options, ref);
+  if (elsewhere.size() == 0) return NAN;
   double own = 0, own_se = 0, real = 0, real_se = 0;
   ClusteredMean(OwnLogLikelihood(m, elsewhere, options, ref), elsewhere.episode, &own, &own_se);
   ClusteredMean(OwnLogLikelihood(m, in.real, options, ref), in.real.episode, &real, &real_se);
@@ -290,13 +289,11 @@ std::pair<double, double> MeanGain(const Eigen::VectorXd& a, const Eigen::Vector
 }
 
 // LegSearch::real_gain, null_gain and z_null_corrected (LegSearchOptions::null_corrected_gain):
-// the best point's and the nominal's own models on the real samples and on `null`, the nominal's
-// recording at other places.
-void NullCorrectedGain(const AnalysisInputs& in, const SearchState& state, const Samples& null,
-                       const LegSearchOptions& options, LegSearch* out) {
+// the best point's and the nominal's own models (`best`, `nominal`) on the real samples and on
+// `null`, the nominal's recording at other places.
+void NullCorrectedGain(const AnalysisInputs& in, const SearchState& state, const OwnModel& best,
+                       const OwnModel& nominal, const Samples& null, const LegSearchOptions& options, LegSearch* out) {
   if (null.size() == 0) return;
-  const OwnModel best = FitOwnModel(state.scored[out->best].samples, {}, options, state.Ref());
-  const OwnModel nominal = FitOwnModel(state.nominal.samples, {}, options, state.Ref());
   const auto [real, real_se] = MeanGain(state.scored[out->best].rows, state.nominal.rows, in.real.episode);
   const auto [gain, gain_se] = MeanGain(OwnLogLikelihood(best, null, options, state.Ref()),
                                         OwnLogLikelihood(nominal, null, options, state.Ref()), null.episode);
@@ -314,12 +311,15 @@ void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, 
       RecordBatch(simulator, RealDesign(in, options.elsewhere_seed), {{}, best}, recording.recording);
   out->recorded += b.recorded;
   out->from_cache += b.from_cache;
+  // Each own model fitted once, for its misfit and the null-corrected gain.
+  const OwnModel nominal_model = FitOwnModel(state.nominal.samples, {}, options, state.Ref());
+  const OwnModel best_model = FitOwnModel(state.scored[out->best].samples, {}, options, state.Ref());
+  const Samples null = RealCommandsOf(b.sets[0], in);
   double se = NAN;
-  out->nominal_misfit =
-      MisfitElsewhere(state.nominal.samples, RealCommandsOf(b.sets[0], in), in, options, state.Ref(), &se);
-  out->best_misfit = MisfitElsewhere(state.scored[out->best].samples, RealCommandsOf(b.sets[1], in), in, options,
-                                     state.Ref(), &out->best_misfit_se);
-  NullCorrectedGain(in, state, RealCommandsOf(b.sets[0], in), options, out);
+  out->nominal_misfit = MisfitElsewhere(nominal_model, null, in, options, state.Ref(), &se);
+  out->best_misfit =
+      MisfitElsewhere(best_model, RealCommandsOf(b.sets[1], in), in, options, state.Ref(), &out->best_misfit_se);
+  NullCorrectedGain(in, state, best_model, nominal_model, null, options, out);
 }
 
 // The gate at other places: the real samples fit the best point's model no worse than its own

@@ -43,9 +43,9 @@ struct Radial {
   double theta = 0, rho = 0;
 };
 Radial RadialPart(const SampleSet& s, int i, int pitch_col, int roll_col, const SlopeGeometry& g) {
-  const Eigen::Vector2d d = Eigen::Vector2d(s.z(i, pitch_col), s.z(i, roll_col)) - g.centre;
-  const double theta = std::atan2(d(1), d(0));
-  return {theta, d.norm() - Harmonics(theta).dot(g.radius)};
+  const Eigen::Vector2d z(s.z(i, pitch_col), s.z(i, roll_col));
+  const Eigen::Vector2d d = z - g.centre;
+  return {std::atan2(d(1), d(0)), RadialResidual(g, z)};
 }
 
 // Mean rho~ and mean unit direction per (command label, direction bin) over `rows`.
