@@ -60,7 +60,7 @@ struct Sim2RealArgs {
   bool refit_without_imu = sim2real::PostureOptions{}.refit_without_imu;
   bool runoff = true;
   bool ground_search = true;
-  bool null_corrected_gain = false;
+  std::string null_corrected_gain = "off";  // auto: on a height field only (MakeOptions)
   std::string leg_search_score = "sag";
   std::string leg_search_on = "remaining";
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
@@ -173,7 +173,8 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.runoff.enabled = args.runoff;
   o.ground.enabled = args.ground_search;
   for (sim2real::LegSearchOptions* search : {&o.legs, &o.runoff.search, &o.payload.search, &o.ground.search}) {
-    search->null_corrected_gain = args.null_corrected_gain;
+    search->null_corrected_gain =
+        args.null_corrected_gain == "on" || (args.null_corrected_gain == "auto" && uneven_ground);
   }
   o.payload.enabled = args.payload_search;
   o.payload.on_posture = args.payload_on_posture;
@@ -446,10 +447,11 @@ void Setup(CLI::App& root) {
                 "on a height field with ground knobs: compare the spread of the real robot's standing tilt with the "
                 "simulated one's and, where it moved, record the ground's knobs until one gives it (on by default; "
                 "docs/sim2real.md, \"The ground's own knobs\")");
-  cmd->add_flag("--null-corrected-gain", args->null_corrected_gain,
-                "experimental: on uneven ground a search's best point must also fit the real samples better than "
-                "the nominal by more than its model fits the nominal's own recording at other places (docs/sim2real.md, "
-                "\"The ground's own knobs\")");
+  cmd->add_option("--null-corrected-gain", args->null_corrected_gain,
+                  "experimental: a search's best point must also fit the real samples better than the nominal by more than its "
+                  "model fits the nominal's own recording at other places; auto: on a height field only "
+                  "(docs/sim2real.md, \"The ground's own knobs\")")
+      ->capture_default_str()->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "

@@ -13,7 +13,10 @@ null,stones,payload,leg: s mod 4), the values from random.Random(s):
   leg: one leg's servo gain in [0.25, 0.5] (actuators.legN.gain, N drawn among the 8 legs);
   friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1);
   rough: the ground's small-scale roughness, a factor in [1.7, 2.6] on terrain.rough.rms_height_m
-     (the knob terrain.rough.rms_scale).
+     (the knob terrain.rough.rms_scale);
+  steps: the terraces' height, a factor in [0.4, 0.7] or [1.5, 2.5] (even odds) on
+     terrain.steps.height_m (the knob terrain.steps.height_scale; a config with steps, e.g.
+     datasets/robots/steps_ground.json).
 The real set is the planted config, protocol paper, the same placements count, seed s. Then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
 what was named, the value, which stage named it (`knobs`: the mean shifts; `ground_search`; `runoff`; `leg_search`)
@@ -24,14 +27,16 @@ located tests permuted whole placements, and the wall time.
 
 Usage: scripts/sim2real_rough_ground.py [--build build] [--config datasets/robots/rough_ground.json]
           [--seeds 301-308] [--kinds null,stones,payload,leg] [--sim-seed 100]
-          [--sim-placements 166] [--threads 2] [--null auto|drawn|recorded] [--out DIR]
+          [--sim-placements 166] [--threads 2] [--null auto|drawn|recorded]
+          [--null-corrected-gain off|auto|on]
+          [--out DIR]
 
 A second run with the same --out and another --null reuses the sim set, the real sets (when their
 config is the same) and the cache, and writes its reports beside the first (report-drawn/...).
 """
 import argparse, copy, json, os, random, subprocess, sys, tempfile, time
 
-KINDS = ["null", "stones", "payload", "leg", "friction", "rough"]
+KINDS = ["null", "stones", "payload", "leg", "friction", "rough", "steps"]
 
 
 def planted(seed, cfg, kinds=KINDS[:4]):
@@ -54,6 +59,10 @@ def planted(seed, cfg, kinds=KINDS[:4]):
         factor = r.uniform(1.7, 2.6)
         cfg["terrain"]["rough"]["rms_height_m"] *= factor
         return "terrain.rough.rms_scale", factor
+    if kind == "steps":
+        factor = r.uniform(0.4, 0.7) if r.random() < 0.5 else r.uniform(1.5, 2.5)
+        cfg["terrain"]["steps"]["height_m"] *= factor
+        return "terrain.steps.height_scale", factor
     if kind == "friction":
         mu = r.uniform(0.3, 0.6)
         cfg.setdefault("friction", {})["sliding"] = mu
@@ -100,6 +109,9 @@ def main():
     ap.add_argument("--threads", default="2")
     ap.add_argument("--null", default="auto", choices=["auto", "drawn", "recorded"],
                     help="the shortfall's null (dgmm sim2real --null); auto: recorded on uneven ground")
+    ap.add_argument("--null-corrected-gain", default="off", choices=["auto", "on", "off"],
+                    help="dgmm sim2real --null-corrected-gain (experimental); other than off, the reports go to "
+                         "report-ncg-auto/ or report-ncg-on/")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     lo, hi = (int(v) for v in a.seeds.split("-"))
@@ -132,9 +144,11 @@ def main():
             dgmm(a.build, "simulate", "--config", real_cfg, "--protocol", "paper", "--placements",
                  str(a.sim_placements), "--seed", str(seed), "-o", real)
         report = os.path.join(d, "report" if a.null == "auto" else f"report-{a.null}")
+        report += "" if a.null_corrected_gain == "off" else f"-ncg-{a.null_corrected_gain}"
         start = time.time()
         dgmm(a.build, "sim2real", "--sim", sim, "--real", real, "-o", report, "--no-figures",
-             "--threads", a.threads, "--cache", os.path.join(out, "cache"), "--null", a.null)
+             "--threads", a.threads, "--cache", os.path.join(out, "cache"), "--null", a.null,
+             "--null-corrected-gain", a.null_corrected_gain)
         print(row(seed, knob, truth, os.path.join(report, "report.json"), time.time() - start), flush=True)
     return 0
 

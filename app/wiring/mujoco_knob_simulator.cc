@@ -86,6 +86,7 @@ MujocoKnobSimulator::MujocoKnobSimulator(const sim::SimConfig& config) : config_
   leg_reach_m_ = robot.leg_reach_m();
   level_ground_ = robot.LevelGround();
   plane_ground_ = robot.PlaneGround();
+  sloped_ground_ = robot.SlopedGround();
 }
 
 std::vector<sim::KnobValue> MujocoKnobSimulator::ToSim(const std::vector<sim2real::KnobValue>& values) const {

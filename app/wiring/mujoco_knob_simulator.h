@@ -29,6 +29,7 @@ class MujocoKnobSimulator : public sim2real::KnobSimulator {
   double leg_reach_m() const override { return leg_reach_m_; }
   bool level_ground() const override { return level_ground_; }
   bool plane_ground() const override { return plane_ground_; }
+  bool sloped_ground() const override { return sloped_ground_; }
 
   const sim::SimConfig& config() const { return config_; }
 
@@ -42,6 +43,7 @@ class MujocoKnobSimulator : public sim2real::KnobSimulator {
   double total_mass_kg_ = 0, leg_reach_m_ = 0;
   bool level_ground_ = false;
   bool plane_ground_ = false;
+  bool sloped_ground_ = false;
 };
 
 }  // namespace dgmm::app

@@ -273,6 +273,8 @@ double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->gro
 
 bool Simulator::LevelGround() const { return impl_->config.slope_deg == 0 && PlaneGround(); }
 
+bool Simulator::SlopedGround() const { return impl_->config.slope_deg != 0; }
+
 bool Simulator::PlaneGround() const {
   if (impl_->config.terrain) return false;
   const mjModel* m = impl_->walker ? impl_->walker->model() : impl_->model.get();

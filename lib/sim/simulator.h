@@ -78,6 +78,8 @@ class Simulator {
   // Is the ground a plane facing up under gravity tilted by the slope (no height field, every geom
   // of the world the robot can touch a plane facing up)? A slope of 0 makes it level.
   bool PlaneGround() const;
+  // Is gravity tilted to a slope (the config's slope_deg not 0), on a plane or a height field?
+  bool SlopedGround() const;
   Eigen::Vector2d TruePitchRoll() const; // <pitch, roll> relative to gravity (rad)
   Eigen::Vector3d Up() const;            // unit vector against gravity, slope frame
   double time_s() const;                 // simulated time since construction

@@ -78,7 +78,7 @@ struct GroundCurve {
 struct GroundSearch {
   bool ran = false;          // the standing spreads were compared
   std::string why;           // why not, or what the search found, in words
-  bool on_slope = false;     // t is z's radial part on the slope's circle
+  bool on_slope = false;     // t is z's radial part on the slope's circle (clear, or a sloped_ground())
   StandingSpread real, sim;
   double ratio = NAN, ratio_se = NAN;  // q and its SE
   double z_moved = 0;        // (q - 1) / SE

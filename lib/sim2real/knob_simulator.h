@@ -106,6 +106,10 @@ class KnobSimulator {
   // Is the ground a plane (level, or tilted by gravity to a slope; no height field)? On a slope the
   // posture compares by the radial part of z (posture.h, SlopeGeometry); level_ground() by default.
   virtual bool plane_ground() const { return level_ground(); }
+  // Is gravity tilted to a slope, on a plane or a height field? Then the ground stage compares by
+  // the radial part of z even where the ground's own tilts blur the slope's circle (ground_search.h);
+  // false by default (the stage then asks the circle's fit alone).
+  virtual bool sloped_ground() const { return false; }
 
   // Scales for constants relative to the robot: its total mass (kg), leg reach (m).
   virtual double total_mass_kg() const = 0;

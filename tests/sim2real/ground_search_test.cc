@@ -1,8 +1,9 @@
 // The ground's standing tilt (ground_search.h) on a fake of its own: a robot on a sloped height
 // field whose standing tilt spreads with the ground's roughness (a Gaussian about the slope's
 // circle) and with its boulders' height (a few placements tilted far), and whose motion spreads
-// with the roughness. A rougher real ground is named with its value; a null moves nothing; a spread
-// no ground knob reaches, or a ground without knobs, names nothing and says why.
+// with the roughness. A rougher real ground is named with its value, on the slope's circle even where
+// the ground's tilts blur it; a null moves nothing; a spread no ground knob reaches, or a ground
+// without knobs, names nothing and says why.
 #include "sim2real/ground_search.h"
 
 #include <gtest/gtest.h>
@@ -12,6 +13,7 @@
 
 #include "sim2real/candidates.h"
 #include "sim2real/inputs.h"
+#include "sim2real/posture.h"
 #include "sim2real/verdict.h"
 
 namespace dgmm::sim2real::test {
@@ -41,8 +43,11 @@ class GroundFake : public KnobSimulator {
   std::string ConfigJson(const std::vector<KnobValue>&) const override { return "{}"; }
   double total_mass_kg() const override { return 10; }
   double leg_reach_m() const override { return 0.3; }
+  bool sloped_ground() const override { return sloped; }
   // The "real" ground's roughness beyond what the knob gives (a factor on every recording).
   double extra_roughness = 1;
+  double tilt_sd = 0.01;  // the standing tilt's SD per axis at roughness 1 (rad; the slope's circle 0.17)
+  bool sloped = false;    // does the simulator say its ground is sloped?
 
  private:
   // Placement p of recording seed s: a heading, a command, a standing tilt; then its executions.
@@ -64,7 +69,7 @@ class GroundFake : public KnobSimulator {
       const Eigen::Vector2d g(unit(rng), unit(rng));
       const bool on_stone = u(rng) < 0.1;
       const double stone_dir = 2 * M_PI * u(rng);
-      const Eigen::Vector2d tilt = 0.01 * rough * g + (on_stone ? 0.04 * stones : 0.0) *
+      const Eigen::Vector2d tilt = tilt_sd * rough * g + (on_stone ? 0.04 * stones : 0.0) *
                                                           Eigen::Vector2d(std::cos(stone_dir), std::sin(stone_dir));
       const Eigen::Vector2d z0 = 0.17 * Eigen::Vector2d(std::cos(heading), std::sin(heading)) + tilt;
       for (int e = 0; e < executions; ++e) {
@@ -90,9 +95,8 @@ struct GroundPair {
   CandidateSet set;
 };
 
-// The sim set at the fake's nominal (seed 11) and a real set from `real` (seed 12) at `planted`.
-GroundPair MakePair(const GroundFake& real, const std::vector<KnobValue>& planted) {
-  const GroundFake sim;
+// The sim set at `sim`'s nominal (seed 11) and a real set from `real` (seed 12) at `planted`.
+GroundPair MakePair(const GroundFake& real, const std::vector<KnobValue>& planted, const GroundFake& sim = GroundFake()) {
   Recording r;
   r.protocol = "paper", r.seed = 11, r.placements = 160;
   Recording rr = r;
@@ -136,6 +140,30 @@ TEST(GroundSearch, ARougherRealGroundIsNamedWithItsValue) {
   ASSERT_EQ(v.named.size(), 1u);
   EXPECT_EQ(v.named[0].knob, "terrain.rough.rms_scale");
   EXPECT_NE(v.sentence.find("tilts more variously"), std::string::npos) << v.sentence;
+}
+
+// Terraces tilt the standing robot about the slope's circle more than the circle's fit accepts
+// (a radius under 4 robust SDs of the radial residuals); a simulator that says its ground is sloped
+// keeps the comparison on the circle, and a rougher real ground moves the spread there. Asked of the
+// fit alone, the stage measures each tilt's distance from the median z, which the circle fills.
+TEST(GroundSearch, ASlopedGroundComparesOnTheCircleWhereTheTiltsBlurIt) {
+  GroundFake sim, real;
+  sim.tilt_sd = real.tilt_sd = 0.06;
+  sim.sloped = real.sloped = true;
+  real.extra_roughness = 2;
+  const GroundPair pair = MakePair(real, {}, sim);
+  ASSERT_FALSE(FitSlopeGeometry(pair.in.sim_set, pair.in.pitch_col, pair.in.roll_col).valid);
+  GroundSearchOptions o = Options();
+  const GroundSearch g = SearchGround(sim, pair.in, pair.set, CandidateOptions{}, o);
+  ASSERT_TRUE(g.ran) << g.why;
+  EXPECT_TRUE(g.on_slope);
+  EXPECT_TRUE(g.moved);
+  EXPECT_GT(g.ratio, 1.5);
+  GroundFake unsaid;
+  unsaid.tilt_sd = 0.06;
+  const GroundSearch h = SearchGround(unsaid, pair.in, pair.set, CandidateOptions{}, o);
+  EXPECT_FALSE(h.on_slope);
+  EXPECT_LT(h.ratio, g.ratio);
 }
 
 // With the null-corrected gain (LegSearchOptions::null_corrected_gain) the rougher ground keeps its
