@@ -448,8 +448,8 @@ void Setup(CLI::App& root) {
                 "simulated one's and, where it moved, record the ground's knobs until one gives it (on by default; "
                 "docs/sim2real.md, \"The ground's own knobs\")");
   cmd->add_option("--null-corrected-gain", args->null_corrected_gain,
-                  "experimental: a search's best point must also fit the real samples better than the nominal by more than its "
-                  "model fits the nominal's own recording at other places; auto: on a height field only "
+                  "experimental: a search's best point must also fit the real samples better than the nominal by "
+                  "more than its model fits the nominal's own recording at other places; auto: on a height field only "
                   "(docs/sim2real.md, \"The ground's own knobs\")")
       ->capture_default_str()->check(CLI::IsMember({"auto", "on", "off"}));
   cmd->add_flag("--runoff,!--no-runoff", args->runoff,

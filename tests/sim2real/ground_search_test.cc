@@ -96,7 +96,8 @@ struct GroundPair {
 };
 
 // The sim set at `sim`'s nominal (seed 11) and a real set from `real` (seed 12) at `planted`.
-GroundPair MakePair(const GroundFake& real, const std::vector<KnobValue>& planted, const GroundFake& sim = GroundFake()) {
+GroundPair MakePair(const GroundFake& real, const std::vector<KnobValue>& planted,
+                    const GroundFake& sim = GroundFake()) {
   Recording r;
   r.protocol = "paper", r.seed = 11, r.placements = 160;
   Recording rr = r;
