@@ -299,6 +299,7 @@ void NullCorrectedGain(const AnalysisInputs& in, const SearchState& state, const
                                         OwnLogLikelihood(nominal, null, options, state.Ref()), null.episode);
   out->real_gain = real, out->null_gain = gain;
   out->z_null_corrected = (real - gain) / std::hypot(real_se, gain_se);
+  out->null_corrected_gate = options.null_corrected_gain;
 }
 
 // The nominal's and the best point's misfits against second recordings at other places.

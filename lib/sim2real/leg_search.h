@@ -138,6 +138,7 @@ struct LegSearch {
   // With the gate at other places: the best's gain over the nominal per sample on the real samples
   // and on the nominal's recording at other places, and their difference in SEs.
   double real_gain = NAN, null_gain = NAN, z_null_corrected = NAN;
+  bool null_corrected_gate = false;  // did z_null_corrected gate the name (LegSearchOptions::null_corrected_gain)?
   bool misfit_elsewhere = false;  // the misfits are against recordings at other places
   int best = -1;                      // index into points
   bool named = false;

@@ -186,7 +186,7 @@ json LegSearchJson(const LegSearch& l) {
           {"best_misfit", JsonNumber(l.best_misfit)}, {"best_misfit_se", JsonNumber(l.best_misfit_se)},
           {"misfit_against", l.misfit_elsewhere ? "other_places" : "own_executions"},
           {"real_gain", JsonNumber(l.real_gain)}, {"null_gain", JsonNumber(l.null_gain)},
-          {"z_null_corrected", JsonNumber(l.z_null_corrected)},
+          {"z_null_corrected", JsonNumber(l.z_null_corrected)}, {"null_corrected_gate", l.null_corrected_gate},
           {"best_plain_score", JsonNumber(l.best_plain)}, {"z_vs_nominal", JsonNumber(l.z_vs_nominal)},
           {"gap_closed", JsonNumber(l.gap_closed)}, {"challenged", l.challenged},
           {"z_vs_named", JsonNumber(l.z_vs_named)}, {"rivals_named", l.rivals_named}, {"legs_as_well", l.legs_as_well},

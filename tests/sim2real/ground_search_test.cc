@@ -181,6 +181,10 @@ TEST(GroundSearch, TheNullCorrectedGainKeepsARightName) {
   EXPECT_GT(g.search.real_gain, 0);
   EXPECT_LT(g.search.null_gain, g.search.real_gain);
   EXPECT_GE(g.search.z_null_corrected, o.search.z);
+  EXPECT_TRUE(g.search.null_corrected_gate);
+  const GroundSearch off = SearchGround(fake, pair.in, pair.set, CandidateOptions{}, Options());
+  EXPECT_FALSE(off.search.null_corrected_gate) << "computed, not gating";
+  EXPECT_TRUE(std::isfinite(off.search.z_null_corrected));
 }
 
 TEST(GroundSearch, ANullMovesNothingAndRecordsNothing) {
