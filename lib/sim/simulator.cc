@@ -271,7 +271,7 @@ std::string Simulator::SelfContactPair() const {
 
 double Simulator::GroundHeight(double x_m, double y_m) const { return impl_->ground->HeightAt(x_m, y_m); }
 
-bool Simulator::LevelGround() const { return impl_->config.slope_deg == 0 && PlaneGround(); }
+bool Simulator::LevelGround() const { return !SlopedGround() && PlaneGround(); }
 
 bool Simulator::SlopedGround() const { return impl_->config.slope_deg != 0; }
 

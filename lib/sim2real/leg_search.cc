@@ -20,14 +20,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-// A recording with its own model and the real samples' log-likelihood per sample under it.
-struct Scored {
-  Samples samples;
-  Eigen::VectorXd rows;
-  LinearGaussianModel model;
-  bool walkable = true;
-};
-
 // log(exp(a) + exp(b)) without overflow.
 double LogAddExp(double a, double b) {
   const double top = std::max(a, b);
@@ -55,6 +47,15 @@ struct OwnModel {
   std::optional<SagModel> sag;
   LinearGaussianModel plain;
   const LinearGaussianModel& model() const { return sag ? sag->core : plain; }
+};
+
+// A recording with its own model and the real samples' log-likelihood per sample under it.
+struct Scored {
+  Samples samples;
+  Eigen::VectorXd rows;
+  OwnModel own;
+  bool walkable = true;
+  const LinearGaussianModel& model() const { return own.model(); }
 };
 
 OwnModel FitOwnModel(const Samples& s, const std::vector<int>& rows, const LegSearchOptions& options,
@@ -87,17 +88,17 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
          OwnLogLikelihood(m, in.real, options, ref).mean();
 }
 
-// The same with a recording of the point at other places, `elsewhere`, as its unseen samples (`m`
-// the own model fitted on all of the point's recording, as the score's is):
+// The same with a recording of the point at other places, `elsewhere`, as its unseen samples (`scored`
+// the point's recording with the own model fitted on all of it and the real samples' rows under it):
 //   misfit = mean robust l(elsewhere) - mean robust l(real).
 // Its SE from the two sets' placement-clustered SEs (independent recordings).
-double MisfitElsewhere(const OwnModel& m, const Samples& elsewhere, const AnalysisInputs& in,
+double MisfitElsewhere(const Scored& scored, const Samples& elsewhere, const AnalysisInputs& in,
                        const LegSearchOptions& options, const SagReference* ref, double* se) {
   *se = NAN;
   if (elsewhere.size() == 0) return NAN;
   double own = 0, own_se = 0, real = 0, real_se = 0;
-  ClusteredMean(OwnLogLikelihood(m, elsewhere, options, ref), elsewhere.episode, &own, &own_se);
-  ClusteredMean(OwnLogLikelihood(m, in.real, options, ref), in.real.episode, &real, &real_se);
+  ClusteredMean(OwnLogLikelihood(scored.own, elsewhere, options, ref), elsewhere.episode, &own, &own_se);
+  ClusteredMean(scored.rows, in.real.episode, &real, &real_se);
   *se = std::hypot(own_se, real_se);
   return own - real;
 }
@@ -113,15 +114,14 @@ Scored ScoreRecording(const SampleSet& recording, const AnalysisInputs& in, cons
     out.rows = Eigen::VectorXd::Constant(in.real.size(), -INFINITY);
     return out;
   }
-  const OwnModel m = FitOwnModel(s, {}, options, ref);
-  out.rows = OwnLogLikelihood(m, in.real, options, ref);
-  out.model = m.model();
+  out.own = FitOwnModel(s, {}, options, ref);
+  out.rows = OwnLogLikelihood(out.own, in.real, options, ref);
   return out;
 }
 
 // The per-axis variance of a recording's residuals under its own model.
 Eigen::VectorXd ResidualVariance(const Scored& scored) {
-  const Eigen::MatrixXd r = scored.model.Residuals(scored.samples);
+  const Eigen::MatrixXd r = scored.model().Residuals(scored.samples);
   return (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, r.rows() - 1.0);
 }
 
@@ -275,7 +275,7 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
     out->named = true;
     out->why = "";
   }
-  out->best_model = state->scored[out->best].model;
+  out->best_model = state->scored[out->best].model();
   out->best_rows = state->scored[out->best].rows;
   out->best_plain = out->best_model.LogLikelihood(in.real).mean();
   out->log_var =
@@ -312,15 +312,15 @@ void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, 
       RecordBatch(simulator, RealDesign(in, options.elsewhere_seed), {{}, best}, recording.recording);
   out->recorded += b.recorded;
   out->from_cache += b.from_cache;
-  // Each own model fitted once, for its misfit and the null-corrected gain.
-  const OwnModel nominal_model = FitOwnModel(state.nominal.samples, {}, options, state.Ref());
-  const OwnModel best_model = FitOwnModel(state.scored[out->best].samples, {}, options, state.Ref());
+  // The own models and real rows are the scores' (ScoreRecording), fitted once.
+  const Scored& best_scored = state.scored[out->best];
+  if (!state.nominal.walkable || !best_scored.walkable) return;  // no own model: misfits stay NaN, nothing named
   const Samples null = RealCommandsOf(b.sets[0], in);
   double se = NAN;
-  out->nominal_misfit = MisfitElsewhere(nominal_model, null, in, options, state.Ref(), &se);
+  out->nominal_misfit = MisfitElsewhere(state.nominal, null, in, options, state.Ref(), &se);
   out->best_misfit =
-      MisfitElsewhere(best_model, RealCommandsOf(b.sets[1], in), in, options, state.Ref(), &out->best_misfit_se);
-  NullCorrectedGain(in, state, best_model, nominal_model, null, options, out);
+      MisfitElsewhere(best_scored, RealCommandsOf(b.sets[1], in), in, options, state.Ref(), &out->best_misfit_se);
+  NullCorrectedGain(in, state, best_scored.own, state.nominal.own, null, options, out);
 }
 
 // The gate at other places: the real samples fit the best point's model no worse than its own
@@ -428,7 +428,7 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
   state.also = also;
   if (options.sag_mode) state.ref = MakeSagReference(in.sim, options.model);
   RecordPoints(simulator, in, set, recording, options, grid, &state, &out);
-  out.nominal_model = state.nominal.model;
+  out.nominal_model = state.nominal.model();
   out.nominal_score = state.nominal.rows.mean();
   Decide(in, knobs, options, &state, &out);
   const double step = out.best >= 0 ? GridStep(grid, out.knob_index, out.nominal) : 0;
