@@ -14,9 +14,11 @@ null,stones,payload,leg: s mod 4), the values from random.Random(s):
   friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1);
   rough: the ground's small-scale roughness, a factor in [1.7, 2.6] on terrain.rough.rms_height_m
      (the knob terrain.rough.rms_scale);
+  smooth: the same knob the other way, a factor in [0.25, 0.6] (a smoother real ground);
   steps: the terraces' height, a factor in [0.4, 0.7] or [1.5, 2.5] (even odds) on
      terrain.steps.height_m (the knob terrain.steps.height_scale; a config with steps, e.g.
      datasets/robots/steps_ground.json).
+  higher_steps: the terraces higher only, a factor in [1.5, 2.5] (the same knob).
 The real set is the planted config, protocol paper, the same placements count, seed s. Then
 `dgmm sim2real` with the sim set's own config. Prints one Markdown row per pair: what was planted,
 what was named, the value, which stage named it (`knobs`: the mean shifts; `ground_search`; `runoff`; `leg_search`)
@@ -36,17 +38,29 @@ config is the same) and the cache, and writes its reports beside the first (repo
 """
 import argparse, copy, json, os, random, subprocess, sys, tempfile, time
 
-KINDS = ["null", "stones", "payload", "leg", "friction", "rough", "steps"]
+KINDS = ["null", "stones", "payload", "leg", "friction", "rough", "steps", "smooth", "higher_steps"]
+
+
+# The ground's kinds: the terrain block and height scaled, the knob that scales it, the factor's draw.
+GROUND = {
+    "stones": ("stones", "height_m", "terrain.stones.height_scale", lambda r: r.uniform(1.3, 1.8)),
+    "rough": ("rough", "rms_height_m", "terrain.rough.rms_scale", lambda r: r.uniform(1.7, 2.6)),
+    "smooth": ("rough", "rms_height_m", "terrain.rough.rms_scale", lambda r: r.uniform(0.25, 0.6)),
+    "steps": ("steps", "height_m", "terrain.steps.height_scale",
+              lambda r: r.uniform(0.4, 0.7) if r.random() < 0.5 else r.uniform(1.5, 2.5)),
+    "higher_steps": ("steps", "height_m", "terrain.steps.height_scale", lambda r: r.uniform(1.5, 2.5)),
+}
 
 
 def planted(seed, cfg, kinds=KINDS[:4]):
     """Plants the seed's physics into `cfg`; returns (knob that should be named or None, truth)."""
     r = random.Random(seed)
     kind = kinds[seed % len(kinds)]
-    if kind == "stones":
-        factor = r.uniform(1.3, 1.8)
-        cfg["terrain"]["stones"]["height_m"] *= factor
-        return "terrain.stones.height_scale", factor
+    if kind in GROUND:
+        block, height, knob, draw = GROUND[kind]
+        factor = draw(r)
+        cfg["terrain"][block][height] *= factor
+        return knob, factor
     if kind == "payload":
         mass = r.uniform(1.5, 3.0)
         cfg["payload"] = {"mass_kg": mass, "position_body_m": [r.uniform(0.0, 0.1), 0.0, 0.05]}
@@ -55,14 +69,6 @@ def planted(seed, cfg, kinds=KINDS[:4]):
         leg, gain = r.randrange(8), r.uniform(0.25, 0.5)
         cfg.setdefault("actuators", {})["leg_gain"] = [gain if i == leg else 1.0 for i in range(8)]
         return f"actuators.leg{leg}.gain", gain
-    if kind == "rough":
-        factor = r.uniform(1.7, 2.6)
-        cfg["terrain"]["rough"]["rms_height_m"] *= factor
-        return "terrain.rough.rms_scale", factor
-    if kind == "steps":
-        factor = r.uniform(0.4, 0.7) if r.random() < 0.5 else r.uniform(1.5, 2.5)
-        cfg["terrain"]["steps"]["height_m"] *= factor
-        return "terrain.steps.height_scale", factor
     if kind == "friction":
         mu = r.uniform(0.3, 0.6)
         cfg.setdefault("friction", {})["sliding"] = mu
