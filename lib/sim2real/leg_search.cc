@@ -88,17 +88,18 @@ double Misfit(const Samples& recording, const AnalysisInputs& in, const LegSearc
          OwnLogLikelihood(m, in.real, options, ref).mean();
 }
 
-// The same with a recording of the point at other places, `elsewhere`, as its unseen samples (`scored`
-// the point's recording with the own model fitted on all of it and the real samples' rows under it):
+// The same with a recording of the point at other places as its unseen samples: `elsewhere` their
+// log-likelihoods under the point's own model (fitted on all of its recording, as the score's is),
+// `placement` their placements, `real_rows` the real samples' (the score's rows):
 //   misfit = mean robust l(elsewhere) - mean robust l(real).
 // Its SE from the two sets' placement-clustered SEs (independent recordings).
-double MisfitElsewhere(const Scored& scored, const Samples& elsewhere, const AnalysisInputs& in,
-                       const LegSearchOptions& options, const SagReference* ref, double* se) {
+double MisfitElsewhere(const Eigen::VectorXd& elsewhere, const std::vector<int>& placement,
+                       const Eigen::VectorXd& real_rows, const AnalysisInputs& in, double* se) {
   *se = NAN;
   if (elsewhere.size() == 0) return NAN;
   double own = 0, own_se = 0, real = 0, real_se = 0;
-  ClusteredMean(OwnLogLikelihood(scored.own, elsewhere, options, ref), elsewhere.episode, &own, &own_se);
-  ClusteredMean(scored.rows, in.real.episode, &real, &real_se);
+  ClusteredMean(elsewhere, placement, &own, &own_se);
+  ClusteredMean(real_rows, in.real.episode, &real, &real_se);
   *se = std::hypot(own_se, real_se);
   return own - real;
 }
@@ -289,14 +290,14 @@ std::pair<double, double> MeanGain(const Eigen::VectorXd& a, const Eigen::Vector
 }
 
 // LegSearch::real_gain, null_gain and z_null_corrected (LegSearchOptions::null_corrected_gain):
-// the best point's and the nominal's own models (`best`, `nominal`) on the real samples and on
-// `null`, the nominal's recording at other places.
-void NullCorrectedGain(const AnalysisInputs& in, const SearchState& state, const OwnModel& best,
-                       const OwnModel& nominal, const Samples& null, const LegSearchOptions& options, LegSearch* out) {
-  if (null.size() == 0) return;
-  const auto [real, real_se] = MeanGain(state.scored[out->best].rows, state.nominal.rows, in.real.episode);
-  const auto [gain, gain_se] = MeanGain(OwnLogLikelihood(best, null, options, state.Ref()),
-                                        OwnLogLikelihood(nominal, null, options, state.Ref()), null.episode);
+// the best point's and the nominal's gains on the real samples (their scores' rows) and on the
+// nominal's recording at other places (`best_null`, `nominal_null`: its samples under each own model).
+void NullCorrectedGain(const AnalysisInputs& in, const Scored& best, const Scored& nominal,
+                       const Eigen::VectorXd& best_null, const Eigen::VectorXd& nominal_null,
+                       const std::vector<int>& null_placement, const LegSearchOptions& options, LegSearch* out) {
+  if (best_null.size() == 0) return;
+  const auto [real, real_se] = MeanGain(best.rows, nominal.rows, in.real.episode);
+  const auto [gain, gain_se] = MeanGain(best_null, nominal_null, null_placement);
   out->real_gain = real, out->null_gain = gain;
   out->z_null_corrected = (real - gain) / std::hypot(real_se, gain_se);
   out->null_corrected_gate = options.null_corrected_gain;
@@ -306,21 +307,25 @@ void NullCorrectedGain(const AnalysisInputs& in, const SearchState& state, const
 void MisfitsElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateOptions& recording,
                       const SearchState& state, const LegSearchOptions& options, LegSearch* out) {
   out->misfit_elsewhere = true;
+  const Scored& best_scored = state.scored[out->best];
+  if (!state.nominal.walkable || !best_scored.walkable) return;  // no own model: misfits stay NaN, nothing named
   std::vector<KnobValue> best = {{out->knob_index, out->value}};
   best.insert(best.end(), out->also.begin(), out->also.end());
   const RecordingBatch b =
       RecordBatch(simulator, RealDesign(in, options.elsewhere_seed), {{}, best}, recording.recording);
   out->recorded += b.recorded;
   out->from_cache += b.from_cache;
-  // The own models and real rows are the scores' (ScoreRecording), fitted once.
-  const Scored& best_scored = state.scored[out->best];
-  if (!state.nominal.walkable || !best_scored.walkable) return;  // no own model: misfits stay NaN, nothing named
-  const Samples null = RealCommandsOf(b.sets[0], in);
+  // The own models and real rows are the scores' (ScoreRecording); each set scored once per model.
+  const Samples null = RealCommandsOf(b.sets[0], in), elsewhere = RealCommandsOf(b.sets[1], in);
+  const auto rows = [&](const Scored& s, const Samples& x) {
+    return x.size() == 0 ? Eigen::VectorXd() : OwnLogLikelihood(s.own, x, options, state.Ref());
+  };
+  const Eigen::VectorXd nominal_null = rows(state.nominal, null);
   double se = NAN;
-  out->nominal_misfit = MisfitElsewhere(state.nominal, null, in, options, state.Ref(), &se);
+  out->nominal_misfit = MisfitElsewhere(nominal_null, null.episode, state.nominal.rows, in, &se);
   out->best_misfit =
-      MisfitElsewhere(best_scored, RealCommandsOf(b.sets[1], in), in, options, state.Ref(), &out->best_misfit_se);
-  NullCorrectedGain(in, state, best_scored.own, state.nominal.own, null, options, out);
+      MisfitElsewhere(rows(best_scored, elsewhere), elsewhere.episode, best_scored.rows, in, &out->best_misfit_se);
+  NullCorrectedGain(in, best_scored, state.nominal, rows(best_scored, null), nominal_null, null.episode, options, out);
 }
 
 // The gate at other places: the real samples fit the best point's model no worse than its own
