@@ -78,6 +78,17 @@ def edit_leg(xml, foot_geom, kind, value, reach_m):
     return xml[:start] + block + xml[end:]
 
 
+def with_absolute_paths(cfg, config_path):
+    """`cfg` with its files (the MJCF, a replayed controller's recordings) made absolute from the folder
+    of config_path, so that a copy written elsewhere still finds them."""
+    here = os.path.dirname(config_path)
+    if "mjcf_path" in cfg:
+        cfg["mjcf_path"] = os.path.abspath(os.path.join(here, cfg["mjcf_path"]))
+    for rec in cfg.get("robot", {}).get("controller", {}).get("recordings", []):
+        rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
+    return cfg
+
+
 def planted(seed, cfg, mass_kg, reach_m, kinds, pair_dir):
     """Plants the seed's physics into the config `cfg`; returns (knob that should be named, truth)."""
     r = random.Random(seed)
@@ -206,11 +217,7 @@ def main():
     MODEL_MAX_FRICTION = a.model_friction
     lo, hi = (int(v) for v in a.seeds.split("-"))
     out = a.out or tempfile.mkdtemp()
-    base = a.base = json.load(open(a.config))
-    here = os.path.dirname(a.config)
-    base["mjcf_path"] = os.path.abspath(os.path.join(here, base["mjcf_path"]))
-    for rec in base["robot"].get("controller", {}).get("recordings", []):  # a replayed controller's files
-        rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
+    base = a.base = with_absolute_paths(json.load(open(a.config)), a.config)
     print(f"Robot {a.config}, seeds {lo}-{hi}, sim2real with --threads {a.threads}\n")
     print("| seed | planted | truth | named | value | within 25% | fit as well | payload moment named / planted (kg cm) "
           "| moment within 25% | status | more placements advised | wall s |")

@@ -12,6 +12,10 @@ null,stones,payload,leg: s mod 4), the values from random.Random(s):
   payload: a payload of 1.5-3 kg on the torso, forward by up to 0.1 m (payload.mass_kg);
   leg: one leg's servo gain in [0.25, 0.5] (actuators.legN.gain, N drawn among the 8 legs);
   friction: the floor's sliding friction in [0.3, 0.6] (floor.friction.sliding; nominal 1);
+  (these three on the built-in octopod; a config with a robot block plants them in the robot's own
+  terms, as scripts/sim2real_robots.py does: a leg by its name, a payload as a share of the robot's
+  mass offset by a share of its leg reach, a friction factor on every geom relative to
+  --model-friction, the largest sliding friction among the model's geoms);
   rough: the ground's small-scale roughness, a factor in [1.7, 2.6] on terrain.rough.rms_height_m
      (the knob terrain.rough.rms_scale);
   smooth: the same knob the other way, a factor in [0.25, 0.6] (a smoother real ground);
@@ -30,13 +34,18 @@ located tests permuted whole placements, and the wall time.
 Usage: scripts/sim2real_rough_ground.py [--build build] [--config datasets/robots/rough_ground.json]
           [--seeds 301-308] [--kinds null,stones,payload,leg] [--sim-seed 100]
           [--sim-placements 166] [--threads 2] [--null auto|drawn|recorded]
-          [--null-corrected-gain off|auto|on]
+          [--null-corrected-gain off|auto|on] [--model-friction 1.0]
           [--out DIR]
 
 A second run with the same --out and another --null reuses the sim set, the real sets (when their
 config is the same) and the cache, and writes its reports beside the first (report-drawn/...).
 """
-import argparse, copy, json, os, random, subprocess, sys, tempfile, time
+import argparse, copy, importlib.util, json, os, random, subprocess, sys, tempfile, time
+
+_spec = importlib.util.spec_from_file_location(
+    "sim2real_robots", os.path.join(os.path.dirname(os.path.abspath(__file__)), "sim2real_robots.py"))
+ROBOTS = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(ROBOTS)  # a robot block's planting: a leg by its name, shares of mass and reach
 
 KINDS = ["null", "stones", "payload", "leg", "friction", "rough", "steps", "smooth", "higher_steps"]
 
@@ -52,8 +61,10 @@ GROUND = {
 }
 
 
-def planted(seed, cfg, kinds=KINDS[:4]):
-    """Plants the seed's physics into `cfg`; returns (knob that should be named or None, truth)."""
+def planted(seed, cfg, kinds=KINDS[:4], robot=None):
+    """Plants the seed's physics into `cfg`; returns (knob that should be named or None, truth). With
+    a robot block, `robot` is (its mass kg, its leg reach m, the pair's folder) and a leg, payload or
+    friction is planted by sim2real_robots.planted in the robot's own terms."""
     r = random.Random(seed)
     kind = kinds[seed % len(kinds)]
     if kind in GROUND:
@@ -61,6 +72,10 @@ def planted(seed, cfg, kinds=KINDS[:4]):
         factor = draw(r)
         cfg["terrain"][block][height] *= factor
         return knob, factor
+    if "robot" in cfg and kind in ("payload", "leg", "friction"):
+        if robot is None:
+            raise ValueError(f"{kind}: a config with a robot block needs the robot's mass and leg reach")
+        return ROBOTS.planted(seed, cfg, *robot[:2], [kind], robot[2])
     if kind == "payload":
         mass = r.uniform(1.5, 3.0)
         cfg["payload"] = {"mass_kg": mass, "position_body_m": [r.uniform(0.0, 0.1), 0.0, 0.05]}
@@ -118,15 +133,19 @@ def main():
     ap.add_argument("--null-corrected-gain", default="off", choices=["auto", "on", "off"],
                     help="dgmm sim2real --null-corrected-gain (experimental); other than off, the reports go to "
                          "report-ncg-auto/ or report-ncg-on/")
+    ap.add_argument("--model-friction", type=float, default=1.0,
+                    help="with a robot block: the largest sliding friction among the model's geoms (the friction "
+                         "kind's factor is relative to it)")
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
+    ROBOTS.MODEL_MAX_FRICTION = a.model_friction
     lo, hi = (int(v) for v in a.seeds.split("-"))
     kinds = a.kinds.split(",")
     if not kinds or any(k not in KINDS for k in kinds):
         ap.error(f"--kinds: expected a comma list among {','.join(KINDS)}, got {a.kinds!r}")
     out = a.out or tempfile.mkdtemp()
     os.makedirs(out, exist_ok=True)
-    base = json.load(open(a.config))
+    base = ROBOTS.with_absolute_paths(json.load(open(a.config)), a.config)
     nominal = os.path.join(out, "nominal.json")
     json.dump(base, open(nominal, "w"), indent=1)
     sim = os.path.join(out, "sim.h5")
@@ -142,7 +161,9 @@ def main():
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)
         cfg = copy.deepcopy(base)
-        knob, truth = planted(seed, cfg, kinds)
+        robot = ((ROBOTS.metadata(sim, "robot_mass_kg"), ROBOTS.metadata(sim, "robot_leg_reach_m"), d)
+                 if "robot" in cfg else None)
+        knob, truth = planted(seed, cfg, kinds, robot)
         real_cfg = os.path.join(d, "real.json")
         real = os.path.join(d, "real.h5")
         if not (os.path.exists(real) and os.path.exists(real_cfg) and json.load(open(real_cfg)) == cfg):

@@ -334,6 +334,13 @@ void GateElsewhere(const KnobSimulator& simulator, const AnalysisInputs& in, con
                    const SearchState& state, const LegSearchOptions& options, const Knob& knob, LegSearch* out) {
   MisfitsElsewhere(simulator, in, recording, state, options, out);
   out->gap_closed = out->nominal_misfit > 0 ? 1 - out->best_misfit / out->nominal_misfit : NAN;
+  if (std::isnan(out->best_misfit)) {
+    out->named = false;
+    out->why = "the best point (" + PointName(knob, out->value) +
+               ") has no model to compare at other places: the robot fell in most placements of its recording "
+               "or of the nominal's";
+    return;
+  }
   if (out->best_misfit <= options.z * out->best_misfit_se) {
     if (!options.null_corrected_gain || !(out->z_null_corrected < options.z)) return;
     out->named = false;

@@ -227,25 +227,36 @@ Eigen::Vector2d PostureDifference(const SampleSet& a, const std::vector<int>& ro
   return n > 0 ? Eigen::Vector2d(sum / n) : Eigen::Vector2d::Constant(NAN);
 }
 
-PostureShift MeasurePostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col, bool first_only,
-                                 int resamples, std::uint64_t seed, const SlopeGeometry* slope) {
-  const auto ua = Placements(a, first_only), ub = Placements(b, first_only);
+namespace {
+
+// The shift over placement units `ua` of a and `ub` of b, with its bootstrap SE: each side
+// resampled by itself, or, paired (ua[i] and ub[i] one placement), both with one pick.
+PostureShift ShiftOverUnits(const SampleSet& a, const std::vector<std::vector<int>>& ua, const SampleSet& b,
+                            const std::vector<std::vector<int>>& ub, bool paired, int pitch_col, int roll_col,
+                            int resamples, std::uint64_t seed, const SlopeGeometry* slope) {
   PostureShift out;
   if (ua.empty() || ub.empty()) return out;
   const int na = static_cast<int>(ua.size()), nb = static_cast<int>(ub.size());
   out.shift = PostureDifference(a, Concatenate(ua, All(na)), b, Concatenate(ub, All(nb)), pitch_col, roll_col, slope);
   out.se = SpreadOfDraws(resamples, seed, [&](std::mt19937_64* rng) {
-    const std::vector<int> pick_a = Resample(na, rng), pick_b = Resample(nb, rng);
+    const std::vector<int> pick_a = Resample(na, rng), pick_b = paired ? pick_a : Resample(nb, rng);
     return PostureDifference(a, Concatenate(ua, pick_a), b, Concatenate(ub, pick_b), pitch_col, roll_col, slope);
   });
   return out;
 }
 
+}  // namespace
+
+PostureShift MeasurePostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col, bool first_only,
+                                 int resamples, std::uint64_t seed, const SlopeGeometry* slope) {
+  return ShiftOverUnits(a, Placements(a, first_only), b, Placements(b, first_only), false, pitch_col, roll_col,
+                        resamples, seed, slope);
+}
+
 PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, int pitch_col, int roll_col,
                                        bool first_only, int resamples, std::uint64_t seed,
                                        const SlopeGeometry* slope) {
-  PostureShift out;
-  if (!a.has_sequence() || !b.has_sequence()) return out;
+  if (!a.has_sequence() || !b.has_sequence()) return {};
   // The placements both recordings kept (a probe that topples the robot keeps fewer), by episode id.
   const auto in_a = RowsByPlacement(a, first_only), in_b = RowsByPlacement(b, first_only);
   std::vector<std::vector<int>> ua, ub;
@@ -254,14 +265,7 @@ PostureShift MeasurePairedPostureShift(const SampleSet& a, const SampleSet& b, i
     if (it == in_b.end()) continue;
     ua.push_back(rows), ub.push_back(it->second);
   }
-  const int n = static_cast<int>(ua.size());
-  if (n == 0) return out;
-  out.shift = PostureDifference(a, Concatenate(ua, All(n)), b, Concatenate(ub, All(n)), pitch_col, roll_col, slope);
-  out.se = SpreadOfDraws(resamples, seed, [&](std::mt19937_64* rng) {
-    const std::vector<int> pick = Resample(n, rng);
-    return PostureDifference(a, Concatenate(ua, pick), b, Concatenate(ub, pick), pitch_col, roll_col, slope);
-  });
-  return out;
+  return ShiftOverUnits(a, ua, b, ub, true, pitch_col, roll_col, resamples, seed, slope);
 }
 
 PostureGround GroundOf(const KnobSimulator& simulator) {

@@ -6,6 +6,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+
+#include "sim2real/recorded_null.h"
 #include "tests/sim2real/stage_fixture.h"
 
 namespace dgmm::sim2real::test {
@@ -98,6 +101,42 @@ TEST(LegSearch, ASecondLookAtOtherPlacesNamesALegTheSamePlaceGateRefused) {
   const Stages g = RunStages({}, 3, extras);
   const LegSearch other = SearchLegGains(SharedFake(), g.in, g.set, g.options.candidates, o);
   EXPECT_FALSE(other.named) << "named " << other.leg << " at " << other.value;
+}
+
+// The shared fake, but the robot falls in every placement of a recording at `seed`.
+class FallsAt : public KnobSimulator {
+ public:
+  explicit FallsAt(std::uint64_t seed) : seed_(seed) {}
+  const std::vector<Knob>& knobs() const override { return SharedFake().knobs(); }
+  std::string Fingerprint() const override { return SharedFake().Fingerprint() + "-falls"; }
+  SampleSet Record(const Recording& r, const std::vector<KnobValue>& v, int threads) const override {
+    const SampleSet s = SharedFake().Record(r, v, threads);
+    return r.seed == seed_ ? s.Subset({}) : s;
+  }
+  CellRecording RecordCell(const Cell& c, const std::vector<KnobValue>& v) const override {
+    return SharedFake().RecordCell(c, v);
+  }
+  std::string ConfigJson(const std::vector<KnobValue>& v) const override { return SharedFake().ConfigJson(v); }
+  double total_mass_kg() const override { return SharedFake().total_mass_kg(); }
+  double leg_reach_m() const override { return SharedFake().leg_reach_m(); }
+
+ private:
+  std::uint64_t seed_;
+};
+
+// Where the robot fell in the recording at other places there is no model to compare the real
+// samples with: nothing is named through the gate, and the reason says so (not a misfit of NaN).
+TEST(LegSearch, AGateAtOtherPlacesWhereTheRobotFellNamesNothing) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  LegSearchOptions o = Options(s);
+  o.min_gap_closed = 1;  // refused at the same places, so the second look at other places decides
+  o.elsewhere_seed = 777;
+  const FallsAt falls(RealDesign(s.in, o.elsewhere_seed).seed);
+  const LegSearch r = SearchLegGains(falls, s.in, s.set, s.options.candidates, o);
+  EXPECT_TRUE(r.misfit_elsewhere);
+  EXPECT_FALSE(r.named) << "named " << r.leg << " at " << r.value;
+  EXPECT_TRUE(std::isnan(r.best_misfit));
+  EXPECT_NE(r.why.find("no model to compare at other places"), std::string::npos) << r.why;
 }
 
 TEST(LegSearch, TheAnswerDoesNotDependOnTheThreadCount) {
