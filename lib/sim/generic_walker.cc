@@ -183,12 +183,13 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   for (std::size_t i = 0; i < n; ++i) u[i] = t / period - phase[i] - shift;
   Eigen::Vector3d sway = Eigen::Vector3d::Zero();  // the torso moves by +sway: every foot by -sway
   sway.head<2>() = envelope * Sway(u);
+  const Eigen::Matrix3d back = LevelBack(RobotPose().rotation, config_.robot->gait.level);
   std::vector<Eigen::Vector3d> targets(n);
   for (std::size_t i = 0; i < n; ++i) {
     const LegChain& leg = robot_.legs[i];
     const Eigen::Vector2d d = FootTravel(robot_, leg, c, config_.robot->gait.turn_rad);
-    targets[i] = robot_.robot_in_torso *
-                 (leg.stance_m + lean - sway + envelope * FootOffset(u[i], duty, d, robot_.step_height_m));
+    const Eigen::Vector3d p = leg.stance_m + lean - sway + envelope * FootOffset(u[i], duty, d, robot_.step_height_m);
+    targets[i] = robot_.robot_in_torso * (config_.robot->gait.level > 0 ? Eigen::Vector3d(back * p) : p);
   }
   std::vector<Eigen::VectorXd> before;  // the last targets sent
   if (feedforward_.enabled()) before = q_;
@@ -213,6 +214,12 @@ const std::vector<double>& GenericWalker::Support() {
   support_.resize(on.size(), 0.0);
   for (std::size_t i = 0; i < on.size(); ++i) support_[i] += rate * (on[i] - support_[i]);
   return support_;
+}
+
+Eigen::Matrix3d LevelBack(const Eigen::Matrix3d& r, double level) {
+  if (level == 0) return Eigen::Matrix3d::Identity();
+  const Eigen::AngleAxisd tilt(Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() * r);
+  return Eigen::AngleAxisd(-level * tilt.angle(), tilt.axis()).toRotationMatrix();
 }
 
 Eigen::Vector3d GenericWalker::GravityAtHeading(const Eigen::Matrix3d& r) const {

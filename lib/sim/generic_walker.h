@@ -17,6 +17,12 @@ namespace dgmm::sim {
 enum class RunOutcome;  // simulator.h
 class Ground;           // ground.h
 
+// The rotation of the feet's targets (robot frame) that takes back `level` of the robot frame's
+// tilt from the slope plane, its heading kept (robot.gait.level):
+//   R_back = AngleAxis(-level theta, a),  (theta, a) the angle and axis of Rz(yaw)^T R;
+// the identity at level 0, and at level 1 the targets lie as they would under a level torso.
+Eigen::Matrix3d LevelBack(const Eigen::Matrix3d& robot_rotation, double level);
+
 class GenericWalker {
  public:
   // Binds config.robot to `model` (already compiled; the walker owns it from here) and applies

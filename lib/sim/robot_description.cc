@@ -71,6 +71,7 @@ GaitDescription ReadGait(const json& j, const std::string& source) {
   f.Number("stance_height_m", &g.stance_height_m, 0, 100);
   f.Number("turn_rad", &g.turn_rad, 0, 3.2);
   f.Number("lean", &g.lean, 0, 1.5);
+  f.Number("level", &g.level, 0, 1);
   f.Number("sway", &g.sway, -1, 1);
   f.Bool("servo_feedforward", &g.servo_feedforward);
   f.Done();
@@ -194,6 +195,7 @@ std::string RobotDescriptionToJson(const RobotDescription& r) {
                {"lean", g.lean},               {"sway", g.sway}};
   if (!g.phases.empty()) gait["phases"] = g.phases;
   if (g.servo_feedforward) gait["servo_feedforward"] = true;  // absent when off: older configs' text unchanged
+  if (g.level > 0) gait["level"] = g.level;  // likewise
   json j = {{"torso_body", r.torso_body},
             {"floor_geom", r.floor_geom},
             {"forward_axis", {r.forward_axis.x(), r.forward_axis.y(), r.forward_axis.z()}},

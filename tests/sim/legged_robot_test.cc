@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -15,6 +17,7 @@
 #include <sstream>
 #include <unistd.h>
 
+#include "sim/generic_walker.h"
 #include "sim/legged_robot.h"
 #include "sim/sim_config.h"
 #include "sim/simulator.h"
@@ -80,6 +83,57 @@ TEST(LeggedRobot, TheHexapodWalksAsCommandedOnFlatGround) {
   const Eigen::Matrix3d turn = before.rotation.transpose() * sim.TorsoPose().rotation;
   const double yaw = std::atan2(turn(1, 0), turn(0, 0));
   EXPECT_NEAR(yaw / (-0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
+}
+
+TEST(LeggedRobot, LevelBackTakesTheTiltBackAndKeepsTheHeading) {
+  using Eigen::AngleAxisd;
+  const Eigen::Matrix3d heading = AngleAxisd(0.7, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Matrix3d r = heading * AngleAxisd(0.3, Eigen::Vector3d::UnitY()) * AngleAxisd(-0.2, Eigen::Vector3d::UnitX());
+  EXPECT_TRUE(LevelBack(r, 0).isIdentity(0));
+  const Eigen::Vector3d p(0.1, -0.05, -0.09);  // a foot's target in the robot frame
+  EXPECT_TRUE((r * LevelBack(r, 1) * p).isApprox(heading * p, 1e-12)) << "all of the tilt taken back";
+  const double tilt = AngleAxisd(heading.transpose() * r).angle();
+  EXPECT_NEAR(AngleAxisd(heading.transpose() * r * LevelBack(r, 0.5)).angle(), 0.5 * tilt, 1e-12);
+}
+
+// Walking five commands from each of 20 places on the hexapod's rough ground: the torso's tilt
+// from the slope plane drifts with the targets in its own frame, and far less with most of it
+// taken back (robot.gait.level).
+int TiltedAfterFiveCommands(double level) {
+  SimConfig c = LoadSimConfig((kRobots / "hexapod_rough_ground.json").string());
+  c.robot->gait.level = level;
+  Simulator sim(c);
+  int tilted = 0;
+  for (int p = 0; p < 20; ++p) {
+    if (sim.Place(-1.0 + 0.5 * (p % 5), -0.75 + 0.5 * (p / 5), 0.5 * p) != RunOutcome::kCompleted) continue;
+    for (int k = 0; k < 5; ++k) {
+      if (sim.RunCommand(Eigen::Vector3d(k % 2 ? 0.5 : -0.5, 0, 0.25)) != RunOutcome::kCompleted) break;
+    }
+    tilted += sim.TorsoPose().rotation(2, 2) < std::cos(25 * M_PI / 180);
+  }
+  return tilted;
+}
+
+TEST(LeggedRobot, LevelingKeepsTheHexapodFromTiltingOnItsRoughGround) {
+  const int open_loop = TiltedAfterFiveCommands(0), leveled = TiltedAfterFiveCommands(0.75);
+  EXPECT_GE(open_loop, 5) << "the drift this guards against, of 20 places";
+  EXPECT_LE(leveled, open_loop / 2);
+}
+
+TEST(LeggedRobot, TheLevelIsWrittenOnlyWhenSetAndReadBack) {
+  SimConfig c = Hexapod();
+  EXPECT_EQ(SimConfigToJson(c).find("\"level\""), std::string::npos) << "older configs' text (and cache keys) unchanged";
+  c.robot->gait.level = 0.75;
+  EXPECT_EQ(SimConfigFromJson(SimConfigToJson(c), "round trip").robot->gait.level, 0.75);
+  const std::string text = SimConfigToJson(c);
+  const std::string over = std::regex_replace(text, std::regex("\"level\": ?0.75"), "\"level\": 1.5");
+  ASSERT_NE(over, text);
+  try {
+    SimConfigFromJson(over, "c.json");
+    ADD_FAILURE() << "a level above 1 was accepted";
+  } catch (const std::exception& e) {
+    EXPECT_NE(std::string(e.what()).find("robot.gait.level"), std::string::npos) << e.what();
+  }
 }
 
 // The hexapod modelled facing +y: every leg's mount turned 90 degrees about the torso's z (position
