@@ -157,13 +157,14 @@ def main():
     print("| seed | planted | truth | named | value | named by | right | status | excess ± SE (null) "
           "| standing tilt ratio (z) | tests permute | wall s |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    # A robot block's scales (its mass and leg reach) from the sim set, for planting in its own terms.
+    scale = ((ROBOTS.metadata(sim, "robot_mass_kg"), ROBOTS.metadata(sim, "robot_leg_reach_m"))
+             if "robot" in base else None)
     for seed in range(lo, hi + 1):
         d = os.path.join(out, str(seed))
         os.makedirs(d, exist_ok=True)
         cfg = copy.deepcopy(base)
-        robot = ((ROBOTS.metadata(sim, "robot_mass_kg"), ROBOTS.metadata(sim, "robot_leg_reach_m"), d)
-                 if "robot" in cfg else None)
-        knob, truth = planted(seed, cfg, kinds, robot)
+        knob, truth = planted(seed, cfg, kinds, scale + (d,) if scale else None)
         real_cfg = os.path.join(d, "real.json")
         real = os.path.join(d, "real.h5")
         if not (os.path.exists(real) and os.path.exists(real_cfg) and json.load(open(real_cfg)) == cfg):

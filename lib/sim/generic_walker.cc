@@ -174,7 +174,8 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   // plane), so that the support polygon stays under the centre of mass on a slope. From the
   // ground's tilt at the robot's heading, not the torso's own wobble (no feedback loop).
   Eigen::Vector3d lean = Eigen::Vector3d::Zero();
-  const Eigen::Vector3d g = GravityAtHeading(RobotPose().rotation);
+  const Eigen::Matrix3d robot = RobotPose().rotation;
+  const Eigen::Vector3d g = GravityAtHeading(robot);
   if (g.z() < -0.5) lean.head<2>() = config_.robot->gait.lean * robot_.stance_height_m * g.head<2>() / -g.z();
   const std::vector<double>& phase = c.x() < 0 ? robot_.timing.phase_backward : robot_.timing.phase;
   const double shift = LateralShift(robot_.timing, phase, sides_, c.y());
@@ -183,7 +184,7 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
   for (std::size_t i = 0; i < n; ++i) u[i] = t / period - phase[i] - shift;
   Eigen::Vector3d sway = Eigen::Vector3d::Zero();  // the torso moves by +sway: every foot by -sway
   sway.head<2>() = envelope * Sway(u);
-  const Eigen::Matrix3d back = LevelBack(RobotPose().rotation, config_.robot->gait.level);
+  const Eigen::Matrix3d back = LevelBack(robot, config_.robot->gait.level);
   std::vector<Eigen::Vector3d> targets(n);
   for (std::size_t i = 0; i < n; ++i) {
     const LegChain& leg = robot_.legs[i];
@@ -216,14 +217,21 @@ const std::vector<double>& GenericWalker::Support() {
   return support_;
 }
 
+namespace {
+// Rz(yaw) of a rotation R: its heading about the slope frame's z.
+Eigen::AngleAxisd Heading(const Eigen::Matrix3d& r) {
+  return Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ());
+}
+}  // namespace
+
 Eigen::Matrix3d LevelBack(const Eigen::Matrix3d& r, double level) {
   if (level == 0) return Eigen::Matrix3d::Identity();
-  const Eigen::AngleAxisd tilt(Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() * r);
+  const Eigen::AngleAxisd tilt(Heading(r).inverse() * r);
   return Eigen::AngleAxisd(-level * tilt.angle(), tilt.axis()).toRotationMatrix();
 }
 
 Eigen::Vector3d GenericWalker::GravityAtHeading(const Eigen::Matrix3d& r) const {
-  return Eigen::AngleAxisd(std::atan2(r(1, 0), r(0, 0)), Eigen::Vector3d::UnitZ()).inverse() *
+  return Heading(r).inverse() *
          Eigen::Vector3d(model_->opt.gravity[0], model_->opt.gravity[1], model_->opt.gravity[2]).normalized();
 }
 
