@@ -71,6 +71,8 @@ void RunSimulate(const SimulateArgs& args) {
                         {"placements", summary.placements},
                         {"falls", summary.falls},
                         {"abandoned_placements", summary.abandoned_placements},
+                        {"executions", summary.executions},
+                        {"tilted_executions", summary.tilted_executions},
                         {"simulated_seconds", summary.simulated_seconds},
                         {"wall_seconds", summary.wall_seconds},
                         {"cpu_seconds", summary.cpu_seconds},

@@ -252,6 +252,23 @@ std::string SelfContactWarning(const SimSummary& sum, const std::string& pair, c
          "can, shorten the gait's steps (robot.gait.stride_reach)";
 }
 
+// The torso started tilted in more than a twentieth of the executions: say how often and why it can.
+std::string TiltedWarning(const SimSummary& sum, const SimConfig& config) {
+  std::ostringstream w;
+  w << "robot: its torso started " << sum.tilted_executions << " of " << sum.executions << " executions tilted more than "
+    << kTiltedDeg << " degrees from the ground's plane, so those samples are of a robot walking tilted";
+  if (!config.robot) return w.str();
+  w << "; the gait's foot targets are fixed in the torso frame, so on uneven ground its tilt can carry over from "
+       "step to step";
+  if (config.robot->gait.level > 0) {
+    w << " (robot.gait.level " << config.robot->gait.level << " takes back that share of it)";
+  } else {
+    w << ": robot.gait.level takes back a share of it at every control step (docs/simulation.md, \"Leveling\": it "
+         "helps some robots and topples others; compare this count with it)";
+  }
+  return w.str();
+}
+
 // The sensed terrain descriptors of terrain.h at the robot's current state.
 Eigen::VectorXd SensedTerrain(const Simulator& sim, const std::vector<std::string>& sensed) {
   Eigen::VectorXd v(static_cast<int>(sensed.size()));
@@ -316,6 +333,7 @@ void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOption
         z.tail(terrain.size()) = terrain;
         pz.push_back(z);
         const Pose start = TrackerReading(sim.TorsoPose(), config.noise, rng);
+        if (sim.TorsoPose().rotation(2, 2) < std::cos(kTiltedDeg * M_PI / 180)) ++sum.tilted_executions;
         const long long touched = sim.SelfContactSteps();
         fell = sim.RunCommand(c) != RunOutcome::kCompleted;
         ++sum.executions;
@@ -360,6 +378,7 @@ void Append(PlanRun&& part, PlanRun* all) {
   r.values.insert(r.values.end(), q.values.begin(), q.values.end());
   all->sum.executions += part.sum.executions;
   all->sum.self_contact_executions += part.sum.self_contact_executions;
+  all->sum.tilted_executions += part.sum.tilted_executions;
   all->sum.falls += part.sum.falls;
   all->sum.abandoned_placements += part.sum.abandoned_placements;
   for (const auto& [command, steps] : part.self_contact_by_command) all->self_contact_by_command[command] += steps;
@@ -427,6 +446,7 @@ void FinishRecording(const SimConfig& config, const ProtocolOptions& options, in
                          [](const auto& a, const auto& b) { return a.second < b.second; });
     sum->warnings.push_back(SelfContactWarning(*sum, run.self_contact_pair, set->command_labels.at(worst->first)));
   }
+  if (sum->tilted_executions * 20 > sum->executions) sum->warnings.push_back(TiltedWarning(*sum, config));
   sum->placements = placements;
   sum->simulated_seconds = run.simulated_seconds;
   auto& meta = set->metadata;

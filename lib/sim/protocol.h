@@ -55,6 +55,10 @@ struct ProtocolOptions {
   bool IsValid(std::string* error) const;
 };
 
+// A torso tilted beyond this from the ground's plane at the start of an execution walks another
+// robot than the one the commands were meant for; the protocol counts those executions and warns.
+inline constexpr double kTiltedDeg = 25;
+
 struct SimSummary {
   int samples = 0;
   int placements = 0;
@@ -65,6 +69,7 @@ struct SimSummary {
   double cpu_seconds = 0;  // process CPU time while simulating (wall time suffers on a busy machine)
   int executions = 0;               // commands run (fallen ones included)
   int self_contact_executions = 0;  // of which the robot touched itself (Simulator::SelfContactSteps)
+  int tilted_executions = 0;        // of which the torso started tilted beyond kTiltedDeg from the ground's plane
   // The config against the robot (Simulator::RobotWarnings) and the robot touching itself.
   std::vector<std::string> warnings;
 

@@ -4,6 +4,8 @@
 
 #include <set>
 
+#include "robot_files.h"
+#include "sim/sim_config.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -246,6 +248,24 @@ TEST(ProtocolCellTest, OnRoughGroundEachPlacementGetsItsOwnHeading) {
   EXPECT_EQ(set.size(), 3);
   cell.headings_rad.pop_back();
   EXPECT_THROW(SimulateCell(c, cell), InputError);
+}
+
+// The hexapod's foot targets are fixed in its torso frame: on its rough ground its tilt carries over
+// from step to step and the protocol says so; on its own slope it walks level and says nothing.
+TEST(ProtocolTest, ATorsoThatStartsTiltedIsCountedAndWarnedOf) {
+  ProtocolOptions o;
+  o.seed = 5;
+  o.placements = 8;
+  o.executions_per_placement = 5;
+  SimSummary rough, plane;
+  SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod_rough_ground.json").string()), o, {}, &rough);
+  SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod.json").string()), o, {}, &plane);
+  EXPECT_GT(rough.tilted_executions * 20, rough.executions);
+  ASSERT_FALSE(rough.warnings.empty());
+  EXPECT_NE(rough.warnings.back().find("tilted more than 25 degrees"), std::string::npos) << rough.warnings.back();
+  EXPECT_NE(rough.warnings.back().find("robot.gait.level"), std::string::npos) << rough.warnings.back();
+  EXPECT_EQ(plane.tilted_executions, 0);
+  for (const std::string& w : plane.warnings) EXPECT_EQ(w.find("tilted"), std::string::npos) << w;
 }
 
 }  // namespace
