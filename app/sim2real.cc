@@ -280,6 +280,14 @@ sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, 
   }
 }
 
+// What the set's recording warned of (a tilted torso, self-contact, ...), at once and in the report.
+void RelayRecordingWarnings(const SampleSet& set, const std::string& path, sim2real::ReportContext* ctx) {
+  for (const std::string& note : sim2real::RecordingNotes(set, path)) {
+    Warn(note);
+    ctx->notes.push_back(note);
+  }
+}
+
 void Run(const Sim2RealArgs& args) {
   const SampleSet sim = ReadSampleSet(args.sim);
   const SampleSet real = ReadSampleSet(args.real);
@@ -292,6 +300,8 @@ void Run(const Sim2RealArgs& args) {
   sim2real::ReportContext ctx;
   ctx.sim_path = args.sim;
   ctx.real_path = args.real;
+  RelayRecordingWarnings(sim, args.sim, &ctx);
+  RelayRecordingWarnings(real, args.real, &ctx);
   std::string why;
   std::unique_ptr<MujocoKnobSimulator> simulator;
   const auto config = ResolveConfig(args, sim, &ctx.simulator_config_source, &ctx.notes, &why);

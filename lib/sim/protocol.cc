@@ -135,6 +135,10 @@ Pose TrackerReading(const Pose& truth, const NoiseConfig& noise, std::mt19937_64
 
 }  // namespace
 
+bool TiltedBeyondThreshold(const Pose& torso_in_ground) {
+  return torso_in_ground.rotation(2, 2) < std::cos(kTiltedDeg * M_PI / 180);
+}
+
 std::string ProtocolName(Protocol protocol) {
   switch (protocol) {
     case Protocol::kPaper: return "paper";
@@ -334,7 +338,7 @@ void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOption
         pz.push_back(z);
         const Pose truth = sim.TorsoPose();
         const Pose start = TrackerReading(truth, config.noise, rng);
-        if (truth.rotation(2, 2) < std::cos(kTiltedDeg * M_PI / 180)) ++sum.tilted_executions;
+        if (TiltedBeyondThreshold(truth)) ++sum.tilted_executions;
         const long long touched = sim.SelfContactSteps();
         fell = sim.RunCommand(c) != RunOutcome::kCompleted;
         ++sum.executions;
@@ -433,6 +437,13 @@ PlanRun RunAll(const SimConfig& config, const ProtocolOptions& options, const st
   return all;
 }
 
+// One warning per line (metadata "recording_warnings": the analyses reading the set relay them).
+std::string JoinLines(const std::vector<std::string>& lines) {
+  std::string out;
+  for (const std::string& line : lines) out += (out.empty() ? "" : "\n") + line;
+  return out;
+}
+
 // The set's samples, summary and metadata from the run.
 void FinishRecording(const SimConfig& config, const ProtocolOptions& options, int placements, PlanRun&& run,
                      SimSummary* sum, SampleSet* set) {
@@ -460,6 +471,9 @@ void FinishRecording(const SimConfig& config, const ProtocolOptions& options, in
   }
   meta["placements"] = std::to_string(sum->placements);
   meta["falls"] = std::to_string(sum->falls);
+  meta["executions"] = std::to_string(sum->executions);
+  meta["tilted_executions"] = std::to_string(sum->tilted_executions);
+  if (!sum->warnings.empty()) meta["recording_warnings"] = JoinLines(sum->warnings);
   meta["abandoned_placements"] = std::to_string(sum->abandoned_placements);
   meta["simulated_seconds"] = std::to_string(sum->simulated_seconds);
   meta["robot_mass_kg"] = std::to_string(run.total_mass_kg);

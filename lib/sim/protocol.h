@@ -58,6 +58,8 @@ struct ProtocolOptions {
 // A torso tilted beyond this from the ground's plane at the start of an execution walks another
 // robot than the one the commands were meant for; the protocol counts those executions and warns.
 inline constexpr double kTiltedDeg = 25;
+// The torso's up axis more than kTiltedDeg from the ground's normal: cos(angle) = R(2, 2).
+bool TiltedBeyondThreshold(const Pose& torso_in_ground);
 
 struct SimSummary {
   int samples = 0;

@@ -50,8 +50,11 @@ struct GaitDescription {
   // Share of the torso's tilt from the slope plane (its heading kept) that the feet's targets take
   // back at every control step (generic_walker.h, LevelBack). 0: the targets stay in the torso
   // frame whatever its tilt, which a plane corrects by itself but uneven ground does not (the
-  // hexapod on its rough ground: 41% of samples tilted beyond 25 degrees at 0, 10% at 0.75; at 1
-  // the loop runs against the servos' lag and the robot falls).
+  // hexapod on its rough ground: 41% of samples tilted beyond 25 degrees from upright at 0, 10% at
+  // 0.75; at 1 the loop runs against the servos' lag and the robot falls). Not for every robot:
+  // it takes from a trotting torso what pushes it back to level (the planar quadruped falls from
+  // 0.25, the sprawled one stands twice as tilted at 0.75). The protocol's tilt warning
+  // (kTiltedDeg, protocol.h: from the ground's plane) says whether a robot needs it.
   double level = 0;
   // Body sway of statically stable gaits: while a leg swings the torso moves `sway` of the way
   // towards the centroid of the other legs' stance points (blended from one swing to the next).

@@ -5,6 +5,7 @@
 #include <map>
 #include <optional>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -162,6 +163,17 @@ std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_pat
          ": locate compares the real residuals with the sim set's cross-fitted ones, which hold whole placements "
          "out, and then finds mismatch between two recordings of the same robot; record the sim set with more "
          "placements (e.g. dgmm simulate --protocol paper --placements 166)";
+}
+
+std::vector<std::string> RecordingNotes(const SampleSet& set, const std::string& path) {
+  std::vector<std::string> notes;
+  const auto it = set.metadata.find("recording_warnings");
+  if (it == set.metadata.end()) return notes;
+  std::istringstream lines(it->second);
+  for (std::string line; std::getline(lines, line);) {
+    if (!line.empty()) notes.push_back(path + ": its recording warned: " + line);
+  }
+  return notes;
 }
 
 PlacementCount RealPlacements(const AnalysisInputs& in) {

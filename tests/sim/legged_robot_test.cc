@@ -19,6 +19,7 @@
 
 #include "sim/generic_walker.h"
 #include "sim/legged_robot.h"
+#include "sim/protocol.h"
 #include "sim/sim_config.h"
 #include "sim/simulator.h"
 #include "robot_files.h"
@@ -109,7 +110,7 @@ int TiltedAfterFiveCommands(double level) {
     for (int k = 0; k < 5; ++k) {
       if (sim.RunCommand(Eigen::Vector3d(k % 2 ? 0.5 : -0.5, 0, 0.25)) != RunOutcome::kCompleted) break;
     }
-    tilted += sim.TorsoPose().rotation(2, 2) < std::cos(25 * M_PI / 180);
+    tilted += TiltedBeyondThreshold(sim.TorsoPose());
   }
   return tilted;
 }

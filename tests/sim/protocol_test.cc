@@ -258,14 +258,22 @@ TEST(ProtocolTest, ATorsoThatStartsTiltedIsCountedAndWarnedOf) {
   o.placements = 8;
   o.executions_per_placement = 5;
   SimSummary rough, plane;
-  SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod_rough_ground.json").string()), o, {}, &rough);
-  SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod.json").string()), o, {}, &plane);
+  const SampleSet rough_set =
+      SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod_rough_ground.json").string()), o, {}, &rough);
+  const SampleSet plane_set = SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod.json").string()), o, {}, &plane);
   EXPECT_GT(rough.tilted_executions * 20, rough.executions);
   ASSERT_FALSE(rough.warnings.empty());
   EXPECT_NE(rough.warnings.back().find("tilted more than 25 degrees"), std::string::npos) << rough.warnings.back();
   EXPECT_NE(rough.warnings.back().find("robot.gait.level"), std::string::npos) << rough.warnings.back();
   EXPECT_EQ(plane.tilted_executions, 0);
   for (const std::string& w : plane.warnings) EXPECT_EQ(w.find("tilted"), std::string::npos) << w;
+  // The set keeps the counts and the warnings, one per line, for the analyses that read it.
+  EXPECT_EQ(rough_set.metadata.at("executions"), std::to_string(rough.executions));
+  EXPECT_EQ(rough_set.metadata.at("tilted_executions"), std::to_string(rough.tilted_executions));
+  EXPECT_NE(rough_set.metadata.at("recording_warnings").find(rough.warnings.back()), std::string::npos);
+  EXPECT_EQ(plane_set.metadata.at("tilted_executions"), "0");
+  const auto it = plane_set.metadata.find("recording_warnings");
+  if (it != plane_set.metadata.end()) EXPECT_EQ(it->second.find("tilted"), std::string::npos) << it->second;
 }
 
 }  // namespace

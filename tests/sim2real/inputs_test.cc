@@ -80,5 +80,15 @@ TEST(Inputs, ASimSetWithOnePlacementPerSettingIsWarnedAbout) {
   EXPECT_EQ(SmallSimSetNote(PrepareInputs(GenerateSynthetic(SyntheticWorld{}, "paper-830", 2), single, 1), "sim.h5"), "");
 }
 
+TEST(Inputs, WhatASetsRecordingWarnedOfIsANoteNamingTheSet) {
+  SampleSet set = GenerateSynthetic(SyntheticWorld{}, "paper", 1);
+  EXPECT_TRUE(RecordingNotes(set, "sim.h5").empty()) << "a log or an older set: nothing to relay";
+  set.metadata["recording_warnings"] = "robot: its torso started 9 of 20 executions tilted\n\nrobot: its legs touched";
+  const std::vector<std::string> notes = RecordingNotes(set, "sim.h5");
+  ASSERT_EQ(notes.size(), 2u) << "one note per warning, empty lines skipped";
+  EXPECT_EQ(notes[0], "sim.h5: its recording warned: robot: its torso started 9 of 20 executions tilted");
+  EXPECT_EQ(notes[1], "sim.h5: its recording warned: robot: its legs touched");
+}
+
 }  // namespace
 }  // namespace dgmm::sim2real
