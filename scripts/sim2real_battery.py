@@ -407,6 +407,15 @@ def find_key(obj, key):
     return None
 
 
+def stop_time(hh_mm, now):
+    """The next time of day `hh_mm` (UTC) at or after `now` (epoch seconds): 01:10 said at 23:15
+    is tomorrow's (it was today's, already past, so nothing started)."""
+    hh, mm = (int(v) for v in hh_mm.split(":"))
+    day = now - now % 86400
+    at = day + (hh * 60 + mm) * 60
+    return at if at >= now else at + 86400
+
+
 def parse_seeds(text):
     """Seeds from "A-B", "A" or a comma-separated list of those ("1019,1020,1030-1039")."""
     seeds = []
@@ -453,10 +462,7 @@ def main():
         ap.error("--jobs: expected 1 or 2 (the machine has 2 cores)")
     seeds = parse_seeds(args.seeds)[: 3 if args.smoke else None]
     if args.stop_at:
-        hh, mm = (int(v) for v in args.stop_at.split(":"))
-        now = time.gmtime()
-        args.stop_at = time.time() + ((hh * 60 + mm) - (now.tm_hour * 60 + now.tm_min)) * 60 \
-            - now.tm_sec
+        args.stop_at = stop_time(args.stop_at, time.time())
     args.out = os.path.abspath(args.out or os.path.join(ROOT, "out", f"battery-{args.seeds}"))
     args.dgmm = os.path.join(os.path.abspath(args.build), "app", "dgmm")
     if not os.access(args.dgmm, os.X_OK):

@@ -63,6 +63,12 @@ class DrawTest(unittest.TestCase):
         self.assertEqual(battery.parse_seeds("7"), [7])
         self.assertEqual(battery.parse_seeds("1019,1020,1030-1032"), [1019, 1020, 1030, 1031, 1032])
 
+    def test_stop_at_is_the_next_such_time(self):
+        evening = 86400 * 20000 + 23 * 3600 + 15 * 60  # 23:15 UTC on some day
+        self.assertEqual(battery.stop_time("23:40", evening), evening + 25 * 60)
+        self.assertEqual(battery.stop_time("01:10", evening), evening + 115 * 60)  # after midnight
+        self.assertEqual(battery.stop_time("23:15", evening), evening)
+
     def test_values_inside_their_ranges(self):
         n = nominals()
         for s in range(3000, 3400):

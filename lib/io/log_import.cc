@@ -8,6 +8,7 @@
 #include <numbers>
 #include <set>
 
+#include "core/set_warnings.h"
 #include "io/csv_reader.h"
 #include "io/log_files.h"
 #include "io/log_time_series.h"
@@ -545,6 +546,7 @@ SampleSet Assemble(SampleSink& sink, const LogImportOptions& o, const std::vecto
   set.metadata["log_window_s"] = o.window_s > 0 ? FormatNumber(o.window_s) : "command segments";
   set.metadata["log_gap_s"] = FormatNumber(summary.gap_s);
   if (o.per_second) set.metadata["log_per_second"] = "pose changes divided by window duration";
+  KeepWarnings(summary.warnings, &set);
   return set;
 }
 

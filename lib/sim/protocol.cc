@@ -10,6 +10,7 @@
 #include <random>
 #include <sstream>
 
+#include "core/set_warnings.h"
 #include "sim/pose.h"
 #include "sim/replay.h"
 #include "sim/simulator.h"
@@ -437,13 +438,6 @@ PlanRun RunAll(const SimConfig& config, const ProtocolOptions& options, const st
   return all;
 }
 
-// One warning per line (metadata "recording_warnings": the analyses reading the set relay them).
-std::string JoinLines(const std::vector<std::string>& lines) {
-  std::string out;
-  for (const std::string& line : lines) out += (out.empty() ? "" : "\n") + line;
-  return out;
-}
-
 // The set's samples, summary and metadata from the run.
 void FinishRecording(const SimConfig& config, const ProtocolOptions& options, int placements, PlanRun&& run,
                      SimSummary* sum, SampleSet* set) {
@@ -473,7 +467,7 @@ void FinishRecording(const SimConfig& config, const ProtocolOptions& options, in
   meta["falls"] = std::to_string(sum->falls);
   meta["executions"] = std::to_string(sum->executions);
   meta["tilted_executions"] = std::to_string(sum->tilted_executions);
-  if (!sum->warnings.empty()) meta["recording_warnings"] = JoinLines(sum->warnings);
+  KeepWarnings(sum->warnings, set);
   meta["abandoned_placements"] = std::to_string(sum->abandoned_placements);
   meta["simulated_seconds"] = std::to_string(sum->simulated_seconds);
   meta["robot_mass_kg"] = std::to_string(run.total_mass_kg);

@@ -5,12 +5,12 @@
 #include <map>
 #include <optional>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "core/set_warnings.h"
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
 #include "util/median.h"
@@ -167,12 +167,7 @@ std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_pat
 
 std::vector<std::string> RecordingNotes(const SampleSet& set, const std::string& path) {
   std::vector<std::string> notes;
-  const auto it = set.metadata.find("recording_warnings");
-  if (it == set.metadata.end()) return notes;
-  std::istringstream lines(it->second);
-  for (std::string line; std::getline(lines, line);) {
-    if (!line.empty()) notes.push_back(path + ": its recording warned: " + line);
-  }
+  for (const std::string& w : KeptWarnings(set)) notes.push_back(path + ": dgmm warned when it made this set: " + w);
   return notes;
 }
 

@@ -65,10 +65,9 @@ SettingCoverage MeasureSettingCoverage(const AnalysisInputs& in);
 // such a pair; 0.8 to 1.5 with 166 placements or random headings.
 std::string SmallSimSetNote(const AnalysisInputs& in, const std::string& sim_path, double ratio = 3.0);
 
-// The warnings a set's recording gave (metadata "recording_warnings", one per line, as `dgmm
-// simulate` writes them: a torso that started tilted, legs touching each other, the config
-// against the robot), each as a note naming the set: what the analysis finds describes the robot
-// as that recording had it. None for a set without them (a log, an older set).
+// The warnings dgmm gave when it made a set (core/set_warnings.h: a torso that started tilted, legs
+// touching each other, windows of unequal length), each as a note naming the set: what the analysis
+// finds describes the robot as that set has it. None for a set without them (an older set, a CSV).
 std::vector<std::string> RecordingNotes(const SampleSet& set, const std::string& path);
 
 }  // namespace dgmm::sim2real

@@ -15,6 +15,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/set_warnings.h"
 #include "io/command_bins.h"
 #include "io/csv_reader.h"
 #include "io/log_files.h"
@@ -502,9 +503,11 @@ TEST(LogImport, UnequalDurationsWarnOrBecomeRates) {
   EXPECT_NEAR(summary.min_window_s, 1.5, 1e-9);
   ASSERT_EQ(summary.warnings.size(), 1u);
   EXPECT_NE(summary.warnings[0].find("--per-second"), std::string::npos) << summary.warnings[0];
+  EXPECT_EQ(KeptWarnings(s), summary.warnings) << "the set keeps them for the analyses that read it";
   o.per_second = true;
   s = ImportLog(o, &summary);
   EXPECT_TRUE(summary.warnings.empty());
+  EXPECT_TRUE(KeptWarnings(s).empty());
   EXPECT_EQ(s.x_units[0], "m/s");
   for (int i = 0; i < s.size(); ++i) {
     EXPECT_NEAR(s.x(i, 0), TrialSpeed(log.labels[i]), kTol) << i;  // speeds, whatever the length

@@ -86,8 +86,8 @@ TEST(Inputs, WhatASetsRecordingWarnedOfIsANoteNamingTheSet) {
   set.metadata["recording_warnings"] = "robot: its torso started 9 of 20 executions tilted\n\nrobot: its legs touched";
   const std::vector<std::string> notes = RecordingNotes(set, "sim.h5");
   ASSERT_EQ(notes.size(), 2u) << "one note per warning, empty lines skipped";
-  EXPECT_EQ(notes[0], "sim.h5: its recording warned: robot: its torso started 9 of 20 executions tilted");
-  EXPECT_EQ(notes[1], "sim.h5: its recording warned: robot: its legs touched");
+  EXPECT_EQ(notes[0], "sim.h5: dgmm warned when it made this set: robot: its torso started 9 of 20 executions tilted");
+  EXPECT_EQ(notes[1], "sim.h5: dgmm warned when it made this set: robot: its legs touched");
 }
 
 }  // namespace
