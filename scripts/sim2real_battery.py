@@ -58,9 +58,8 @@ ROBOTS = {  # name -> nominal sim config; MJCF of the built-in robot for MJCF ed
 }
 SIM_PLACEMENTS, SMOKE_SIM_PLACEMENTS, SMOKE_REAL_PLACEMENTS = 166, 40, 20
 LOCK = threading.Lock()
-# Metadata of the real set that would reveal the concealed change.
-# What the real robot's recording says of it beyond its samples: its config, seed and mass, and its
-# summary (falls, the executions that started tilted, the warnings `dgmm sim2real` relays as notes).
+# Metadata of the real set that would reveal the concealed change: its config, seed and mass, and its
+# recording's summary (falls, the executions that started tilted, the warnings `dgmm sim2real` relays).
 REVEALING_METADATA = ("sim_config", "seed", "robot_mass_kg", "falls", "abandoned_placements", "executions",
                       "tilted_executions", "recording_warnings")
 
