@@ -79,7 +79,8 @@ void Setup(CLI::App& root) {
       "Draft a simulation config with a robot block for your MJCF (docs/simulation.md, \"Bring your own robot\"): "
       "the torso is the body with the free joint, the floor the named plane on the world body, a leg each jointed "
       "branch below the torso whose lowest geom stands on the ground at the rest pose (its driven joints torso to "
-      "foot, undriven ones passive, named by their joints' common prefix, side from the geometry). The draft is "
+      "foot, undriven ones passive, named by their joints' common prefix, side from the geometry; a branch carrying "
+      "legs on both sides is a body segment, its joints held when driven). The draft is "
       "bound as dgmm simulate binds it and what it lacks is said; read it before you trust it.");
   cmd->add_option("mjcf", args->mjcf, "the robot's MJCF (a scene with a floor, or the robot with one)")->required();
   cmd->add_option("-o,--output", args->output, "config to write (JSON; default: stdout)");

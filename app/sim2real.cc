@@ -280,12 +280,16 @@ sim2real::Analysis AnalyseOrLocate(const SampleSet& sim, const SampleSet& real, 
   }
 }
 
-// What the set's recording warned of (a tilted torso, self-contact, ...), at once and in the report.
+// A note the user hears at once (stderr) and finds in the report.
+void WarnAndNote(const std::string& note, sim2real::ReportContext* ctx) {
+  if (note.empty()) return;
+  Warn(note);
+  ctx->notes.push_back(note);
+}
+
+// What the set's recording warned of (a tilted torso, self-contact, ...).
 void RelayRecordingWarnings(const SampleSet& set, const std::string& path, sim2real::ReportContext* ctx) {
-  for (const std::string& note : sim2real::RecordingNotes(set, path)) {
-    Warn(note);
-    ctx->notes.push_back(note);
-  }
+  for (const std::string& note : sim2real::RecordingNotes(set, path)) WarnAndNote(note, ctx);
 }
 
 void Run(const Sim2RealArgs& args) {
@@ -316,10 +320,7 @@ void Run(const Sim2RealArgs& args) {
               " sim samples");
   const sim2real::Analysis a =
       AnalyseOrLocate(sim, real, args, config, &simulator, &why, &ctx);
-  if (const std::string note = sim2real::SmallSimSetNote(a.inputs, args.sim); !note.empty()) {
-    Warn(note);
-    ctx.notes.push_back(note);
-  }
+  WarnAndNote(sim2real::SmallSimSetNote(a.inputs, args.sim), &ctx);
   if (a.baseline.permute_placements) {
     ctx.notes.push_back("locate's tests permute whole placements (" + a.baseline.permute_why +
                         "), so a region needs several placements on each side to be found");

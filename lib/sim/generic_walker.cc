@@ -31,9 +31,11 @@ void GenericWalker::Start() {
   data_.reset(mj_makeData(model_.get()));
   scratch_.reset(mj_makeData(model_.get()));
   for (int k = 0; k < 7; ++k) scratch_->qpos[robot_.torso_qpos + k] = k == 3 ? 1 : 0;  // torso frame = world
+  for (std::size_t i = 0; i < robot_.held_qpos.size(); ++i) scratch_->qpos[robot_.held_qpos[i]] = robot_.held_q[i];
   mj_setConst(model_.get(), data_.get());
   q_.resize(robot_.legs.size());
-  std::vector<int> actuators = robot_.leg_actuators;
+  std::vector<int> actuators = robot_.leg_actuators;  // then the held joints' servos
+  actuators.insert(actuators.end(), robot_.held_actuators.begin(), robot_.held_actuators.end());
   if (!robot_.replay.empty()) {
     actuators.clear();
     for (int a = 0; a < model_->nu; ++a) actuators.push_back(a);
@@ -86,7 +88,9 @@ void GenericWalker::HoldStance() {
 }
 
 void GenericWalker::StanceTargets() {
-  u_.resize(static_cast<int>(robot_.leg_actuators.size()));
+  const int legs = static_cast<int>(robot_.leg_actuators.size());
+  u_.resize(legs + robot_.held_q.size());
+  u_.tail(robot_.held_q.size()) = robot_.held_q;
   int k = 0;
   std::vector<Eigen::Vector3d> feet;
   for (std::size_t i = 0; i < robot_.legs.size(); ++i) {
@@ -98,7 +102,7 @@ void GenericWalker::StanceTargets() {
   const double* w = data_->qpos + robot_.torso_qpos + 3;  // not xmat: it may predate a placement
   const Eigen::Matrix3d torso = Eigen::Quaterniond(w[0], w[1], w[2], w[3]).toRotationMatrix();
   const LegPlan plan{q_, {}, feet, Support(), GravityAtHeading(torso * robot_.robot_in_torso)};
-  u_ += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
+  u_.head(legs) += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
 }
 
 const ReplayTrack& GenericWalker::Recording(const Eigen::Vector3d& c) const {
@@ -205,7 +209,7 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
     plan.q_velocity.push_back((q_[i] - before[i]) / (control_every_ * model_->opt.timestep));
     plan.feet_robot_m.push_back(robot_.robot_in_torso.transpose() * targets[i]);
   }
-  u_ += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
+  u_.head(static_cast<int>(robot_.leg_actuators.size())) += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
 }
 
 const std::vector<double>& GenericWalker::Support() {

@@ -130,30 +130,79 @@ LegChain BindChain(const mjModel* m, const RobotDescription& r, int i, int torso
   return leg;
 }
 
-// Every joint is a leg's, passive or the torso's free joint; every actuator drives a leg joint.
-void CheckEverythingAccounted(const mjModel* m, const RobotDescription& r, const LeggedRobot& bound,
+// An actuator for a message: its name, else its index and the joint it drives.
+std::string ActuatorLabel(const mjModel* m, int a) {
+  const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
+  if (name) return std::string("actuator \"") + name + "\"";
+  std::string label = "actuator " + std::to_string(a) + " (unnamed";
+  if (m->actuator_trntype[a] == mjTRN_JOINT) {
+    const char* joint = mj_id2name(m, mjOBJ_JOINT, m->actuator_trnid[2 * a]);
+    if (joint) label += std::string(", on joint \"") + joint + "\"";
+  }
+  return label + ")";
+}
+
+// robot.held_joints: hinges or slides of no leg, each driven by a position servo (with the gait),
+// held at its rest value, which lies within what the joint and its servo allow.
+void BindHeld(const mjModel* m, const RobotDescription& r, const std::set<int>& leg_joints, const std::string& source,
+              LeggedRobot* bound) {
+  const MjDataPtr rest = RestPoseData(m, bound->torso_qpos);
+  bound->held_q.resize(static_cast<int>(r.held_joints.size()));
+  for (std::size_t i = 0; i < r.held_joints.size(); ++i) {
+    const std::string& name = r.held_joints[i];
+    const int j = Find(m, mjOBJ_JOINT, name, "joint", "robot.held_joints", source);
+    std::string problem;
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) problem = "is not a hinge or slide joint";
+    if (leg_joints.count(j)) problem = "is also a leg's joint";
+    if (std::count(r.passive_joints.begin(), r.passive_joints.end(), name)) problem = "is also declared passive";
+    const int a = ActuatorOf(m, j);
+    if (problem.empty() && !r.controller.replay() && (a < 0 || !IsPositionServo(m, a))) {
+      problem = a < 0 ? "is driven by no actuator (list it in robot.passive_joints)"
+                      : "is not driven by a position servo, which the gait needs to hold it";
+    }
+    const double q = rest->qpos[m->jnt_qposadr[j]];
+    const Eigen::Vector2d range = TargetRange(m, j, a);
+    if (problem.empty() && !(q >= range[0] - 1e-9 && q <= range[1] + 1e-9)) {
+      char what[120];
+      std::snprintf(what, sizeof what, "rests at %g, outside what its range and its servo allow [%g, %g]", q,
+                    range[0], range[1]);
+      problem = what;
+    }
+    if (!problem.empty()) throw MakeInputError(source, "robot.held_joints", "joint \"" + name + "\" " + problem);
+    bound->held_qpos.push_back(m->jnt_qposadr[j]);
+    bound->held_actuators.push_back(a);
+    bound->held_q[static_cast<int>(i)] = q;
+  }
+}
+
+// Every joint is a leg's, passive, held or the torso's free joint; every actuator drives a leg
+// joint or a held one.
+void CheckEverythingAccounted(const mjModel* m, const RobotDescription& r, LeggedRobot* bound,
                               const std::string& source) {
-  std::set<int> leg_joints, leg_actuators(bound.leg_actuators.begin(), bound.leg_actuators.end()), passive;
-  for (const auto& leg : bound.legs) leg_joints.insert(leg.joints.begin(), leg.joints.end());
+  std::set<int> leg_joints, accounted, driven(bound->leg_actuators.begin(), bound->leg_actuators.end());
+  for (const auto& leg : bound->legs) leg_joints.insert(leg.joints.begin(), leg.joints.end());
   for (const auto& name : r.passive_joints) {
     const int j = Find(m, mjOBJ_JOINT, name, "joint", "robot.passive_joints", source);
     if (leg_joints.count(j)) {
       throw MakeInputError(source, "robot.passive_joints", "joint \"" + name + "\" is also a leg's driven joint");
     }
-    passive.insert(j);
+    accounted.insert(j);
   }
+  BindHeld(m, r, leg_joints, source, bound);
+  for (const auto& name : r.held_joints) accounted.insert(mj_name2id(m, mjOBJ_JOINT, name.c_str()));
+  driven.insert(bound->held_actuators.begin(), bound->held_actuators.end());
+  accounted.insert(leg_joints.begin(), leg_joints.end());
   for (int j = 0; j < m->njnt; ++j) {
-    if (m->jnt_type[j] == mjJNT_FREE || leg_joints.count(j) || passive.count(j)) continue;
+    if (m->jnt_type[j] == mjJNT_FREE || accounted.count(j)) continue;
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
     throw MakeInputError(source, "robot.legs",
                          std::string("joint \"") + (name ? name : "(unnamed)") +
-                             "\" belongs to no leg and is not declared in robot.passive_joints");
+                             "\" belongs to no leg and is declared neither in robot.passive_joints (undriven) nor in "
+                             "robot.held_joints (driven, held at rest: a spine, a neck, a tail)");
   }
   for (int a = 0; a < m->nu && !r.controller.replay(); ++a) {  // a replay drives every actuator
-    if (leg_actuators.count(a)) continue;
-    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
-    throw MakeInputError(source, "robot.legs",
-                         std::string("actuator \"") + (name ? name : "(unnamed)") + "\" drives no leg's joint");
+    if (driven.count(a)) continue;
+    throw MakeInputError(source, "robot.legs", ActuatorLabel(m, a) + " drives no leg's joint and no held joint");
   }
 }
 
@@ -409,7 +458,7 @@ LeggedRobot BindRobot(const mjModel* m, const RobotDescription& r, const std::st
     b.legs.push_back(BindChain(m, r, i, b.torso_body, source));
     b.leg_actuators.insert(b.leg_actuators.end(), b.legs.back().actuators.begin(), b.legs.back().actuators.end());
   }
-  CheckEverythingAccounted(m, r, b, source);
+  CheckEverythingAccounted(m, r, &b, source);
   BindReplay(m, r, source, &b);
   MeasureRest(m, r, source, &b);
   std::vector<LegPlace> places;

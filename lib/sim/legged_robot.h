@@ -36,6 +36,9 @@ struct LeggedRobot {
   Eigen::Matrix3d robot_in_torso = Eigen::Matrix3d::Identity();  // columns: forward, left, up
   std::vector<LegChain> legs;
   std::vector<int> leg_actuators;  // every actuator a leg drives
+  // robot.held_joints: qpos addresses, their actuators (-1: none, a replay's robot) and rest values.
+  std::vector<int> held_qpos, held_actuators;
+  Eigen::VectorXd held_q;
   GaitTiming timing;
   double reach_m = 0, stance_height_m = 0, stride_m = 0, step_height_m = 0;
   // A replay controller's tracks (one per robot.controller.recordings entry, columns in actuator
@@ -46,7 +49,8 @@ struct LeggedRobot {
 
 // Binds and validates (one-line InputError "<source>: robot.<part>: <problem>"): parts exist and
 // are of the right kind, each leg's joints lie on its torso-to-foot chain, every joint is driven
-// by a position servo of its leg or declared passive, no actuator drives anything else, declared
+// by a position servo of its leg, declared passive, or declared held (driven off the legs, held at
+// rest by the gait's position servo), no actuator drives anything else, declared
 // sides agree with the geometry, the gait fits the legs and every foot reaches the ground at the
 // stance height.
 LeggedRobot BindRobot(const mjModel* model, const RobotDescription& robot, const std::string& source);

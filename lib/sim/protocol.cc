@@ -452,7 +452,7 @@ void FinishRecording(const SimConfig& config, const ProtocolOptions& options, in
                          [](const auto& a, const auto& b) { return a.second < b.second; });
     sum->warnings.push_back(SelfContactWarning(*sum, run.self_contact_pair, set->command_labels.at(worst->first)));
   }
-  if (sum->tilted_executions * 20 > sum->executions) sum->warnings.push_back(TiltedWarning(*sum, config));
+  if (sum->TiltedTooOften()) sum->warnings.push_back(TiltedWarning(*sum, config));
   sum->placements = placements;
   sum->simulated_seconds = run.simulated_seconds;
   auto& meta = set->metadata;

@@ -78,6 +78,8 @@ struct SimSummary {
   double SimulatedPerWallSecond() const;
   double SamplesPerWallSecond() const;
   std::string BriefReport() const;
+  // The torso started tilted in more than a twentieth of the executions: the protocol warns.
+  bool TiltedTooOften() const { return tilted_executions * 20 > executions; }
 };
 
 // Progress callback: (placements done, placements total).

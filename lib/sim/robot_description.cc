@@ -135,6 +135,7 @@ RobotDescription RobotDescriptionFromJson(const std::string& json_text, const st
   f.String("floor_geom", &r.floor_geom);
   f.Vector3("forward_axis", &r.forward_axis);
   f.Strings("passive_joints", &r.passive_joints);
+  f.Strings("held_joints", &r.held_joints);
   f.Bool("overwrite_physics", &r.overwrite_physics);
   const json* legs = f.Find("legs");
   const json* gait = f.Find("gait");
@@ -203,6 +204,7 @@ std::string RobotDescriptionToJson(const RobotDescription& r) {
             {"passive_joints", r.passive_joints},
             {"gait", gait},
             {"overwrite_physics", r.overwrite_physics}};
+  if (!r.held_joints.empty()) j["held_joints"] = r.held_joints;  // absent when none: older configs' text unchanged
   if (!r.leg_gain.empty()) j["leg_gain"] = r.leg_gain;
   if (r.controller.replay()) {
     json recordings = json::array();

@@ -88,6 +88,9 @@ struct RobotDescription {
   Eigen::Vector3d forward_axis = Eigen::Vector3d::UnitX();  // torso frame
   std::vector<LegDescription> legs;
   std::vector<std::string> passive_joints;  // joints deliberately left undriven
+  // Driven joints of no leg (a spine between body segments, a neck, a tail): the generic gait
+  // holds each at its rest value (the first keyframe, else qpos0); a replay drives them as recorded.
+  std::vector<std::string> held_joints;
   GaitDescription gait;
   std::map<std::string, double> leg_gain;   // by leg name: scales the leg's actuator gains
   ControllerDescription controller;

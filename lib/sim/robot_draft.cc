@@ -63,14 +63,14 @@ int FindFloor(const mjModel* m, const std::string& source, std::vector<std::stri
   return planes[0];
 }
 
-// Jointed branches in model order: bodies with a joint whose bodies between them and the torso
-// have none (welded parts are looked through), each with its lowest geom that can touch the floor.
-std::vector<Branch> FindBranches(const mjModel* m, const mjData* d, int torso, int floor) {
+// The first jointed bodies below `parent` in model order (bodies between them and `parent` have no
+// joint: welded parts are looked through), each with its lowest geom that can touch the floor.
+std::vector<Branch> BranchesBelow(const mjModel* m, const mjData* d, int parent, int floor) {
   std::vector<Branch> branches;
-  for (int b = torso + 1; b < m->nbody; ++b) {
-    if (!IsDescendant(m, b, torso) || m->body_jntnum[b] == 0) continue;
+  for (int b = parent + 1; b < m->nbody; ++b) {
+    if (!IsDescendant(m, b, parent) || m->body_jntnum[b] == 0) continue;
     bool first = true;
-    for (int a = m->body_parentid[b]; a != torso; a = m->body_parentid[a]) first = first && m->body_jntnum[a] == 0;
+    for (int a = m->body_parentid[b]; a != parent; a = m->body_parentid[a]) first = first && m->body_jntnum[a] == 0;
     if (!first) continue;
     Branch branch{b};
     for (int g = 0; g < m->ngeom; ++g) {
@@ -82,6 +82,52 @@ std::vector<Branch> FindBranches(const mjModel* m, const mjData* d, int torso, i
     branches.push_back(branch);
   }
   return branches;
+}
+
+// Where the branches below the torso reach the ground, and which are body segments.
+struct Branches {
+  std::vector<Branch> legs_or_not;  // each a leg candidate (or a tail, a head: NotALeg)
+  std::vector<int> segments;        // bodies carrying legs on both sides (behind a spine joint)
+};
+
+// A branch whose own branches put feet (within the foot band of the lowest point, `foot_z`) on
+// both sides of the forward axis is a body segment, as no leg stands on both sides: its legs are
+// the branches below it (recursively), its own joints the body's.
+void CollectBranches(const mjModel* m, const mjData* d, int parent, int floor, const Eigen::Matrix3d& frame,
+                     double foot_z, Branches* out) {
+  for (const Branch& b : BranchesBelow(m, d, parent, floor)) {
+    std::set<int> sides;
+    for (const Branch& sub : BranchesBelow(m, d, b.root, floor)) {
+      if (sub.foot_geom < 0 || sub.low_z > foot_z) continue;
+      const mjtNum* p = d->geom_xpos + 3 * sub.foot_geom;
+      sides.insert(FootSide(frame, Eigen::Vector3d(p[0], p[1], p[2])));
+    }
+    if (sides.size() < 2) {
+      out->legs_or_not.push_back(b);
+      continue;
+    }
+    out->segments.push_back(b.root);
+    CollectBranches(m, d, b.root, floor, frame, foot_z, out);
+  }
+}
+
+// A body segment's own joints: held when driven, passive when not (a note says which).
+void SegmentJoints(const mjModel* m, int body, RobotDescription* r, std::vector<std::string>* notes) {
+  std::string held, passive;
+  for (int j = m->body_jntadr[body]; j < m->body_jntadr[body] + m->body_jntnum[body]; ++j) {
+    const std::string name = Name(m, mjOBJ_JOINT, j);
+    if (name.empty()) {
+      notes->push_back("body segment \"" + Name(m, mjOBJ_BODY, body) + "\": joint " + std::to_string(j) +
+                       " has no name: name it to list it");
+      continue;
+    }
+    const bool driven = ActuatorOf(m, j) >= 0;
+    (driven ? r->held_joints : r->passive_joints).push_back(name);
+    (driven ? held : passive) += (driven ? held : passive).empty() ? name : ", " + name;
+  }
+  notes->push_back("body \"" + Name(m, mjOBJ_BODY, body) + "\" carries legs on both sides: a body segment, its legs "
+                   "drafted below it" + (held.empty() ? "" : "; held at rest (driven): " + held) +
+                   (passive.empty() ? "" : "; passive: " + passive));
 }
 
 // The common prefix of the leg's joint names without trailing separators ("FR" of FR_hip_joint,
@@ -256,12 +302,14 @@ RobotDraft DraftRobot(const std::string& mjcf_path, const RobotDraftOptions& opt
   r.forward_axis = options.forward_axis;
   const MjDataPtr d = RestPoseData(m, m->jnt_qposadr[m->body_jntadr[torso]]);
   mj_kinematics(m, d.get());
-  std::vector<Branch> branches = FindBranches(m, d.get(), torso, floor);
   double lowest = 0;
-  for (const auto& b : branches) lowest = b.foot_geom >= 0 ? std::min(lowest, b.low_z) : lowest;
+  for (const auto& b : BranchesBelow(m, d.get(), torso, floor)) lowest = b.foot_geom >= 0 ? std::min(lowest, b.low_z) : lowest;
   if (!(lowest < 0)) throw MakeInputError(mjcf_path, "worldbody", "no jointed branch below the torso reaches the ground");
+  Branches branches;
+  CollectBranches(m, d.get(), torso, floor, RobotFrame(options.forward_axis), (1 - options.foot_band) * lowest, &branches);
+  for (int body : branches.segments) SegmentJoints(m, body, &r, &draft.notes);
   std::vector<Branch> legs;
-  for (const auto& b : branches) {
+  for (const auto& b : branches.legs_or_not) {
     if (b.foot_geom < 0 || b.low_z > (1 - options.foot_band) * lowest) {
       NotALeg(m, b, &r.passive_joints, &draft.notes);
       continue;

@@ -18,7 +18,9 @@
 #include <unistd.h>
 
 #include "sim/generic_walker.h"
+#include "sim/ground.h"
 #include "sim/legged_robot.h"
+#include "sim/mujoco_model.h"
 #include "sim/protocol.h"
 #include "sim/sim_config.h"
 #include "sim/simulator.h"
@@ -174,6 +176,19 @@ Eigen::Vector3d Travel(Simulator& sim, const Eigen::Vector3d& command) {
   const Eigen::Vector3d moved = start.rotation.transpose() * (sim.TorsoPose().position_m - start.position_m);
   const Eigen::Matrix3d turn = start.rotation.transpose() * sim.TorsoPose().rotation;
   return Eigen::Vector3d(moved.x(), moved.y(), std::atan2(turn(1, 0), turn(0, 0)));
+}
+
+// Half a forward command travels within 25% of half the stride and straight (sideways under
+// 15% of it); half a turn turns the commanded way within 30%.
+void ExpectWalksAsCommanded(Simulator& sim) {
+  const RobotDescription& r = *sim.config().robot;
+  const double cycles = sim.config().command_duration_s / r.gait.period_s;
+  const double stride = r.gait.stride_reach * sim.leg_reach_m() * cycles;
+  const Eigen::Vector3d forward = Travel(sim, Eigen::Vector3d(0.5, 0, 0));
+  EXPECT_NEAR(forward.x() / (0.5 * stride), 1.0, 0.25);
+  EXPECT_LT(std::abs(forward.y()) / (0.5 * stride), 0.15);
+  const Eigen::Vector3d turn = Travel(sim, Eigen::Vector3d(0, 0, -0.5));
+  EXPECT_NEAR(turn.z() / (-0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
 }
 
 TEST(LeggedRobot, TheForwardAxisTurnsTheRobotsFrame) {
@@ -680,15 +695,100 @@ TEST(LeggedRobot, AHexapodThatLostALegWalksInTheWave) {
   const fs::path path = fs::temp_directory_path() / ("dgmm_five_legs_" + std::to_string(::getpid()) + ".xml");
   Simulator sim(HexapodWithout("rear_right", path));
   fs::remove(path);
-  const RobotDescription& r = *sim.config().robot;
   ASSERT_EQ(sim.leg_count(), 5);
-  const double cycles = sim.config().command_duration_s / r.gait.period_s;
-  const double stride = r.gait.stride_reach * sim.leg_reach_m() * cycles;
-  const Eigen::Vector3d forward = Travel(sim, Eigen::Vector3d(0.5, 0, 0));
-  EXPECT_NEAR(forward.x() / (0.5 * stride), 1.0, 0.25);
-  EXPECT_LT(std::abs(forward.y()) / (0.5 * stride), 0.15);
-  const Eigen::Vector3d turn = Travel(sim, Eigen::Vector3d(0, 0, -0.5));
-  EXPECT_NEAR(turn.z() / (-0.5 * r.gait.turn_rad * cycles), 1.0, 0.3);
+  ExpectWalksAsCommanded(sim);
+}
+
+// The centipede (datasets/robots/centipede.json): three body segments in a row, the middle one
+// hung from the head by a driven yaw joint (robot.held_joints), the tail by a passive spring.
+SimConfig Centipede(double slope_deg = 0) {
+  SimConfig c = LoadSimConfig((kRobots / "centipede.json").string());
+  c.slope_deg = slope_deg;
+  return c;
+}
+
+// Its MJCF with `from` replaced by `to` (and `extra` before the model's end), at a temporary path.
+SimConfig EditedCentipede(const fs::path& path, const std::string& from, const std::string& to,
+                          const std::string& extra = "") {
+  std::string xml = ReadText(kRobots / "centipede.xml");
+  if (!from.empty()) xml.replace(xml.find(from), from.size(), to);
+  xml.insert(xml.rfind("</mujoco>"), extra);
+  std::ofstream(path) << xml;
+  SimConfig c = Centipede();
+  c.mjcf_path = path.string();
+  return c;
+}
+
+// Twelve legs on three segments walk as commanded on flat ground and on its 10 degree slope:
+// forward within 25% and straight (cross-talk under 15%), turning the commanded way within 30%.
+TEST(LeggedRobot, TheCentipedeWalksOnItsSegmentedBody) {
+  for (const double slope : {0.0, 10.0}) {
+    SCOPED_TRACE(slope);
+    Simulator sim(Centipede(slope));
+    ASSERT_EQ(sim.leg_count(), 12);
+    ExpectWalksAsCommanded(sim);
+  }
+}
+
+// A held joint is held at its rest value: with a keyframe that bends spine1 by 0.1 rad, the
+// walking robot keeps it there (within 0.03 rad) and the round trip keeps the declaration. A gait
+// that sent nothing to its servo would leave the ctrl at 0 and straighten it.
+TEST(LeggedRobot, AHeldJointIsHeldAtItsRestWhileTheRobotWalks) {
+  const fs::path path = fs::temp_directory_path() / ("dgmm_bent_centipede_" + std::to_string(::getpid()) + ".xml");
+  std::string qpos = "0 0 0.16 1 0 0 0";
+  for (int j = 0; j < 38; ++j) qpos += j == 12 ? " 0.1" : " 0";  // seg0's 12 legs' joints, spine1, ...
+  const SimConfig c = EditedCentipede(path, "", "", "<keyframe><key qpos='" + qpos + "'/></keyframe>");
+  const Ground plane(c);
+  GenericWalker walker(c, LoadRobotModel(c), plane, "bent centipede");
+  fs::remove(path);
+  ASSERT_EQ(walker.robot().held_qpos.size(), 1u);
+  EXPECT_NEAR(walker.robot().held_q[0], 0.1, 1e-12);
+  walker.Start();
+  ASSERT_EQ(walker.Place(0, 0, 0), RunOutcome::kCompleted);
+  const int spine = walker.robot().held_qpos[0];
+  double worst = 0;
+  ASSERT_EQ(walker.Run(Eigen::Vector3d(0.5, 0, 0.3),
+                       [&](int) { worst = std::max(worst, std::abs(walker.data()->qpos[spine] - 0.1)); }),
+            RunOutcome::kCompleted);
+  EXPECT_LT(worst, 0.03);
+  const RobotDescription back = RobotDescriptionFromJson(RobotDescriptionToJson(*c.robot), "round trip");
+  EXPECT_EQ(back.held_joints, std::vector<std::string>{"spine1"});
+}
+
+TEST(LeggedRobot, HeldJointsAreCheckedNamingTheJoint) {
+  auto error = [](const std::string& from, const std::string& to, auto edit) {
+    const fs::path path = fs::temp_directory_path() / ("dgmm_held_" + std::to_string(::getpid()) + ".xml");
+    SimConfig c = EditedCentipede(path, from, to);
+    edit(&*c.robot);
+    std::string message;
+    try {
+      Simulator sim(c);
+    } catch (const std::exception& e) {
+      message = e.what();
+    }
+    fs::remove(path);
+    return message;
+  };
+  auto expect = [](const std::string& message, const std::string& part) {
+    EXPECT_NE(message.find(part), std::string::npos) << "expected \"" << part << "\" in: " << message;
+  };
+  auto none = [](RobotDescription*) {};
+  expect(error("", "", [](RobotDescription* r) { r->held_joints.clear(); }),
+         "robot.legs: joint \"spine1\" belongs to no leg and is declared neither in robot.passive_joints");
+  expect(error("", "", [](RobotDescription* r) { r->held_joints = {"spine1", "s0a_left_knee"}; }),
+         "robot.held_joints: joint \"s0a_left_knee\" is also a leg's joint");
+  expect(error("", "", [](RobotDescription* r) { r->held_joints = {"spine1", "spine2"}; }),
+         "robot.held_joints: joint \"spine2\" is also declared passive");
+  expect(error("", "", [](RobotDescription* r) { r->held_joints = {"spine1", "no_such_joint"}; }),
+         "robot.held_joints: the model has no joint named \"no_such_joint\"");
+  expect(error("<position name=\"spine1\" joint=\"spine1\" kp=\"30\"/>", "<motor joint=\"spine1\"/>", none),
+         "robot.held_joints: joint \"spine1\" is not driven by a position servo");
+  expect(error("<position name=\"spine1\" joint=\"spine1\" kp=\"30\"/>", "", none),
+         "robot.held_joints: joint \"spine1\" is driven by no actuator");
+  // An actuator without a name is told by its index and joint.
+  expect(error("<position name=\"spine1\" joint=\"spine1\" kp=\"30\"/>", "<position joint=\"spine1\" kp=\"30\"/>",
+               [](RobotDescription* r) { r->held_joints.clear(), r->passive_joints.push_back("spine1"); }),
+         "actuator 36 (unnamed, on joint \"spine1\") drives no leg's joint and no held joint");
 }
 
 }  // namespace

@@ -262,7 +262,7 @@ TEST(ProtocolTest, ATorsoThatStartsTiltedIsCountedAndWarnedOf) {
   const SampleSet rough_set =
       SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod_rough_ground.json").string()), o, {}, &rough);
   const SampleSet plane_set = SimulateProtocol(LoadSimConfig((test::kRobots / "hexapod.json").string()), o, {}, &plane);
-  EXPECT_GT(rough.tilted_executions * 20, rough.executions);
+  EXPECT_TRUE(rough.TiltedTooOften()) << rough.tilted_executions << " of " << rough.executions;
   ASSERT_FALSE(rough.warnings.empty());
   EXPECT_NE(rough.warnings.back().find("tilted more than 25 degrees"), std::string::npos) << rough.warnings.back();
   EXPECT_NE(rough.warnings.back().find("robot.gait.level"), std::string::npos) << rough.warnings.back();

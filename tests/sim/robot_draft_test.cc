@@ -58,7 +58,7 @@ std::string ErrorOf(const std::string& xml) {
 
 TEST(RobotDraft, TheProjectsRobotsAreDraftedAsTheirConfigsDescribeThem) {
   for (const char* name : {"hexapod.json", "sprawled_quadruped.json", "planar_quadruped.json",
-                           "mammal_quadruped/mammal_quadruped.json", "scorpion_generic.json"}) {
+                           "mammal_quadruped/mammal_quadruped.json", "scorpion_generic.json", "centipede.json"}) {
     SCOPED_TRACE(name);
     const SimConfig shipped = LoadSimConfig((kRobots / name).string());
     const RobotDescription& want = *shipped.robot;
@@ -78,6 +78,7 @@ TEST(RobotDraft, TheProjectsRobotsAreDraftedAsTheirConfigsDescribeThem) {
       if (!leg.side.empty()) EXPECT_EQ(drafted.side, leg.side);
     }
     EXPECT_EQ(got.passive_joints, want.passive_joints);
+    EXPECT_EQ(got.held_joints, want.held_joints);  // the centipede's driven spine joint
     // Each draft binds as dgmm simulate binds a robot block (with the generic gait: the mammal's
     // shipped config replays its own controller instead, which a draft cannot guess).
     EXPECT_EQ(draft.bind_error, "");
