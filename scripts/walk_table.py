@@ -15,9 +15,16 @@ import h5py
 import numpy as np
 
 
+class Refused(Exception):
+    """dgmm refused a config (e.g. a gait pattern for another number of legs): its one-line error."""
+
+
 def record(dgmm, config, out, seed):
-    subprocess.run([dgmm, "--quiet", "simulate", "--config", config, "--protocol", "paper", "--seed", str(seed),
-                    "-o", out], check=True, stdout=subprocess.DEVNULL)
+    r = subprocess.run([dgmm, "--quiet", "simulate", "--config", config, "--protocol", "paper", "--seed", str(seed),
+                        "-o", out], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    if r.returncode != 0:
+        lines = [l for l in r.stderr.splitlines() if l.strip()]
+        raise Refused(lines[-1] if lines else f"dgmm simulate exited with status {r.returncode}")
 
 
 def load(path):
@@ -67,7 +74,13 @@ def main():
                          "across the slope one way only, so without this a slide downhill shows as cross-talk")
     a = ap.parse_args()
     dgmm = os.path.join(a.build, "app", "dgmm")
-    base = json.load(open(a.config))
+    try:
+        base = json.load(open(a.config))
+        base["robot"]
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        print(f"walk_table.py: error: {a.config}: a simulation config with a robot block expected ({e})",
+              file=sys.stderr)
+        return 2
     here = os.path.dirname(a.config)
     base["mjcf_path"] = os.path.abspath(os.path.join(here, base["mjcf_path"]))
     for rec in base["robot"].get("controller", {}).get("recordings", []):  # a replayed controller's files
@@ -75,6 +88,7 @@ def main():
     tmp = tempfile.mkdtemp()
     print(f"Robot: {a.config}; paper protocol, seed {a.seed}; ratio = measured / commanded, cross = off-axis share\n")
     header = None
+    refused = []  # (slope, pattern, dgmm's error): listed under the table
     for slope in [float(s) for s in a.slopes.split(",")]:
         for pattern in a.patterns.split(","):
             cfg = json.loads(json.dumps(base))
@@ -83,13 +97,17 @@ def main():
             path = os.path.join(tmp, f"{pattern}_{slope:g}.json")
             json.dump(cfg, open(path, "w"))
             out = os.path.join(tmp, f"{pattern}_{slope:g}.h5")
-            record(dgmm, path, out, a.seed)
-            data = load(out)
-            if a.mirrored and slope != 0:  # the same placements with the plane tilted the other way
-                cfg["slope_deg"] = -slope
-                json.dump(cfg, open(path, "w"))
+            try:
                 record(dgmm, path, out, a.seed)
-                data = pooled(data, load(out))
+                data = load(out)
+                if a.mirrored and slope != 0:  # the same placements with the plane tilted the other way
+                    cfg["slope_deg"] = -slope
+                    json.dump(cfg, open(path, "w"))
+                    record(dgmm, path, out, a.seed)
+                    data = pooled(data, load(out))
+            except Refused as e:
+                refused.append((slope, pattern, str(e)))
+                continue
             # The leg reach the simulator derived from the model and the gait as it ran, defaults
             # filled in (set metadata): a config may leave out any gait length.
             meta = h5py.File(out, "r")["metadata"].attrs
@@ -107,7 +125,9 @@ def main():
             cells = " | ".join(f"{rows[k][0]:.2f}" if k in rows else "fell" for k in header)
             where = f"+-{slope:g}" if a.mirrored and slope != 0 else f"{slope:g}"
             print(f"| {where} deg | {pattern} | {cells} | {max(r[1] for r in rows.values()):.2f} |")
-    return 0
+    for slope, pattern, error in refused:
+        print(f"\nrefused: {slope:g} deg, {pattern}: {error}")
+    return 0 if header is not None else 2  # nothing walked: a failure
 
 
 if __name__ == "__main__":

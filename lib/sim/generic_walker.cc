@@ -209,7 +209,8 @@ void GenericWalker::Control(const Eigen::Vector3d& c, double t, double duration)
     plan.q_velocity.push_back((q_[i] - before[i]) / (control_every_ * model_->opt.timestep));
     plan.feet_robot_m.push_back(robot_.robot_in_torso.transpose() * targets[i]);
   }
-  u_.head(static_cast<int>(robot_.leg_actuators.size())) += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
+  const int legs = static_cast<int>(robot_.leg_actuators.size());
+  u_.head(legs) += feedforward_.Offsets(model_.get(), scratch_.get(), robot_, plan);
 }
 
 const std::vector<double>& GenericWalker::Support() {

@@ -303,14 +303,17 @@ RobotDraft DraftRobot(const std::string& mjcf_path, const RobotDraftOptions& opt
   const MjDataPtr d = RestPoseData(m, m->jnt_qposadr[m->body_jntadr[torso]]);
   mj_kinematics(m, d.get());
   double lowest = 0;
-  for (const auto& b : BranchesBelow(m, d.get(), torso, floor)) lowest = b.foot_geom >= 0 ? std::min(lowest, b.low_z) : lowest;
+  for (const auto& b : BranchesBelow(m, d.get(), torso, floor)) {
+    if (b.foot_geom >= 0) lowest = std::min(lowest, b.low_z);
+  }
   if (!(lowest < 0)) throw MakeInputError(mjcf_path, "worldbody", "no jointed branch below the torso reaches the ground");
   Branches branches;
-  CollectBranches(m, d.get(), torso, floor, RobotFrame(options.forward_axis), (1 - options.foot_band) * lowest, &branches);
+  const double foot_z = (1 - options.foot_band) * lowest;
+  CollectBranches(m, d.get(), torso, floor, RobotFrame(options.forward_axis), foot_z, &branches);
   for (int body : branches.segments) SegmentJoints(m, body, &r, &draft.notes);
   std::vector<Branch> legs;
   for (const auto& b : branches.legs_or_not) {
-    if (b.foot_geom < 0 || b.low_z > (1 - options.foot_band) * lowest) {
+    if (b.foot_geom < 0 || b.low_z > foot_z) {
       NotALeg(m, b, &r.passive_joints, &draft.notes);
       continue;
     }
