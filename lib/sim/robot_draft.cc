@@ -185,17 +185,21 @@ std::optional<LegDescription> DescribeLeg(const mjModel* m, const Branch& branch
   return leg;
 }
 
-// A branch that is not a leg: its named joints are passive (a note says so).
-void NotALeg(const mjModel* m, const Branch& branch, std::vector<std::string>* passive,
-             std::vector<std::string>* notes) {
+// A branch that is not a leg (a tail, a head): its named joints are held when driven, passive
+// when not (a note says so).
+void NotALeg(const mjModel* m, const Branch& branch, RobotDescription* r, std::vector<std::string>* notes) {
   const std::string root = Name(m, mjOBJ_BODY, branch.root);
-  notes->push_back("branch at body \"" + (root.empty() ? std::to_string(branch.root) : root) +
-                   "\" does not reach the ground at rest: not a leg, its joints passive");
+  bool held = false;
   for (int j = 0; j < m->njnt; ++j) {
-    if (IsDescendant(m, m->jnt_bodyid[j], branch.root) && !Name(m, mjOBJ_JOINT, j).empty()) {
-      passive->push_back(Name(m, mjOBJ_JOINT, j));
-    }
+    const std::string name = Name(m, mjOBJ_JOINT, j);
+    if (!IsDescendant(m, m->jnt_bodyid[j], branch.root) || name.empty()) continue;
+    const bool driven = ActuatorOf(m, j) >= 0;
+    (driven ? r->held_joints : r->passive_joints).push_back(name);
+    held = held || driven;
   }
+  notes->push_back("branch at body \"" + (root.empty() ? std::to_string(branch.root) : root) +
+                   "\" does not reach the ground at rest: not a leg, its joints " +
+                   (held ? "held at rest where driven, passive where not" : "passive"));
 }
 
 // Joints of a branch off its foot chain: undriven ones are passive; driven ones are noted.
@@ -314,7 +318,7 @@ RobotDraft DraftRobot(const std::string& mjcf_path, const RobotDraftOptions& opt
   std::vector<Branch> legs;
   for (const auto& b : branches.legs_or_not) {
     if (b.foot_geom < 0 || b.low_z > foot_z) {
-      NotALeg(m, b, &r.passive_joints, &draft.notes);
+      NotALeg(m, b, &r, &draft.notes);
       continue;
     }
     const std::optional<LegDescription> leg = DescribeLeg(m, b, &r.passive_joints, &draft.notes);

@@ -4,8 +4,8 @@
 // joint, the floor the plane on the world body, and a leg each jointed branch below the torso whose
 // lowest geom that can touch the floor stands near the lowest of them all (a tail or a head above
 // the feet is not a leg; a branch whose own branches stand on both sides of the forward axis is a
-// body segment behind a spine joint, its legs drafted below it and its joints held when driven,
-// passive when not). A leg's joints are its driven hinges and slides from the torso (or its
+// body segment behind a spine joint, its legs drafted below it; the joints of either are held
+// when driven, passive when not). A leg's joints are its driven hinges and slides from the torso (or its
 // segment) to that geom, torso first; undriven ones are passive; its foot is that geom; its name the common prefix of
 // its joints' names ("FR" of FR_hip_joint, FR_thigh_joint, FR_calf_joint), else its first body's.
 // The draft is then bound as `dgmm simulate` binds a robot block, so what it lacks is said at once.

@@ -102,6 +102,26 @@ TEST(RobotDraft, ABranchAboveTheFeetIsNotALegAndItsJointsArePassive) {
   EXPECT_NE(draft.notes[0].find("\"tail\" does not reach the ground"), std::string::npos) << draft.notes[0];
 }
 
+TEST(RobotDraft, ADrivenTailIsHeldAtRest) {
+  // The same tail wagged by a position servo: its joint is held (until 2026-12-07 it was listed as
+  // passive and the draft did not bind: the tail's servo drove no leg's joint).
+  const std::string tail =
+      "<freejoint name=\"root\"/><body name=\"tail\" pos=\"-0.16 0 0.02\"><joint name=\"tail_wag\" type=\"hinge\" "
+      "axis=\"0 0 1\" range=\"-30 30\"/><geom type=\"capsule\" fromto=\"0 0 0 -0.1 0 0.03\" size=\"0.01\" "
+      "mass=\"0.02\"/></body>";
+  std::string xml = EditedHexapod("<freejoint name=\"root\"/>", tail);
+  ASSERT_NE(xml, "");
+  xml.insert(xml.find("</actuator>"), "<position name=\"tail_wag\" joint=\"tail_wag\" kp=\"5\"/>");
+  TempModel model(xml);
+  const RobotDraft draft = DraftRobot(model.path());
+  EXPECT_EQ(draft.robot.legs.size(), 6u);
+  EXPECT_EQ(draft.robot.held_joints, std::vector<std::string>{"tail_wag"});
+  EXPECT_TRUE(draft.robot.passive_joints.empty());
+  EXPECT_EQ(draft.bind_error, "");
+  ASSERT_FALSE(draft.notes.empty());
+  EXPECT_NE(draft.notes[0].find("held at rest where driven"), std::string::npos) << draft.notes[0];
+}
+
 TEST(RobotDraft, AnUnnamedFootIsItsBodyWithTheGeomsOffset) {
   const std::string xml = EditedHexapod("name=\"front_left_foot\" ", "");
   ASSERT_NE(xml, "");
