@@ -143,9 +143,10 @@ std::string ActuatorLabel(const mjModel* m, int a) {
 }
 
 // robot.held_joints: hinges or slides of no leg, each driven by a position servo (with the gait),
-// held at its rest value, which lies within what the joint and its servo allow.
-void BindHeld(const mjModel* m, const RobotDescription& r, const std::set<int>& leg_joints, const std::string& source,
-              LeggedRobot* bound) {
+// held at its rest value, which lies within what the joint and its servo allow. Returns their ids.
+std::vector<int> BindHeld(const mjModel* m, const RobotDescription& r, const std::set<int>& leg_joints,
+                          const std::string& source, LeggedRobot* bound) {
+  std::vector<int> ids;
   const MjDataPtr rest = RestPoseData(m, bound->torso_qpos);
   bound->held_q.resize(static_cast<int>(r.held_joints.size()));
   for (std::size_t i = 0; i < r.held_joints.size(); ++i) {
@@ -172,7 +173,9 @@ void BindHeld(const mjModel* m, const RobotDescription& r, const std::set<int>& 
     bound->held_qpos.push_back(m->jnt_qposadr[j]);
     bound->held_actuators.push_back(a);
     bound->held_q[static_cast<int>(i)] = q;
+    ids.push_back(j);
   }
+  return ids;
 }
 
 // Every joint is a leg's, passive, held or the torso's free joint; every actuator drives a leg
@@ -188,8 +191,7 @@ void CheckEverythingAccounted(const mjModel* m, const RobotDescription& r, Legge
     }
     accounted.insert(j);
   }
-  BindHeld(m, r, leg_joints, source, bound);
-  for (const auto& name : r.held_joints) accounted.insert(mj_name2id(m, mjOBJ_JOINT, name.c_str()));
+  for (int j : BindHeld(m, r, leg_joints, source, bound)) accounted.insert(j);
   driven.insert(bound->held_actuators.begin(), bound->held_actuators.end());
   accounted.insert(leg_joints.begin(), leg_joints.end());
   for (int j = 0; j < m->njnt; ++j) {

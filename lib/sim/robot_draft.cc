@@ -111,6 +111,13 @@ void CollectBranches(const mjModel* m, const mjData* d, int parent, int floor, c
   }
 }
 
+// A joint of no leg listed as held when driven, passive when not; true when driven.
+bool ListHeldOrPassive(const mjModel* m, int j, const std::string& name, RobotDescription* r) {
+  const bool driven = ActuatorOf(m, j) >= 0;
+  (driven ? r->held_joints : r->passive_joints).push_back(name);
+  return driven;
+}
+
 // A body segment's own joints: held when driven, passive when not (a note says which).
 void SegmentJoints(const mjModel* m, int body, RobotDescription* r, std::vector<std::string>* notes) {
   std::string held, passive;
@@ -121,9 +128,8 @@ void SegmentJoints(const mjModel* m, int body, RobotDescription* r, std::vector<
                        " has no name: name it to list it");
       continue;
     }
-    const bool driven = ActuatorOf(m, j) >= 0;
-    (driven ? r->held_joints : r->passive_joints).push_back(name);
-    (driven ? held : passive) += (driven ? held : passive).empty() ? name : ", " + name;
+    std::string& list = ListHeldOrPassive(m, j, name, r) ? held : passive;
+    list += list.empty() ? name : ", " + name;
   }
   notes->push_back("body \"" + Name(m, mjOBJ_BODY, body) + "\" carries legs on both sides: a body segment, its legs "
                    "drafted below it" + (held.empty() ? "" : "; held at rest (driven): " + held) +
@@ -193,9 +199,7 @@ void NotALeg(const mjModel* m, const Branch& branch, RobotDescription* r, std::v
   for (int j = 0; j < m->njnt; ++j) {
     const std::string name = Name(m, mjOBJ_JOINT, j);
     if (!IsDescendant(m, m->jnt_bodyid[j], branch.root) || name.empty()) continue;
-    const bool driven = ActuatorOf(m, j) >= 0;
-    (driven ? r->held_joints : r->passive_joints).push_back(name);
-    held = held || driven;
+    held = ListHeldOrPassive(m, j, name, r) || held;
   }
   notes->push_back("branch at body \"" + (root.empty() ? std::to_string(branch.root) : root) +
                    "\" does not reach the ground at rest: not a leg, its joints " +
