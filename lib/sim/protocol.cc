@@ -14,6 +14,7 @@
 #include "sim/pose.h"
 #include "sim/replay.h"
 #include "sim/simulator.h"
+#include "sim/walk_check.h"
 #include "util/error.h"
 #include "util/parallel_for.h"
 
@@ -452,6 +453,8 @@ void FinishRecording(const SimConfig& config, const ProtocolOptions& options, in
                          [](const auto& a, const auto& b) { return a.second < b.second; });
     sum->warnings.push_back(SelfContactWarning(*sum, run.self_contact_pair, set->command_labels.at(worst->first)));
   }
+  const std::string walk = WalkWarning(WalkRatios(*set, CommandedWalkOf(config, run.leg_reach_m)));
+  if (!walk.empty()) sum->warnings.push_back(walk);
   if (sum->TiltedTooOften()) sum->warnings.push_back(TiltedWarning(*sum, config));
   sum->placements = placements;
   sum->simulated_seconds = run.simulated_seconds;
