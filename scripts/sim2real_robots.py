@@ -215,7 +215,10 @@ def main():
         ap.error(f"--kinds: unknown {', '.join(unknown)}; expected some of {', '.join(KINDS)}")
     global MODEL_MAX_FRICTION
     MODEL_MAX_FRICTION = a.model_friction
-    lo, hi = (int(v) for v in a.seeds.split("-"))
+    try:  # "65110-65115" or one seed "65113"
+        lo, hi = (int(v) for v in (a.seeds.split("-") if "-" in a.seeds else (a.seeds, a.seeds)))
+    except ValueError:
+        ap.error(f"--seeds: expected a seed or a range FIRST-LAST, got {a.seeds!r}")
     out = a.out or tempfile.mkdtemp()
     base = a.base = with_absolute_paths(json.load(open(a.config)), a.config)
     print(f"Robot {a.config}, seeds {lo}-{hi}, sim2real with --threads {a.threads}\n")

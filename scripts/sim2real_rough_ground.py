@@ -139,7 +139,10 @@ def main():
     ap.add_argument("--out", default=None)
     a = ap.parse_args()
     ROBOTS.MODEL_MAX_FRICTION = a.model_friction
-    lo, hi = (int(v) for v in a.seeds.split("-"))
+    try:  # "65110-65115" or one seed "65113"
+        lo, hi = (int(v) for v in (a.seeds.split("-") if "-" in a.seeds else (a.seeds, a.seeds)))
+    except ValueError:
+        ap.error(f"--seeds: expected a seed or a range FIRST-LAST, got {a.seeds!r}")
     kinds = a.kinds.split(",")
     if not kinds or any(k not in KINDS for k in kinds):
         ap.error(f"--kinds: expected a comma list among {','.join(KINDS)}, got {a.kinds!r}")

@@ -17,7 +17,7 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v9";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v10";
 // v6: a recording runs in chunks of this many placements, each with its own random stream, so
 // one recording can use several threads (sim::ProtocolOptions::chunk_placements). v7: a servo
 // gets the ctrl that holds its joint at the target (through its gear) and the gait keeps within
@@ -33,6 +33,9 @@ constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v9";
 // products of inertia included; before, its parallel-axis terms were added per axis of the body's
 // frame to the moments of the principal frame (such recordings changed; the hexapod's, planar
 // quadruped's and octopod's not).
+// v10: the generic gait solves its targets at least 60 times a cycle (generic_walker.h,
+// ControlEvery; before, at 100 Hz whatever the cycle): recordings of gaits whose cycle is under
+// 0.6 s changed (the scorpion's robot block), others not.
 constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {

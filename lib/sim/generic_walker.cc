@@ -12,6 +12,11 @@
 
 namespace dgmm::sim {
 
+int ControlEvery(double period_s, double timestep_s) {
+  const double control_s = std::min(kControlPeriodS, period_s / kControlsPerCycle);
+  return std::max(1, static_cast<int>(std::lround(control_s / timestep_s)));
+}
+
 GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Ground& ground, const std::string& source)
     : config_(config), model_(std::move(model)), ground_(&ground), source_(source) {
   robot_ = BindRobot(model_.get(), *config.robot, source);
@@ -23,8 +28,7 @@ GenericWalker::GenericWalker(const SimConfig& config, MjModelPtr model, const Gr
     feedforward_ = ServoFeedforward(model_.get(), robot_, config.robot->gait.period_s);  // nominal: before the experiment
   }
   ApplyExperiment(config, robot_, model_.get(), source);
-  const double kControlPeriodS = 0.01;  // inverse kinematics at 100 Hz, not every physics step
-  control_every_ = std::max(1, static_cast<int>(std::lround(kControlPeriodS / config.timestep_s)));
+  control_every_ = ControlEvery(config.robot->gait.period_s, config.timestep_s);
 }
 
 void GenericWalker::Start() {

@@ -34,12 +34,14 @@ void AddLegKnobs(const SimConfig& config, const LeggedRobot& bound, std::vector<
   }
 }
 
-// Latency of every actuator signal (probe: 7% of the gait cycle), and backlash of the joint
-// servos when the robot has any (a torque replay has none).
+// Latency of every actuator signal (probe: 7% of the gait cycle; range up to a third of the cycle,
+// 0.2 s at the least), and backlash of the joint servos when the robot has any (a torque replay
+// has none).
 void AddActuationKnobs(const SimConfig& config, const mjModel* m, std::vector<Knob>* knobs) {
   const double lat = config.actuators.latency_s;
-  const double probe = std::min(0.2, lat + 0.07 * config.robot->gait.period_s);
-  knobs->push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, 0.2, {probe}));
+  const double hi = std::max(0.2, config.robot->gait.period_s / 3);
+  const double probe = std::min(hi, lat + 0.07 * config.robot->gait.period_s);
+  knobs->push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, hi, {probe}));
   bool servos = false;
   for (int a = 0; a < m->nu; ++a) {
     servos |= m->actuator_trntype[a] == mjTRN_JOINT && IsPositionServo(m, a);

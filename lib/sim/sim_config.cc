@@ -1,6 +1,7 @@
 // JSON (nlohmann) loading and saving of SimConfig; strict: unknown keys and wrong types are errors.
 #include "sim/sim_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,13 @@ namespace dgmm::sim {
 namespace {
 
 using nlohmann::json;
+
+// A number in its shortest form ("0.2", "0.4").
+std::string Shortest(double v) {
+  std::ostringstream s;
+  s << v;
+  return s.str();
+}
 
 bool Check(bool ok, const std::string& message, std::string* error) {
   if (!ok && error) *error = message;
@@ -34,6 +42,11 @@ bool CheckPayload(const PayloadConfig& p, bool robot_block, std::string* error) 
 }
 
 }  // namespace
+
+double MaxLatencyS(const SimConfig& config) {
+  const double period = config.robot ? config.robot->gait.period_s : config.gait.period_s;
+  return std::isfinite(period) ? std::max(0.2, period / 3) : 0.2;
+}
 
 bool SimConfig::IsValid(std::string* error) const {
   const auto& f = friction;
@@ -57,8 +70,10 @@ bool SimConfig::IsValid(std::string* error) const {
                  a.torque_limit_nm > 0 && Finite(a.joint_damping_nms_per_rad) &&
                  a.joint_damping_nms_per_rad >= 0,
              "actuators: expected positive kp and torque limit, non-negative damping", error) ||
-      !Check(Finite(a.latency_s) && a.latency_s >= 0 && a.latency_s <= 0.2,
-             "actuators.latency_s: expected a value in [0, 0.2] s", error) ||
+      !Check(Finite(a.latency_s) && a.latency_s >= 0 && a.latency_s <= MaxLatencyS(*this),
+             "actuators.latency_s: expected a value in [0, " + Shortest(MaxLatencyS(*this)) +
+                 "] s (a third of the gait's cycle, 0.2 s at the least)",
+             error) ||
       !Check(Finite(a.backlash_rad) && a.backlash_rad >= 0 && a.backlash_rad <= 0.2,
              "actuators.backlash_rad: expected a value in [0, 0.2] rad", error))
     return false;

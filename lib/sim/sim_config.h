@@ -45,7 +45,7 @@ struct ActuatorConfig {
   std::array<double, kNumLegs> leg_gain{1, 1, 1, 1, 1, 1, 1, 1};  // kp scale per leg
   double joint_damping_nms_per_rad = 0.5;
   double torque_limit_nm = 12.0;
-  double latency_s = 0.0;  // delay between a target's computation and the servo seeing it, [0, 0.2]
+  double latency_s = 0.0;  // delay between a target's computation and the servo seeing it, [0, MaxLatencyS]
   double backlash_rad = 0.0;  // total free play of each leg joint's gear train, [0, 0.2]
 };
 
@@ -110,6 +110,10 @@ struct SimConfig {
 
 // Parses a JSON object; unknown keys are errors (typos must not silently fall back to defaults).
 // Throws InputError "<source_name>: <field>: <problem>" for bad JSON, types or values.
+// The longest actuator latency a config may give: a third of its gait's cycle, 0.2 s at the least
+// (a robot four times the hexapod's size walks a 1.2 s cycle).
+double MaxLatencyS(const SimConfig& config);
+
 SimConfig SimConfigFromJson(const std::string& json_text, const std::string& source_name);
 // Reads a JSON config file; a relative mjcf_path or replay recording is made absolute against the
 // config file's folder (so a set's recorded config finds them from any working directory).

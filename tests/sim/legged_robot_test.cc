@@ -447,6 +447,18 @@ TEST(LeggedRobot, APayloadIsBoundedByTheRobotsMassAndReach) {
   EXPECT_FALSE(big.IsValid(&error));
 }
 
+// The gait's targets are solved at least 60 times a cycle and at 100 Hz at the least: the hexapod
+// (0.6 s, 2 ms steps) and the slower robots every 5 steps as before; a 0.5 s cycle every 4; a
+// robot a quarter of the hexapod's size (0.3 s cycle, 1 ms steps) every 5 steps, as the hexapod's
+// 60 a cycle, not 10; a step longer than that, every step.
+TEST(LeggedRobot, TheGaitIsSolvedOftenEnoughForItsCycle) {
+  for (double period : {0.6, 0.8}) EXPECT_EQ(ControlEvery(period, 0.002), 5) << period;
+  EXPECT_EQ(ControlEvery(0.5, 0.002), 4);
+  EXPECT_EQ(ControlEvery(1.2, 0.004), 3);   // four times the hexapod's size: its 100 Hz
+  EXPECT_EQ(ControlEvery(0.3, 0.001), 5);
+  EXPECT_EQ(ControlEvery(0.05, 0.002), 1);
+}
+
 // Placements span 2.5 leg reaches of a robot block's robot (1 m for the built-in one) unless the
 // config gives a width; on terrain, a width that leaves under 2 reaches to the edge is warned about.
 TEST(LeggedRobot, PlacementsSpanTheRobotsReach) {

@@ -78,6 +78,23 @@ TEST(SimConfigTest, RejectsBadInputNamingTheField) {
   }
 }
 
+// An actuator's latency may be up to a third of the gait's cycle, 0.2 s at the least: a robot
+// whose cycle is 1.2 s (four times the hexapod's size) may lag 0.4 s, the built-in robot 0.2 s.
+TEST(SimConfigTest, TheLongestLatencyFollowsTheGaitsCycle) {
+  SimConfig builtin;
+  EXPECT_DOUBLE_EQ(MaxLatencyS(builtin), 0.2);
+  SimConfig slow;
+  slow.robot = RobotDescription{};
+  slow.robot->gait.period_s = 1.2;
+  EXPECT_NEAR(MaxLatencyS(slow), 0.4, 1e-12);
+  std::string error;
+  slow.actuators.latency_s = 0.3;
+  EXPECT_TRUE(slow.IsValid(&error) || error.find("latency") == std::string::npos) << error;
+  slow.actuators.latency_s = 0.45;
+  EXPECT_FALSE(slow.IsValid(&error));
+  EXPECT_NE(error.find("actuators.latency_s: expected a value in [0, 0.4] s"), std::string::npos) << error;
+}
+
 TEST(SimConfigTest, SaveAndLoadResolvesRelativeMjcf) {
   const auto dir = std::filesystem::temp_directory_path() / "dgmm_sim_config_test";
   std::filesystem::create_directories(dir);
