@@ -8,10 +8,11 @@
 
 #include "sim/actuation_line.h"
 #include "sim/gait_reach.h"
-#include "sim/stance_load.h"
 #include "sim/generic_walker.h"
 #include "sim/ground.h"
 #include "sim/mujoco_model.h"
+#include "sim/stance_load.h"
+#include "sim/walk_check.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -231,6 +232,8 @@ std::vector<std::string> Simulator::RobotWarnings() const {
     const LeggedRobot& robot = impl_->walker->robot();
     out = GaitReachWarnings(MeasureGaitMisses(impl_->walker->model(), robot, c.robot->gait.turn_rad), robot);
   }
+  const std::string tracker = TrackerNoiseWarning(c.noise.tracker_position_sd_m, CommandedWalkOf(c, leg_reach_m()));
+  if (!tracker.empty()) out.push_back(tracker);
   if (impl_->walker) {
     const LeggedRobot& robot = impl_->walker->robot();
     const mjModel* m = impl_->walker->model();

@@ -59,6 +59,16 @@ TEST(WalkCheck, NothingIsJudgedWithoutTheGaitsCommand) {
   EXPECT_TRUE(WalkRatios(other, kWant).empty());
 }
 
+// 3 mm of tracker noise is 3% of the 0.1 m a half command moves this robot: no warning; on a robot
+// that moves 0.04 m, 7.5%: named with both lengths. Nothing is commanded by a replay.
+TEST(WalkCheck, ATrackerCoarseForTheRobotsStepsIsWarnedOf) {
+  EXPECT_EQ(TrackerNoiseWarning(0.003, kWant), "");
+  const std::string w = TrackerNoiseWarning(0.003, CommandedWalk{0.04, 0.4, 2});
+  EXPECT_NE(w.find("noise.tracker_position_sd_m: 0.003 m is 7.5% of the 0.04 m a half command moves the robot"),
+            std::string::npos) << w;
+  EXPECT_EQ(TrackerNoiseWarning(0.003, CommandedWalk{}), "");
+}
+
 // The hexapod walks in its tripod and its recording says nothing of it; in a wave of a 0.2 s cycle
 // (a swing of 33 ms) it does not (forward 0.08 of the command, turns the wrong way), and the set
 // keeps the warning for the analyses that read it.
