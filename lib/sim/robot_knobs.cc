@@ -8,6 +8,7 @@
 
 #include "sim/knobs.h"
 #include "sim/legged_robot.h"
+#include "sim/sim_config.h"
 #include "util/error.h"
 
 namespace dgmm::sim {
@@ -39,7 +40,7 @@ void AddLegKnobs(const SimConfig& config, const LeggedRobot& bound, std::vector<
 // has none).
 void AddActuationKnobs(const SimConfig& config, const mjModel* m, std::vector<Knob>* knobs) {
   const double lat = config.actuators.latency_s;
-  const double hi = std::max(0.2, config.robot->gait.period_s / 3);
+  const double hi = MaxLatencyS(config);
   const double probe = std::min(hi, lat + 0.07 * config.robot->gait.period_s);
   knobs->push_back(MakeKnob(KnobKind::kLatency, -1, "actuators.latency_s", "latency", "s", lat, 0.0, hi, {probe}));
   bool servos = false;

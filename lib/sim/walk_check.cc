@@ -42,7 +42,6 @@ CommandedWalk CommandedWalkOf(const SimConfig& config, double leg_reach_m) {
 }
 
 std::vector<WalkRatio> WalkRatios(const SampleSet& set, const CommandedWalk& want) {
-  static const char* kNames[] = {"long", "lat", "turn"};
   std::vector<WalkRatio> out;
   const bool named = set.command_dim_names == std::vector<std::string>{"long", "lat", "turn"};
   if (!named || set.x.cols() < 6 || !(want.cycles > 0)) return out;
@@ -57,7 +56,8 @@ std::vector<WalkRatio> WalkRatios(const SampleSet& set, const CommandedWalk& wan
     }
     const double commanded = set.commands(c, k) * (k < 2 ? want.stride_m : want.turn_rad) * want.cycles;
     if (n == 0 || commanded == 0) continue;
-    out.push_back({std::string(kNames[k]) + " " + Signed(set.commands(c, k)), sum / n / commanded, commanded});
+    out.push_back({set.command_dim_names[k] + " " + Signed(set.commands(c, k)), sum / n / commanded, commanded,
+                   k < 2 ? "m" : "rad"});
   }
   return out;
 }
@@ -76,7 +76,7 @@ std::string WalkWarning(const std::vector<WalkRatio>& ratios, const WalkBand& ba
   const size_t shown = std::min<size_t>(off.size(), 3);
   for (size_t i = 0; i < shown; ++i) {
     w << (i ? ", " : "") << off[i].command << " moved it " << Number(off[i].ratio) << " of the commanded "
-      << Number(std::abs(off[i].commanded)) << (off[i].command[0] == 't' ? " rad" : " m");
+      << Number(std::abs(off[i].commanded)) << " " << off[i].unit;
   }
   if (off.size() > shown) w << " (and " << off.size() - shown << " more)";
   w << " per execution (the mean of a pure command's executions against stride or turn x cycles; outside "

@@ -27,7 +27,8 @@ CommandedWalk CommandedWalkOf(const SimConfig& config, double leg_reach_m);
 struct WalkRatio {
   std::string command;  // "long +0.5", "lat -0.5", "turn +0.5"
   double ratio = 0;     // measured / commanded (1: as commanded)
-  double commanded = 0; // per execution (m or rad)
+  double commanded = 0; // per execution, in `unit`
+  std::string unit;     // "m" (long, lat) or "rad" (turn)
 };
 
 // The ratio of every pure command with samples, in the set's command order (none when the set's
