@@ -43,6 +43,11 @@ KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const
     check.doubts.push_back(c.knob + " pinned at its " + (check.pinned_low ? "lower" : "upper") + " limit " +
                            Value(check.pinned_low ? lo : hi, c.unit));
   }
+  for (const auto& f : r.refined) {
+    if (f.candidate != k || f.rugged.empty()) continue;
+    check.rugged = true;
+    check.doubts.push_back(c.knob + ": " + f.rugged);
+  }
   if (check.unconverged) {
     for (const auto& f : r.refined) {
       if (f.candidate == k && !f.converged) {

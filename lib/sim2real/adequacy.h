@@ -10,8 +10,8 @@
 //     `shortfall_z` SE (the larger of the real SE and the null's spread) and `min_shortfall_nats`
 //     is a doubt;
 //   - each selected knob: its value (the fit's own reading) inside the knob's range, not pinned at
-//     a limit, physically possible (>= physical_min; a gain or friction at 0 is not), and its
-//     refinement converged;
+//     a limit, physically possible (>= physical_min; a gain or friction at 0 is not), its
+//     refinement converged, and its likelihood search rose to one peak (refine.h);
 //   - the residual: structure within placements or in the tails (residual_structure.h), and
 //     whether each effect is constant over the session and the execution index (drift.h).
 #include <string>
@@ -41,6 +41,7 @@ struct KnobCheck {
   double value = 0;         // clamped to the knob's range
   bool outside_range = false, pinned_low = false, pinned_high = false, impossible = false;
   bool unconverged = false;
+  bool rugged = false;      // its likelihood search does not rise to one peak (KnobRefinement::rugged)
   std::vector<std::string> doubts;  // in words, naming the knob
 };
 

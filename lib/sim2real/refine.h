@@ -65,6 +65,11 @@ struct KnobRefinement {
   bool recorded = false;    // the best signature is a new recording (not the probe's)
   std::string why;          // why it did not converge, in words (empty: the coefficient's distance from 1)
   SearchSpan as_well;       // the search's points that fit as well as its best (no search: empty)
+  // Empty when the search's scores rise to one peak; else, in words, the point that fits worse than
+  // a point on either side of it in value by more than as_well_z SEs: recordings at nearby values
+  // then differ by chance (a chaotic walk) more than by the value, or two values fit, and the
+  // value's interval (the real samples' resampling) does not hold that.
+  std::string rugged;
 };
 
 struct Refinement {

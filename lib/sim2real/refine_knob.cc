@@ -131,6 +131,24 @@ SearchSpan AsWell(const KnobSearch& s, const std::vector<KnobPoint>& pts, const 
   return FitAsWellSpan(rows, static_cast<int>(&best - pts.data()), values, {}, s.in.real.episode, s.options.as_well_z);
 }
 
+// Empty, or why the search's scores do not rise to one peak (DeepestDip), in words.
+std::string Rugged(const KnobSearch& s, const std::vector<KnobPoint>& pts) {
+  std::vector<Eigen::VectorXd> rows;
+  std::vector<double> values;
+  for (const auto& p : pts) rows.push_back(p.rows), values.push_back(p.value);
+  const ScoreDip dip = DeepestDip(rows, values, s.in.real.episode, s.options.as_well_z);
+  if (!dip.Found()) return "";
+  const double n = static_cast<double>(s.in.real.size());
+  auto z = [](const PairedSum& d) { return d.se > 0 ? d.sum / d.se : INFINITY; };
+  return Fmt("its likelihood search does not rise to one peak: the recording at %.4g fits worse than those at ",
+             values[dip.at]) +
+         Fmt("%.4g and %.4g on either side of it ", values[dip.left], values[dip.right]) +
+         Fmt("(by %.2f and %.2f nats per real sample, ", dip.below.sum / n, dip.above.sum / n) +
+         Fmt("z %.1f and %.1f), so recordings at nearby values differ by more than their values explain (a chaotic "
+             "walk, or two values that fit), and the value may lie outside its interval",
+             z(dip.below), z(dip.above));
+}
+
 // Every candidate of the knob takes the best recording as its signature; the selection reruns.
 void Adopt(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoint& best, bool bracketed) {
   for (int j : s.same) {
@@ -149,6 +167,7 @@ void Adopt(const KnobSearch& s, const std::vector<KnobPoint>& pts, const KnobPoi
   }
   if (!bracketed) kr.why = "the likelihood search's best value lies at the edge of the values searched";
   kr.as_well = AsWell(s, pts, best);
+  kr.rugged = Rugged(s, pts);
   s.r->refined.push_back(kr);
 }
 

@@ -78,4 +78,31 @@ SearchSpan FitAsWellSpan(const std::vector<Eigen::VectorXd>& rows, int best, con
   return span;
 }
 
+ScoreDip DeepestDip(const std::vector<Eigen::VectorXd>& rows, const std::vector<double>& values,
+                    const std::vector<int>& placement, double z) {
+  const UnitIds units = NumberUnits(placement);
+  std::vector<int> order(rows.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return values[a] < values[b]; });
+  std::vector<double> score(rows.size());
+  for (size_t i = 0; i < rows.size(); ++i) score[i] = rows[i].sum();
+  auto by_score = [&](int a, int b) { return score[a] < score[b]; };
+  auto best_of = [&](auto first, auto last) { return *std::max_element(first, last, by_score); };
+  ScoreDip out;
+  double depth = 0;
+  for (size_t i = 1; i + 1 < order.size(); ++i) {
+    const int at = order[i], left = best_of(order.begin(), order.begin() + i);
+    const int right = best_of(order.begin() + i + 1, order.end());
+    if (FitsAsWellAs(rows[left], rows[at], units, z, true) || FitsAsWellAs(rows[right], rows[at], units, z, true)) {
+      continue;
+    }
+    const PairedSum below = PairedDifference(rows[left], rows[at], units);
+    const PairedSum above = PairedDifference(rows[right], rows[at], units);
+    if (std::min(below.sum, above.sum) <= depth) continue;
+    out = {at, left, right, below, above};
+    depth = std::min(below.sum, above.sum);
+  }
+  return out;
+}
+
 }  // namespace dgmm::sim2real

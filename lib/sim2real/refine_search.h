@@ -61,4 +61,17 @@ std::vector<bool> FitAsWellAsTheBest(const std::vector<Eigen::VectorXd>& rows, i
 SearchSpan FitAsWellSpan(const std::vector<Eigen::VectorXd>& rows, int best, const std::vector<double>& values,
                          const std::vector<double>& x, const std::vector<int>& placement, double z);
 
+// The deepest dip in a search's scores: the point `at` that fits worse than the best point below it
+// (`left`) and the best point above it (`right`) in value, each deficit D above z times its
+// standard error (PairedDifference), the smaller of the two deficits the dip's depth. at = -1: the
+// scores rise to one peak within their errors. A likelihood in a knob's value may have two peaks;
+// recordings of a chaotic walk also give dips, each value's recording off by its own chance.
+struct ScoreDip {
+  int at = -1, left = -1, right = -1;
+  PairedSum below, above;  // at's deficits against left and right
+  bool Found() const { return at >= 0; }
+};
+ScoreDip DeepestDip(const std::vector<Eigen::VectorXd>& rows, const std::vector<double>& values,
+                    const std::vector<int>& placement, double z);
+
 }  // namespace dgmm::sim2real

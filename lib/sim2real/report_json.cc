@@ -84,7 +84,7 @@ json KnobsJson(const Analysis& a) {
   json refined = json::array();
   for (const auto& f : r.refined) {
     refined.push_back({{"knob", f.knob}, {"value", f.value}, {"coefficient", JsonNumber(f.coefficient)}, {"converged", f.converged},
-                       {"fits_as_well", SearchSpanJson(f.as_well)}});
+                       {"fits_as_well", SearchSpanJson(f.as_well)}, {"single_peaked", f.rugged.empty()}});
   }
   json removed = json::array();
   for (int k : r.selection.removed) removed.push_back(set.candidates[k].key);
@@ -135,7 +135,7 @@ json AdequacyJson(const Analysis& a) {
     checks.push_back({{"key", a.candidates.candidates[c.candidate].key}, {"fitted_value", JsonNumber(c.fitted)},
                       {"value", JsonNumber(c.value)}, {"outside_range", c.outside_range}, {"pinned_low", c.pinned_low},
                       {"pinned_high", c.pinned_high}, {"impossible", c.impossible}, {"unconverged", c.unconverged},
-                      {"doubts", c.doubts}});
+                      {"not_single_peaked", c.rugged}, {"doubts", c.doubts}});
   }
   return {{"regions_after", Regions(q.after.regions)}, {"conditional_flagged_regions_after", q.after.conditional_flagged},
           {"heat_map_after", HeatMap(a, q.after.heat)},

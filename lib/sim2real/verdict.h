@@ -55,7 +55,8 @@ struct VerdictNamed {
   double inclusion = -1;  // of the family, in [0, 1]; < 0: not computed (--bootstrap 0), written as null
   double candidate_inclusion = -1;       // of this candidate alone
   int tie_group = -1;     // index into ties, -1: null
-  std::vector<std::string> flags;        // "pinned_low", "pinned_high", "outside_range", "impossible", "unconverged"
+  // "pinned_low", "pinned_high", "outside_range", "impossible", "unconverged", "not_single_peaked"
+  std::vector<std::string> flags;
   std::vector<std::string> doubts;       // in words
 };
 

@@ -51,7 +51,8 @@ VerdictNamed Named(const CandidateSet& set, const Refinement& r, const Confidenc
   }
   const std::pair<bool, const char*> flags[] = {{check.pinned_low, "pinned_low"},     {check.pinned_high, "pinned_high"},
                                                 {check.outside_range, "outside_range"}, {check.impossible, "impossible"},
-                                                {check.unconverged, "unconverged"}};
+                                                {check.unconverged, "unconverged"},
+                                                {check.rugged, "not_single_peaked"}};
   for (const auto& [on, name] : flags) {
     if (on) n.flags.push_back(name);
   }

@@ -27,6 +27,30 @@ TEST(Adequacy, APlantedKnobInsideItsRangeLeavesNoDoubt) {
   EXPECT_FALSE(s.adequacy.below_ceiling);
 }
 
+// A search whose scores dipped (refine_search.h, DeepestDip): the knob's check carries its words as
+// a doubt and the flag, and the verdict is no longer `explained`.
+TEST(Adequacy, ASearchThatDoesNotRiseToOnePeakIsDoubted) {
+  test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 4);
+  ASSERT_FALSE(s.refinement.refined.empty());
+  KnobRefinement& f = s.refinement.refined[0];
+  ASSERT_EQ(f.rugged, "") << "the fake's friction rises to one peak";
+  f.rugged = "its likelihood search does not rise to one peak";
+  std::mt19937_64 rng(2);
+  s.confidence = AssessConfidence(s.set, s.refinement, rng);
+  const Adequacy a = AssessAdequacy(s.in, s.base, {}, s.set, s.refinement, s.options.adequacy);
+  const KnobCheck* c = nullptr;
+  for (const auto& check : a.checks) c = check.candidate == f.candidate ? &check : c;
+  ASSERT_NE(c, nullptr);
+  EXPECT_TRUE(c->rugged);
+  ASSERT_EQ(c->doubts.size(), 1u);
+  EXPECT_EQ(c->doubts[0], f.knob + ": its likelihood search does not rise to one peak");
+  const Naming naming = DecideNamed(s.set, s.refinement, s.confidence, a, s.options.verdict);
+  const Verdict v = ComposeVerdict(s.base, s.set, s.refinement, s.confidence, a, naming, {}, s.options.verdict);
+  ASSERT_FALSE(v.named.empty());
+  EXPECT_EQ(v.named[0].flags, std::vector<std::string>{"not_single_peaked"});
+  EXPECT_NE(v.status, "explained");
+}
+
 TEST(Adequacy, AValueBelowTheRangeIsPinnedAndDoubted) {
   const test::Stages s = test::RunStages({{test::kFriction, 0.02}}, 6);
   const KnobCheck* c = CheckOf(s, "friction");

@@ -67,6 +67,47 @@ TEST(RefineSearch, ALargerZAdmitsMorePoints) {
 // Where the deficit cannot be told (lengths differ, one placement, no spread with z infinite, not a
 // number), FitsAsWellAs answers what its caller asks for: "no" when collecting points that fit as
 // well, "yes" for the payload's middle line, which is recorded unless it clearly fits worse.
+// Points at values 1..5 whose log-likelihoods per sample are `means` plus placement noise.
+std::vector<Eigen::VectorXd> Scored(const std::vector<double>& means, double sd) {
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> noise(0.0, sd);
+  std::vector<Eigen::VectorXd> rows;
+  for (double m : means) {
+    Eigen::VectorXd r(200);
+    for (int g = 0; g < 40; ++g) r.segment(5 * g, 5).setConstant(m + noise(rng));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+TEST(RefineSearch, ScoresThatRiseToOnePeakHaveNoDip) {
+  const Rows r;
+  const std::vector<double> values = {5, 1, 4, 2, 3};  // in any order
+  EXPECT_FALSE(DeepestDip(Scored({-0.5, -0.8, -0.2, -0.4, 0}, 0.01), values, r.placement, 2.0).Found());
+  EXPECT_FALSE(DeepestDip(Scored({-0.5, -0.8}, 0.01), {1, 2}, r.placement, 2.0).Found()) << "two points";
+}
+
+TEST(RefineSearch, APointWorseThanPointsOnEitherSideIsTheDip) {
+  const Rows r;
+  // By value: 1: -0.3, 2: -0.6, 3: -0.1, 4: -0.9, 5: 0. The point at 4 lies 0.8 below the best to
+  // its left (3) and 0.9 below the one to its right (5); the point at 2, 0.3 and 0.6: a shallower dip.
+  const std::vector<double> values = {1, 2, 3, 4, 5};
+  const ScoreDip dip = DeepestDip(Scored({-0.3, -0.6, -0.1, -0.9, 0}, 0.05), values, r.placement, 2.0);
+  ASSERT_TRUE(dip.Found());
+  EXPECT_EQ(dip.at, 3);
+  EXPECT_EQ(dip.left, 2);
+  EXPECT_EQ(dip.right, 4);
+  EXPECT_NEAR(dip.below.sum, 0.8 * 200, 0.05 * 5 * 40);
+  EXPECT_NEAR(dip.above.sum, 0.9 * 200, 0.05 * 5 * 40);
+  EXPECT_GT(dip.below.se, 0);
+}
+
+TEST(RefineSearch, ADipWithinThePlacementsNoiseIsNone) {
+  const Rows r;
+  // The same means with placement noise of sd 3 nats per sample: SE of a deficit about 130 nats.
+  EXPECT_FALSE(DeepestDip(Scored({-0.3, -0.6, -0.1, -0.9, 0}, 3.0), {1, 2, 3, 4, 5}, r.placement, 2.0).Found());
+}
+
 TEST(RefineSearch, WhatCannotBeToldIsTheCallersAnswer) {
   Rows r;
   const UnitIds units = NumberUnits(r.placement);

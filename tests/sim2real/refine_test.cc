@@ -54,6 +54,7 @@ TEST(Refine, FrictionIsFoundByALikelihoodSearchOverItsValue) {
   EXPECT_LE(a.points, a.searched);
   EXPECT_EQ(a.searched, scored);
   EXPECT_TRUE(std::isnan(a.x_lower)) << "a forward offset only for the payload";
+  EXPECT_EQ(r.refined[0].rugged, "") << "the fake's friction scores rise to one peak";
 }
 
 TEST(Refine, AFrictionThatOnlySlipsBelowAThresholdIsFoundWhereTheLinearReadingIsFlat) {
