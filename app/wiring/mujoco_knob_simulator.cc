@@ -17,7 +17,7 @@ namespace {
 // Bump when a change of lib/sim changes what a recording at the same inputs contains (v2: the key
 // covers the compiled model, not the top-level MJCF text; v3: the generic gait solves every
 // leg's inverse kinematics in one pass).
-constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v10";
+constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v11";
 // v6: a recording runs in chunks of this many placements, each with its own random stream, so
 // one recording can use several threads (sim::ProtocolOptions::chunk_placements). v7: a servo
 // gets the ctrl that holds its joint at the target (through its gear) and the gait keeps within
@@ -36,6 +36,8 @@ constexpr const char* kSimulatorCodeVersion = "dgmm-mujoco-sim-v10";
 // v10: the generic gait solves its targets at least 60 times a cycle (generic_walker.h,
 // ControlEvery; before, at 100 Hz whatever the cycle): recordings of gaits whose cycle is under
 // 0.6 s changed (the scorpion's robot block), others not.
+// v11: recordings pair their sensor noise placement by placement whatever falls
+// (sim::ProtocolOptions::paired_streams): recordings with a fall changed, others not.
 constexpr int kChunkPlacements = 13;
 
 sim2real::Knob::Role RoleOf(sim::KnobKind kind) {
@@ -107,6 +109,7 @@ SampleSet MujocoKnobSimulator::Record(const sim2real::Recording& recording,
                                       const std::vector<sim2real::KnobValue>& values, int threads) const {
   sim::ProtocolOptions options;
   options.chunk_placements = kChunkPlacements;
+  options.paired_streams = true;  // a signature is a difference of two recordings: their noise pairs up
   options.threads = std::max(1, threads);
   options.protocol = sim::ParseProtocol(recording.protocol);
   options.seed = recording.seed;

@@ -305,7 +305,80 @@ struct PlanRun {
   double total_mass_kg = 0, leg_reach_m = 0;
 };
 
-// Runs placements [first, last) of `plan` on `sim`, drawing retries and sensor noise from `rng`.
+// Where an attempt at a placement draws its retry spot and sensor noise from.
+struct Draws {
+  std::mt19937_64& rng;
+  std::normal_distribution<double>& unit;  // the IMU's (its cached second draw carries over)
+};
+
+// The stream of retry `attempt` at placement p of a recording with paired streams: from the seed,
+// the placement's index and the attempt alone.
+std::mt19937_64 RetryStream(std::uint64_t seed, int p, int attempt) {
+  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
+                    static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(attempt), 0x72747279u};
+  return std::mt19937_64(seq);
+}
+
+// Advances (rng, unit) by the draws a placement of `reps` executions makes when none falls.
+void SkipPlacementDraws(const NoiseConfig& noise, int reps, std::mt19937_64& rng,
+                        std::normal_distribution<double>& unit) {
+  for (int r = 0; r < reps; ++r) {
+    unit(rng), unit(rng);
+    TrackerReading(Pose{}, noise, rng);
+    TrackerReading(Pose{}, noise, rng);
+  }
+}
+
+// One attempt at placement `where`: places the robot and runs its `reps` executions, their pose
+// changes into px and their z into pz; false as soon as the robot falls.
+bool RunAttempt(Simulator& sim, const SimConfig& config, const Placement& where, int reps,
+                const Eigen::MatrixXd& commands, const std::vector<std::string>& sensed, Draws draws, PlanRun* out,
+                std::vector<Eigen::Matrix<double, 6, 1>>* px, std::vector<Eigen::VectorXd>* pz) {
+  SimSummary& sum = out->sum;
+  const double half = sim.placement_half_width_m();
+  if (sim.Place(half * where.x_unit, half * where.y_unit, where.heading_rad) != RunOutcome::kCompleted) return false;
+  for (int r = 0; r < reps; ++r) {
+    const int id = where.sequence.empty() ? where.command : where.sequence[r];
+    const Eigen::Vector3d c = where.values.empty() ? Eigen::Vector3d(commands.row(id).transpose()) : where.values[r];
+    const Eigen::Vector2d z_true = sim.TruePitchRoll();
+    const Eigen::VectorXd terrain = SensedTerrain(sim, sensed);
+    Eigen::VectorXd z(2 + terrain.size());
+    z[1] = z_true[1] + config.noise.imu_roll_sd_rad * draws.unit(draws.rng);   // roll's draw first: the order
+    z[0] = z_true[0] + config.noise.imu_pitch_sd_rad * draws.unit(draws.rng);  // the shipped sets were made in
+    z.tail(terrain.size()) = terrain;
+    pz->push_back(z);
+    const Pose truth = sim.TorsoPose();
+    const Pose start = TrackerReading(truth, config.noise, draws.rng);
+    if (TiltedBeyondThreshold(truth)) ++sum.tilted_executions;
+    const long long touched = sim.SelfContactSteps();
+    const bool fell = sim.RunCommand(c) != RunOutcome::kCompleted;
+    ++sum.executions;
+    if (sim.SelfContactSteps() > touched) ++sum.self_contact_executions;
+    out->self_contact_by_command[id] += sim.SelfContactSteps() - touched;
+    const Pose end = TrackerReading(sim.TorsoPose(), config.noise, draws.rng);
+    px->push_back(DeltaPoseBody(start, end));
+    if (fell) return false;
+  }
+  return true;
+}
+
+// Keeps the executions of a completed attempt at placement p.
+void Keep(const Placement& where, int p, const std::vector<Eigen::Matrix<double, 6, 1>>& px,
+          const std::vector<Eigen::VectorXd>& pz, Recorded* rec) {
+  for (size_t r = 0; r < px.size(); ++r) {
+    rec->command.push_back(where.sequence.empty() ? where.command : where.sequence[r]);
+    rec->episode.push_back(p);
+    rec->step.push_back(static_cast<int>(r));
+    rec->xs.push_back(px[r]);
+    rec->zs.push_back(pz[r]);
+    if (!where.values.empty()) rec->values.push_back(where.values[r]);
+  }
+}
+
+// Runs placements [first, last) of `plan` on `sim`, drawing retries and sensor noise from `rng`
+// (with options.paired_streams, retries from streams of their own and `rng` advanced by one
+// completed placement's draws whatever happened, so that a fall does not shift later placements'
+// noise: recordings of one plan at different knob values pair their noise placement by placement).
 void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOptions& options,
                    const std::vector<Placement>& plan, int first, int last, const Eigen::MatrixXd& commands,
                    std::mt19937_64& rng, const std::function<void()>& placed, PlanRun* out) {
@@ -313,57 +386,34 @@ void RunPlacements(Simulator& sim, const SimConfig& config, const ProtocolOption
   const std::vector<std::string> sensed = config.terrain ? config.terrain->sensed : std::vector<std::string>();
   std::uniform_real_distribution<double> position(-1.0, 1.0);
   std::normal_distribution<double> unit(0.0, 1.0);
-  Recorded& rec = out->rec;
-  SimSummary& sum = out->sum;
   for (int p = first; p < last; ++p) {
     Placement where = plan[p];
-    bool kept = false;
+    const std::mt19937_64 rng_before = rng;
+    const std::normal_distribution<double> unit_before = unit;
+    bool kept = false, kept_first = false;
     for (int attempt = 0; attempt <= options.max_retries_per_placement && !kept; ++attempt) {
+      const bool own = options.paired_streams && attempt > 0;
+      std::mt19937_64 retry = own ? RetryStream(options.seed, p, attempt) : std::mt19937_64();
+      std::normal_distribution<double> retry_unit(0.0, 1.0);
+      const Draws draws{own ? retry : rng, own ? retry_unit : unit};
       if (attempt > 0) {  // re-place somewhere else on the slope, same heading and command
-        where.x_unit = position(rng);
-        where.y_unit = position(rng);
+        where.x_unit = position(draws.rng);
+        where.y_unit = position(draws.rng);
       }
-      const double half = sim.placement_half_width_m();
-      bool fell = sim.Place(half * where.x_unit, half * where.y_unit, where.heading_rad) != RunOutcome::kCompleted;
       std::vector<Eigen::Matrix<double, 6, 1>> px;
       std::vector<Eigen::VectorXd> pz;
-      for (int r = 0; r < reps && !fell; ++r) {
-        const int id = where.sequence.empty() ? where.command : where.sequence[r];
-        const Eigen::Vector3d c =
-            where.values.empty() ? Eigen::Vector3d(commands.row(id).transpose()) : where.values[r];
-        const Eigen::Vector2d z_true = sim.TruePitchRoll();
-        const Eigen::VectorXd terrain = SensedTerrain(sim, sensed);
-        Eigen::VectorXd z(2 + terrain.size());
-        z[1] = z_true[1] + config.noise.imu_roll_sd_rad * unit(rng);  // roll's draw first: the order
-        z[0] = z_true[0] + config.noise.imu_pitch_sd_rad * unit(rng); // the shipped sets were made in
-        z.tail(terrain.size()) = terrain;
-        pz.push_back(z);
-        const Pose truth = sim.TorsoPose();
-        const Pose start = TrackerReading(truth, config.noise, rng);
-        if (TiltedBeyondThreshold(truth)) ++sum.tilted_executions;
-        const long long touched = sim.SelfContactSteps();
-        fell = sim.RunCommand(c) != RunOutcome::kCompleted;
-        ++sum.executions;
-        if (sim.SelfContactSteps() > touched) ++sum.self_contact_executions;
-        out->self_contact_by_command[id] += sim.SelfContactSteps() - touched;
-        const Pose end = TrackerReading(sim.TorsoPose(), config.noise, rng);
-        px.push_back(DeltaPoseBody(start, end));
-      }
-      if (fell) {
-        ++sum.falls;
+      if (!RunAttempt(sim, config, where, reps, commands, sensed, draws, out, &px, &pz)) {
+        ++out->sum.falls;
         continue;
       }
-      kept = true;
-      for (int r = 0; r < reps; ++r) {
-        rec.command.push_back(where.sequence.empty() ? where.command : where.sequence[r]);
-        rec.episode.push_back(p);
-        rec.step.push_back(r);
-        rec.xs.push_back(px[r]);
-        rec.zs.push_back(pz[r]);
-        if (!where.values.empty()) rec.values.push_back(where.values[r]);
-      }
+      kept = true, kept_first = attempt == 0;
+      Keep(where, p, px, pz, &out->rec);
     }
-    if (!kept) ++sum.abandoned_placements;
+    if (options.paired_streams && !kept_first) {  // in step with a recording whose first attempt held
+      rng = rng_before, unit = unit_before;
+      SkipPlacementDraws(config.noise, reps, rng, unit);
+    }
+    if (!kept) ++out->sum.abandoned_placements;
     if (placed) placed();
   }
   out->simulated_seconds = sim.time_s();

@@ -51,6 +51,13 @@ struct ProtocolOptions {
   // threads: the set depends on the chunk size, not on the thread count.
   int chunk_placements = 0;
   int threads = 1;
+  // false: a fall's retries draw their spot and sensor noise from the recording's stream, so every
+  // later placement's noise shifts (how the shipped sets were made). true: retries draw from
+  // streams of their own (seed, placement, attempt) and the recording's stream moves on as if the
+  // placement had held, so recordings of one plan at different knob values share each placement's
+  // noise whatever falls in either (sim2real's paired signatures); a recording without falls is
+  // the same either way.
+  bool paired_streams = false;
 
   bool IsValid(std::string* error) const;
 };

@@ -22,6 +22,7 @@ namespace {
 
 constexpr double kStepFactor = 1.6;  // grid spacing: the deviation from nominal, in ratios
 constexpr double kResolution = 0.25;  // a bracket this narrow in u (a 12% change of deviation) is done
+constexpr double kFullShare = 0.9;  // a point pairing this share of the fullest recording's samples is judged
 
 struct KnobPoint {
   double value = 0, u = 0;
@@ -131,11 +132,17 @@ SearchSpan AsWell(const KnobSearch& s, const std::vector<KnobPoint>& pts, const 
   return FitAsWellSpan(rows, static_cast<int>(&best - pts.data()), values, {}, s.in.real.episode, s.options.as_well_z);
 }
 
-// Empty, or why the search's scores do not rise to one peak (DeepestDip), in words.
+// Empty, or why the search's scores do not rise to one peak (DeepestDip), in words. Only points
+// recorded as fully as the fullest are judged (a probe kept from the first look pairs 2 executions
+// of 5: its score is noisier, not chaotic).
 std::string Rugged(const KnobSearch& s, const std::vector<KnobPoint>& pts) {
+  int most = 0;
+  for (const auto& p : pts) most = std::max(most, s.set->shifts[p.shift].pairs());
   std::vector<Eigen::VectorXd> rows;
   std::vector<double> values;
-  for (const auto& p : pts) rows.push_back(p.rows), values.push_back(p.value);
+  for (const auto& p : pts) {
+    if (s.set->shifts[p.shift].pairs() >= kFullShare * most) rows.push_back(p.rows), values.push_back(p.value);
+  }
   const ScoreDip dip = DeepestDip(rows, values, s.in.real.episode, s.options.as_well_z);
   if (!dip.Found()) return "";
   const double n = static_cast<double>(s.in.real.size());

@@ -126,6 +126,58 @@ TEST(ProtocolTest, FallsAreCountedNotRecorded) {
   EXPECT_EQ(set.metadata.at("falls"), std::to_string(summary.falls));
 }
 
+// Samples of placement `episode`, step by step: x then z of each.
+std::vector<double> PlacementSamples(const SampleSet& set, int episode) {
+  std::vector<double> out;
+  for (int i = 0; i < set.size(); ++i) {
+    if (set.episode[i] != episode) continue;
+    for (int j = 0; j < set.x.cols(); ++j) out.push_back(set.x(i, j));
+    for (int j = 0; j < set.z.cols(); ++j) out.push_back(set.z(i, j));
+  }
+  return out;
+}
+
+// With paired streams a fall's retries draw from streams of their own: a recording that retries
+// and one that gives up on the same falls record every later placement alike. Without, the
+// retries' draws shift every later placement's sensor noise.
+TEST(ProtocolTest, PairedStreamsKeepLaterPlacementsNoiseWhateverFalls) {
+  SimConfig c;  // placements 2, 4 and 5 of seed 1 fall at every attempt, 0, 1 and 3 hold
+  c.slope_deg = 30;
+  c.payload.mass_kg = 3;
+  c.payload.position_body_m = Eigen::Vector3d(0, 0.4, 0.4);
+  auto record = [&](bool paired, int retries) {
+    ProtocolOptions o = Short(1);
+    o.max_retries_per_placement = retries;
+    o.paired_streams = paired;
+    return SimulateProtocol(c, o);
+  };
+  const SampleSet gives_up = record(true, 0), retries = record(true, 2);
+  const SampleSet gives_up_unpaired = record(false, 0), retries_unpaired = record(false, 2);
+  int first_fall = -1, later_in_both = 0, unpaired_differ = 0;
+  for (int p = 0; p < 6; ++p) {
+    const std::vector<double> a = PlacementSamples(gives_up, p), b = PlacementSamples(retries, p);
+    if (a.empty() && first_fall < 0) first_fall = p;
+    if (first_fall < 0 || p == first_fall || a.empty() || b.empty()) continue;
+    ++later_in_both;
+    EXPECT_EQ(a, b) << "placement " << p << " after the fall at " << first_fall;
+    unpaired_differ += PlacementSamples(gives_up_unpaired, p) != PlacementSamples(retries_unpaired, p);
+  }
+  ASSERT_GE(first_fall, 0) << "the config makes the robot fall";
+  ASSERT_GT(later_in_both, 0) << "a placement after the fall held in both";
+  EXPECT_GT(unpaired_differ, 0) << "without paired streams the retries shift later noise";
+}
+
+TEST(ProtocolTest, PairedStreamsLeaveARecordingWithoutFallsAsItWas) {
+  ProtocolOptions o = Short(3);
+  SimSummary summary;
+  const SampleSet plain = SimulateProtocol(SimConfig{}, o, {}, &summary);
+  ASSERT_EQ(summary.falls, 0);
+  o.paired_streams = true;
+  const SampleSet paired = SimulateProtocol(SimConfig{}, o);
+  EXPECT_EQ(paired.x, plain.x);
+  EXPECT_EQ(paired.z, plain.z);
+}
+
 TEST(ProtocolTest, TrajectoriesRunASequenceOfCommandsPerPlacement) {
   ProtocolOptions o;
   o.protocol = ParseProtocol("trajectories");
