@@ -5,10 +5,12 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <initializer_list>
 #include <map>
 #include <mutex>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "core/set_warnings.h"
 #include "sim/pose.h"
@@ -305,6 +307,16 @@ struct PlanRun {
   double total_mass_kg = 0, leg_reach_m = 0;
 };
 
+// A stream of its own from the seed, the indices `ids` and a `tag` naming what it is for:
+// seed_seq{seed low, seed high, ids..., tag}.
+std::mt19937_64 SubStream(std::uint64_t seed, std::initializer_list<std::uint32_t> ids, std::uint32_t tag) {
+  std::vector<std::uint32_t> words = {static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32)};
+  words.insert(words.end(), ids);
+  words.push_back(tag);
+  std::seed_seq seq(words.begin(), words.end());
+  return std::mt19937_64(seq);
+}
+
 // Where an attempt at a placement draws its retry spot and sensor noise from.
 struct Draws {
   std::mt19937_64& rng;
@@ -314,9 +326,7 @@ struct Draws {
 // The stream of retry `attempt` at placement p of a recording with paired streams: from the seed,
 // the placement's index and the attempt alone.
 std::mt19937_64 RetryStream(std::uint64_t seed, int p, int attempt) {
-  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(attempt), 0x72747279u};
-  return std::mt19937_64(seq);
+  return SubStream(seed, {static_cast<std::uint32_t>(p), static_cast<std::uint32_t>(attempt)}, 0x72747279u);
 }
 
 // Advances (rng, unit) by the draws a placement of `reps` executions makes when none falls.
@@ -451,9 +461,7 @@ void Append(PlanRun&& part, PlanRun* all) {
 // The generator of chunk `chunk` of a chunked recording: its own stream, from the seed and the
 // chunk's index alone.
 std::mt19937_64 ChunkStream(std::uint64_t seed, int chunk) {
-  std::seed_seq seq{static_cast<std::uint32_t>(seed), static_cast<std::uint32_t>(seed >> 32),
-                    static_cast<std::uint32_t>(chunk), 0x63686b75u};
-  return std::mt19937_64(seq);
+  return SubStream(seed, {static_cast<std::uint32_t>(chunk)}, 0x63686b75u);
 }
 
 // Runs the whole plan: on one simulator with the plan's generator, or (chunk_placements > 0) in

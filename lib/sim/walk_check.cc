@@ -90,9 +90,9 @@ std::string TrackerNoiseWarning(double tracker_sd_m, const CommandedWalk& want, 
   if (!(travel > 0) || !(tracker_sd_m > share * travel)) return "";
   return "noise.tracker_position_sd_m: " + Number(tracker_sd_m) + " m is " + Number(100 * tracker_sd_m / travel) +
          "% of the " + Number(travel) + " m a half command moves the robot in an execution (over " +
-         Number(100 * share) + "%): the tracker's noise is a length of its own, not of the robot's, and dgmm "
-         "sim2real can name values biased beyond their intervals from such sets (docs/simulation.md, \"One robot at "
-         "three sizes\"); give your tracker's noise in the config's noise block";
+         Number(100 * share) + "%): the tracker's noise is a length of its own, not of the robot's, and such sets "
+         "tell dgmm sim2real less of the robot's motion (docs/simulation.md, \"One robot at three sizes\"); give "
+         "your tracker's noise in the config's noise block";
 }
 
 }  // namespace dgmm::sim

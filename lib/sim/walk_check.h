@@ -45,8 +45,8 @@ std::string WalkWarning(const std::vector<WalkRatio>& ratios, const WalkBand& ba
 // moves the robot in one execution, 0.5 stride cycles: one line naming both (empty otherwise or
 // when nothing is commanded). The noise is a length of the tracker's, not of the robot's: the
 // config's default 3 mm is 2.2% of the hexapod's travel and 8.9% of a copy of it a quarter of its
-// size, on which dgmm sim2real named a friction 38% high with an interval that missed the truth
-// (docs/simulation.md, "One robot at three sizes"); 0.75 mm named it right.
+// size (docs/simulation.md, "One robot at three sizes": the friction named 38% high there came from
+// recordings whose noise stopped pairing after falls, since mended by ProtocolOptions::paired_streams).
 inline constexpr double kTrackerNoiseShare = 0.05;
 std::string TrackerNoiseWarning(double tracker_sd_m, const CommandedWalk& want, double share = kTrackerNoiseShare);
 

@@ -44,17 +44,13 @@ KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const
                            Value(check.pinned_low ? lo : hi, c.unit));
   }
   for (const auto& f : r.refined) {
-    if (f.candidate != k || f.rugged.empty()) continue;
-    check.rugged = true;
-    check.doubts.push_back(c.knob + ": " + f.rugged);
-  }
-  if (check.unconverged) {
-    for (const auto& f : r.refined) {
-      if (f.candidate == k && !f.converged) {
-        check.doubts.push_back(c.knob + (f.why.empty() ? Fmt(": its refinement did not converge (best signature "
-                                                             "coefficient %.2f, 1 expected)", f.coefficient)
-                                                       : ": " + f.why));
-      }
+    if (f.candidate != k) continue;
+    check.rugged |= !f.rugged.empty();
+    if (!f.rugged.empty()) check.doubts.push_back(c.knob + ": " + f.rugged);
+    if (!f.converged) {
+      check.doubts.push_back(c.knob + (f.why.empty() ? Fmt(": its refinement did not converge (best signature "
+                                                           "coefficient %.2f, 1 expected)", f.coefficient)
+                                                     : ": " + f.why));
     }
   }
   return check;
