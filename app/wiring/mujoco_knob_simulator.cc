@@ -138,6 +138,7 @@ sim2real::CellRecording MujocoKnobSimulator::RecordCell(const sim2real::Cell& ce
   options.placements = cell.placements;
   options.executions_per_placement = cell.executions_per_placement;
   options.seed = cell.seed;
+  options.paired_streams = true;  // as the recordings (v11): cells at two values pair their noise whatever falls
   if (config_.terrain) {  // rough ground: pitch and roll depend on the position too
     options.headings_rad = sim::HeadingsForTerrain(config_, options, cell.terrain(0), cell.terrain(1));
     std::snprintf(where, sizeof where, "headings matched per placement on the %.3g deg slope's rough ground",

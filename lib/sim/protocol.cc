@@ -602,6 +602,8 @@ SampleSet SimulateCell(const SimConfig& config, const CellOptions& cell, SimSumm
   options.seed = cell.seed;
   options.executions_per_placement = cell.executions_per_placement;
   options.placements = cell.placements;
+  options.max_retries_per_placement = cell.max_retries_per_placement;
+  options.paired_streams = cell.paired_streams;
   if (!options.IsValid(&error) || cell.placements < 1 || !std::isfinite(cell.heading_rad)) {
     throw MakeInputError("cell options", "", error.empty() ? "placements >= 1 and a finite heading" : error);
   }

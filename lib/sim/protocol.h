@@ -114,6 +114,10 @@ struct CellOptions {
   int placements = 4;
   int executions_per_placement = 5;
   std::uint64_t seed = 0;
+  int max_retries_per_placement = 3;  // as ProtocolOptions'
+  // As ProtocolOptions': true pairs two cells' sensor noise placement by placement whatever falls
+  // in either (sim2real's experiment check compares cells at two knob values).
+  bool paired_streams = false;
 };
 
 // Runs one cell; the same options and seed draw the same positions and sensor noise, so two runs

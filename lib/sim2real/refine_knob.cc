@@ -145,15 +145,12 @@ std::string Rugged(const KnobSearch& s, const std::vector<KnobPoint>& pts) {
   }
   const ScoreDip dip = DeepestDip(rows, values, s.in.real.episode, s.options.as_well_z);
   if (!dip.Found()) return "";
-  const double n = static_cast<double>(s.in.real.size());
-  auto z = [](const PairedSum& d) { return d.se > 0 ? d.sum / d.se : INFINITY; };
   return Fmt("its likelihood search does not rise to one peak: the recording at %.4g fits worse than those at ",
              values[dip.at]) +
          Fmt("%.4g and %.4g on either side of it ", values[dip.left], values[dip.right]) +
-         Fmt("(by %.2f and %.2f nats per real sample, ", dip.below.sum / n, dip.above.sum / n) +
-         Fmt("z %.1f and %.1f), so recordings at nearby values differ by more than their values explain (a chaotic "
-             "walk, or two values that fit), and the value may lie outside its interval",
-             z(dip.below), z(dip.above));
+         DipDeficits(dip, static_cast<int>(s.in.real.size())) +
+         ", so recordings at nearby values differ by more than their values explain (a chaotic walk, or two values "
+         "that fit), and the value may lie outside its interval";
 }
 
 // Every candidate of the knob takes the best recording as its signature; the selection reruns.

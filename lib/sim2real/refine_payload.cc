@@ -329,6 +329,50 @@ SearchSpan AsWell(const AnalysisInputs& in, const std::vector<PayloadPoint>& gri
   return FitAsWellSpan(rows, static_cast<int>(&best - grid.data()), masses, x, in.real.episode, z);
 }
 
+// The recorded points through the best on its sideways way along one line, each place once: the
+// masses at its forward offset (`along_mass`) or the forward offsets at its mass.
+std::vector<const PayloadPoint*> LineThrough(const std::vector<PayloadPoint>& grid, const PayloadPoint& best,
+                                             bool along_mass) {
+  std::vector<const PayloadPoint*> line;
+  for (const auto& p : grid) {
+    const bool on = p.moment == best.moment && (along_mass ? p.x == best.x : p.mass == best.mass);
+    const bool again = std::any_of(line.begin(), line.end(), [&](const PayloadPoint* q) {
+      return q->mass == p.mass && q->x == p.x && q->y == p.y;
+    });
+    if (on && !again) line.push_back(&p);
+  }
+  return line;
+}
+
+// Empty, or why the search's scores do not rise to one peak through its best point: the deeper of
+// the dips (DeepestDip) along the masses recorded at the best's forward offset (the half steps
+// among them) and along the forward offsets recorded at its mass, in words.
+std::string Rugged(const AnalysisInputs& in, const std::vector<PayloadPoint>& grid, const PayloadPoint& best,
+                   double z) {
+  ScoreDip deepest;
+  std::vector<double> values;
+  bool by_mass = true;
+  for (const bool along_mass : {true, false}) {
+    std::vector<Eigen::VectorXd> rows;
+    std::vector<double> v;
+    for (const PayloadPoint* p : LineThrough(grid, best, along_mass)) {
+      rows.push_back(p->rows), v.push_back(along_mass ? p->mass : p->x);
+    }
+    const ScoreDip dip = DeepestDip(rows, v, in.real.episode, z);
+    if (dip.Found() && (!deepest.Found() || dip.Depth() > deepest.Depth())) deepest = dip, values = v, by_mass = along_mass;
+  }
+  if (!deepest.Found()) return "";
+  const std::string line = by_mass ? Fmt("at the forward offset %.3g m the recording of %.4g kg", best.x,
+                                         values[deepest.at])
+                                   : Fmt("at %.4g kg the recording %.3g m forward", best.mass, values[deepest.at]);
+  const std::string sides = by_mass ? Fmt("those of %.4g and %.4g kg", values[deepest.left], values[deepest.right])
+                                    : Fmt("those %.3g and %.3g m forward", values[deepest.left], values[deepest.right]);
+  return "its likelihood search does not rise to one peak: " + line + " fits worse than " + sides +
+         " on either side of it " + DipDeficits(deepest, static_cast<int>(in.real.size())) +
+         ", so recordings of nearby payloads differ by more than their places explain (a chaotic walk, or two places "
+         "that fit), and the payload may lie outside its interval";
+}
+
 // The best point becomes the payload's signature (column 0 of its design) and the selection reruns.
 void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const std::vector<PayloadPoint>& grid,
            const PayloadPoint& best, bool converged, double as_well_z, CandidateSet* set, Refinement* r) {
@@ -341,6 +385,7 @@ void Adopt(const AnalysisInputs& in, const Baseline& base, int pay, const std::v
   if (pos != sel.end()) kr.coefficient = r->selection.fit.theta[pos - sel.begin()](0);
   if (!converged) kr.why = "the likelihood search's best payload lies at the edge of the masses and offsets searched";
   kr.as_well = AsWell(in, grid, best, as_well_z);
+  kr.rugged = Rugged(in, grid, best, as_well_z);
   r->refined.push_back(kr);
   r->payload_mass = best.mass, r->payload_x = best.x, r->payload_y = best.y;
   r->searched[pay] = true;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "sim2real/sentence_format.h"
 #include "sim2real/units.h"
 
 namespace dgmm::sim2real {
@@ -103,6 +104,13 @@ ScoreDip DeepestDip(const std::vector<Eigen::VectorXd>& rows, const std::vector<
     depth = std::min(below.sum, above.sum);
   }
   return out;
+}
+
+std::string DipDeficits(const ScoreDip& dip, int real_samples) {
+  const double n = real_samples;
+  auto z = [](const PairedSum& d) { return d.se > 0 ? d.sum / d.se : INFINITY; };
+  return Fmt("(by %.2f and %.2f nats per real sample, ", dip.below.sum / n, dip.above.sum / n) +
+         Fmt("z %.1f and %.1f)", z(dip.below), z(dip.above));
 }
 
 }  // namespace dgmm::sim2real

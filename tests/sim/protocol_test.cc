@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <functional>
 #include <set>
 
 #include "core/set_warnings.h"
@@ -137,24 +139,15 @@ std::vector<double> PlacementSamples(const SampleSet& set, int episode) {
   return out;
 }
 
-// With paired streams a fall's retries draw from streams of their own: a recording that retries
-// and one that gives up on the same falls record every later placement alike. Without, the
-// retries' draws shift every later placement's sensor noise.
-TEST(ProtocolTest, PairedStreamsKeepLaterPlacementsNoiseWhateverFalls) {
-  SimConfig c;  // placements 2, 4 and 5 of seed 1 fall at every attempt, 0, 1 and 3 hold
-  c.slope_deg = 30;
-  c.payload.mass_kg = 3;
-  c.payload.position_body_m = Eigen::Vector3d(0, 0.4, 0.4);
-  auto record = [&](bool paired, int retries) {
-    ProtocolOptions o = Short(1);
-    o.max_retries_per_placement = retries;
-    o.paired_streams = paired;
-    return SimulateProtocol(c, o);
-  };
+// Recordings of one plan, paired or not, that retry a fall or give up on it: with paired streams
+// the two record every placement after the first fall alike; without, the retries' draws shift
+// every later placement's sensor noise. The plan must make the robot fall at some of its
+// `placements` and hold at a later one.
+void ExpectLaterPlacementsPaired(const std::function<SampleSet(bool paired, int retries)>& record, int placements) {
   const SampleSet gives_up = record(true, 0), retries = record(true, 2);
   const SampleSet gives_up_unpaired = record(false, 0), retries_unpaired = record(false, 2);
   int first_fall = -1, later_in_both = 0, unpaired_differ = 0;
-  for (int p = 0; p < 6; ++p) {
+  for (int p = 0; p < placements; ++p) {
     const std::vector<double> a = PlacementSamples(gives_up, p), b = PlacementSamples(retries, p);
     if (a.empty() && first_fall < 0) first_fall = p;
     if (first_fall < 0 || p == first_fall || a.empty() || b.empty()) continue;
@@ -162,9 +155,51 @@ TEST(ProtocolTest, PairedStreamsKeepLaterPlacementsNoiseWhateverFalls) {
     EXPECT_EQ(a, b) << "placement " << p << " after the fall at " << first_fall;
     unpaired_differ += PlacementSamples(gives_up_unpaired, p) != PlacementSamples(retries_unpaired, p);
   }
-  ASSERT_GE(first_fall, 0) << "the config makes the robot fall";
+  ASSERT_GE(first_fall, 0) << "the plan makes the robot fall";
   ASSERT_GT(later_in_both, 0) << "a placement after the fall held in both";
   EXPECT_GT(unpaired_differ, 0) << "without paired streams the retries shift later noise";
+}
+
+// A payload heavy and high on one side on a 30 deg slope: the robot falls at some headings and
+// commands, at every attempt.
+SimConfig FallingConfig() {
+  SimConfig c;
+  c.slope_deg = 30;
+  c.payload.mass_kg = 3;
+  c.payload.position_body_m = Eigen::Vector3d(0, 0.4, 0.4);
+  return c;
+}
+
+// With paired streams a fall's retries draw from streams of their own: a recording that retries
+// and one that gives up on the same falls record every later placement alike (placements 2, 4 and
+// 5 of seed 1 fall, 0, 1 and 3 hold).
+TEST(ProtocolTest, PairedStreamsKeepLaterPlacementsNoiseWhateverFalls) {
+  ExpectLaterPlacementsPaired(
+      [](bool paired, int retries) {
+        ProtocolOptions o = Short(1);
+        o.max_retries_per_placement = retries;
+        o.paired_streams = paired;
+        return SimulateProtocol(FallingConfig(), o);
+      },
+      6);
+}
+
+// The same for one cell of the experiment check (sim2real compares cells at two knob values).
+TEST(ProtocolCellTest, PairedStreamsKeepLaterPlacementsNoiseWhateverFalls) {
+  ExpectLaterPlacementsPaired(
+      [](bool paired, int retries) {
+        CellOptions cell;
+        cell.command = Eigen::Vector3d(0.5, 0, 0);
+        // Facing uphill (heading 0) the robot falls at every attempt, sideways it holds.
+        cell.headings_rad = {M_PI / 2, M_PI / 2, 0, M_PI / 2, 0, M_PI / 2, M_PI / 2, M_PI / 2};
+        cell.placements = 8;
+        cell.executions_per_placement = 3;
+        cell.seed = 1;
+        cell.max_retries_per_placement = retries;
+        cell.paired_streams = paired;
+        return SimulateCell(FallingConfig(), cell);
+      },
+      8);
 }
 
 TEST(ProtocolTest, PairedStreamsLeaveARecordingWithoutFallsAsItWas) {

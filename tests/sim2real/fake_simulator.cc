@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <random>
 
 #include "util/error.h"
@@ -51,6 +52,14 @@ Values ValuesOf(const std::vector<Knob>& knobs, const std::vector<KnobValue>& va
   return out;
 }
 
+// u in [-1, 1] drawn from v's value alone (FakePayload::chaos).
+double Chance(double v) {
+  std::uint64_t bits = 0;
+  std::memcpy(&bits, &v, sizeof bits);
+  std::mt19937_64 rng(bits);
+  return std::uniform_real_distribution<double>(-1.0, 1.0)(rng);
+}
+
 Eigen::Vector3d Gravity(double pitch, double roll) {
   return {std::sin(pitch), -std::sin(roll) * std::cos(pitch), -std::cos(roll) * std::cos(pitch)};
 }
@@ -76,8 +85,10 @@ Eigen::Vector3d Mean(const Values& k, const Eigen::Vector3d& c, double pitch, do
   if (first) x *= 1 - k.v[kLatency] / 0.1;  // motion lost at the first execution after a command change
   // The mass's own effect (payload.power bends it); the offsets' go with the moments M x and M y,
   // as gravity's torque does, or the forward offset's with the offset alone.
-  const double m = payload.gain * std::pow(k.v[kPayloadMass], payload.power), torque = payload.gain * k.v[kPayloadMass];
-  const double forward = payload.offset_alone ? 2.5 * payload.gain : torque;  // 2.5: the fake's usual mass
+  const double luck = 1 + payload.chaos * Chance(k.v[kPayloadMass]);
+  const double m = luck * payload.gain * std::pow(k.v[kPayloadMass], payload.power);
+  const double torque = luck * payload.gain * k.v[kPayloadMass];
+  const double forward = payload.offset_alone ? luck * 2.5 * payload.gain : torque;  // 2.5: the fake's usual mass
   x += m * Eigen::Vector3d(-0.01 * std::abs(c(0)), 0.01 * g(1), 0);
   x += torque * Eigen::Vector3d(0.02 * k.v[kPayloadY] * g(0), 0.05 * k.v[kPayloadY] * std::abs(c(0)),
                                 0.2 * k.v[kPayloadY] * c(0));

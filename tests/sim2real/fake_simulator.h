@@ -47,6 +47,9 @@ struct FakePayload {
   // The forward offset acts by itself, as if the mass were always 2.5 kg (on the mammal-shaped
   // robot's trot the data fix the offset, not the moment M x).
   bool offset_alone = false;
+  // Each payload mass walks its own way, as recordings of a chaotic walk do: the payload's whole
+  // effect times 1 + chaos u, u in [-1, 1] drawn from the mass's value alone.
+  double chaos = 0;
 };
 
 // What a recording adds beyond the knobs (the "real" robot's extras).
@@ -78,7 +81,8 @@ class FakeSimulator : public KnobSimulator {
                 ? "-payload-" + std::to_string(payload.gain) + "-" + std::to_string(payload.power) + "-" +
                       std::to_string(payload.bend)
                 : "") +
-           (payload.offset_alone ? "-offset-alone" : "") + (level ? "-level" : "") +
+           (payload.offset_alone ? "-offset-alone" : "") +
+           (payload.chaos != 0 ? "-chaos-" + std::to_string(payload.chaos) : "") + (level ? "-level" : "") +
            (sloped_plane ? "-sloped-plane" : "") +
            (level_z_sd != 0.02 ? "-z-sd-" + std::to_string(level_z_sd) : "") +
            (tilt_steers != 0 ? "-tilt-steers-" + std::to_string(tilt_steers) : "");
