@@ -125,16 +125,27 @@ std::vector<Placement> PlanPlacements(const ProtocolOptions& options, int num_co
   return plan;
 }
 
-// A tracker reading of the true pose: position and body-frame rotation perturbed.
-Pose TrackerReading(const Pose& truth, const NoiseConfig& noise, std::mt19937_64& rng) {
+// A tracker's error: its reading of a true pose is the position offset and the body-frame rotation
+// (roll, pitch, yaw) applied to it.
+struct TrackerError {
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  double roll_rad = 0, pitch_rad = 0, yaw_rad = 0;
+  Pose Read(const Pose& truth) const {
+    Pose read = truth;
+    read.position_m += position_m;
+    read.rotation = truth.rotation * FromRollPitchYaw(roll_rad, pitch_rad, yaw_rad);
+    return read;
+  }
+};
+
+TrackerError DrawTrackerError(const NoiseConfig& noise, std::mt19937_64& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
-  Pose read = truth;
-  for (int k = 0; k < 3; ++k) read.position_m[k] += noise.tracker_position_sd_m * n(rng);
-  const double roll = noise.tracker_roll_sd_rad * n(rng);
-  const double pitch = noise.tracker_pitch_sd_rad * n(rng);
-  const double yaw = noise.tracker_yaw_sd_rad * n(rng);
-  read.rotation = truth.rotation * FromRollPitchYaw(roll, pitch, yaw);
-  return read;
+  TrackerError e;
+  for (int k = 0; k < 3; ++k) e.position_m[k] = noise.tracker_position_sd_m * n(rng);
+  e.roll_rad = noise.tracker_roll_sd_rad * n(rng);
+  e.pitch_rad = noise.tracker_pitch_sd_rad * n(rng);
+  e.yaw_rad = noise.tracker_yaw_sd_rad * n(rng);
+  return e;
 }
 
 }  // namespace
@@ -323,6 +334,24 @@ struct Draws {
   std::normal_distribution<double>& unit;  // the IMU's (its cached second draw carries over)
 };
 
+// The sensor noise of one execution, drawn in the order the shipped sets were made in: the IMU's
+// roll, then pitch, then the tracker's error at the start and at the end of the execution. The
+// one place that order is written: a recording and a placement skipped (SkipPlacementDraws) both
+// draw through it.
+struct ExecutionNoise {
+  double imu_roll_rad = 0, imu_pitch_rad = 0;
+  TrackerError start, end;
+};
+
+ExecutionNoise DrawExecutionNoise(const NoiseConfig& noise, Draws draws) {
+  ExecutionNoise e;
+  e.imu_roll_rad = noise.imu_roll_sd_rad * draws.unit(draws.rng);
+  e.imu_pitch_rad = noise.imu_pitch_sd_rad * draws.unit(draws.rng);
+  e.start = DrawTrackerError(noise, draws.rng);
+  e.end = DrawTrackerError(noise, draws.rng);
+  return e;
+}
+
 // The stream of retry `attempt` at placement p of a recording with paired streams: from the seed,
 // the placement's index and the attempt alone.
 std::mt19937_64 RetryStream(std::uint64_t seed, int p, int attempt) {
@@ -332,11 +361,7 @@ std::mt19937_64 RetryStream(std::uint64_t seed, int p, int attempt) {
 // Advances (rng, unit) by the draws a placement of `reps` executions makes when none falls.
 void SkipPlacementDraws(const NoiseConfig& noise, int reps, std::mt19937_64& rng,
                         std::normal_distribution<double>& unit) {
-  for (int r = 0; r < reps; ++r) {
-    unit(rng), unit(rng);
-    TrackerReading(Pose{}, noise, rng);
-    TrackerReading(Pose{}, noise, rng);
-  }
+  for (int r = 0; r < reps; ++r) DrawExecutionNoise(noise, {rng, unit});
 }
 
 // One attempt at placement `where`: places the robot and runs its `reps` executions, their pose
@@ -352,20 +377,21 @@ bool RunAttempt(Simulator& sim, const SimConfig& config, const Placement& where,
     const Eigen::Vector3d c = where.values.empty() ? Eigen::Vector3d(commands.row(id).transpose()) : where.values[r];
     const Eigen::Vector2d z_true = sim.TruePitchRoll();
     const Eigen::VectorXd terrain = SensedTerrain(sim, sensed);
+    const ExecutionNoise noise = DrawExecutionNoise(config.noise, draws);
     Eigen::VectorXd z(2 + terrain.size());
-    z[1] = z_true[1] + config.noise.imu_roll_sd_rad * draws.unit(draws.rng);   // roll's draw first: the order
-    z[0] = z_true[0] + config.noise.imu_pitch_sd_rad * draws.unit(draws.rng);  // the shipped sets were made in
+    z[0] = z_true[0] + noise.imu_pitch_rad;
+    z[1] = z_true[1] + noise.imu_roll_rad;
     z.tail(terrain.size()) = terrain;
     pz->push_back(z);
     const Pose truth = sim.TorsoPose();
-    const Pose start = TrackerReading(truth, config.noise, draws.rng);
+    const Pose start = noise.start.Read(truth);
     if (TiltedBeyondThreshold(truth)) ++sum.tilted_executions;
     const long long touched = sim.SelfContactSteps();
     const bool fell = sim.RunCommand(c) != RunOutcome::kCompleted;
     ++sum.executions;
     if (sim.SelfContactSteps() > touched) ++sum.self_contact_executions;
     out->self_contact_by_command[id] += sim.SelfContactSteps() - touched;
-    const Pose end = TrackerReading(sim.TorsoPose(), config.noise, draws.rng);
+    const Pose end = noise.end.Read(sim.TorsoPose());
     px->push_back(DeltaPoseBody(start, end));
     if (fell) return false;
   }
