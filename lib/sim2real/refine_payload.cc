@@ -359,7 +359,8 @@ std::string Rugged(const AnalysisInputs& in, const std::vector<PayloadPoint>& gr
       rows.push_back(p->rows), v.push_back(along_mass ? p->mass : p->x);
     }
     const ScoreDip dip = DeepestDip(rows, v, in.real.episode, z);
-    if (dip.Found() && (!deepest.Found() || dip.Depth() > deepest.Depth())) deepest = dip, values = v, by_mass = along_mass;
+    if (!dip.Found() || (deepest.Found() && dip.Depth() <= deepest.Depth())) continue;
+    deepest = dip, values = v, by_mass = along_mass;
   }
   if (!deepest.Found()) return "";
   const std::string line = by_mass ? Fmt("at the forward offset %.3g m the recording of %.4g kg", best.x,
