@@ -82,7 +82,7 @@ def with_absolute_paths(cfg, config_path):
     """`cfg` with its files (the MJCF, a replayed controller's recordings) made absolute from the folder
     of config_path, so that a copy written elsewhere still finds them."""
     here = os.path.dirname(config_path)
-    if "mjcf_path" in cfg:
+    if cfg.get("mjcf_path"):  # empty: the built-in robot
         cfg["mjcf_path"] = os.path.abspath(os.path.join(here, cfg["mjcf_path"]))
     for rec in cfg.get("robot", {}).get("controller", {}).get("recordings", []):
         rec["file"] = os.path.abspath(os.path.join(here, rec["file"]))
