@@ -2,15 +2,17 @@
 """Is a simulated robot's walk chaotic? Records the paper protocol twice with one seed, once as the
 config is and once with its payload heavier by a small share of the robot's mass (at the payload's
 position, the torso's origin when it has none; by default 0.03%, 1 g on a 3.2 kg robot: a change
-no measurement of the real robot could see), and prints per pose
-axis the RMS of the two recordings' paired difference of x over the executions' spread about
-their command's mean:
+no measurement of the real robot could see), and prints per pose axis the RMS of the two
+recordings' paired difference of x over the executions' spread about their command's mean:
     ratio_j = sqrt(mean_i (x_ij - x'_ij)^2) / sd_j(x_i - mean of x over i's command).
 Near 0, the two recordings pair execution by execution: dgmm sim2real's signatures (a knob's
 recording less the nominal's, same seed) cancel the walk's own variation. Near sqrt(2) = 1.41,
 every execution decorrelated by the change: a knob's recording then differs from the nominal's by
 chance as much as by its physics, and no knob value is read from one recording
-(docs/sim2real.md, "A chaotic walk").
+(docs/sim2real.md, "A chaotic walk"). After a fall dgmm simulate draws every later placement's
+sensor noise afresh (its retries draw from the recording's stream), so when either recording fell
+the script says so and the ratio may overstate the walk's chaos (not when both fell at the same
+placements alike).
 
 Usage: scripts/walk_chaos.py --config datasets/robots/planar_quadruped.json [--build build]
                              [--seed 5] [--share 0.0003]
@@ -59,7 +61,9 @@ def record(dgmm, cfg, seed, where):
         raise RuntimeError((run.stderr.strip().splitlines() or ["dgmm simulate failed"])[-1])
     with h5py.File(where + ".h5", "r") as f:
         keys = list(zip(f["episode"][()], f["step"][()]))
-        return dict(zip(keys, f["x"][()])), dict(zip(keys, f["command"][()])), float(f["metadata"].attrs["robot_mass_kg"])
+        meta = f["metadata"].attrs
+        return (dict(zip(keys, f["x"][()])), dict(zip(keys, f["command"][()])), float(meta["robot_mass_kg"]),
+                int(meta["falls"]))
 
 
 def in_both(x, x_changed, command):
@@ -82,9 +86,9 @@ def main():
             raise RuntimeError(f"{dgmm} is not built")
         cfg = with_absolute_paths(json.load(open(a.config)), a.config)
         with tempfile.TemporaryDirectory() as tmp:
-            x, command, mass_kg = record(dgmm, cfg, a.seed, os.path.join(tmp, "as_is"))
+            x, command, mass_kg, falls = record(dgmm, cfg, a.seed, os.path.join(tmp, "as_is"))
             added_kg = a.share * mass_kg
-            x_changed, _, _ = record(dgmm, heavier(cfg, added_kg), a.seed, os.path.join(tmp, "heavier"))
+            x_changed, _, _, falls_changed = record(dgmm, heavier(cfg, added_kg), a.seed, os.path.join(tmp, "heavier"))
         x, x_changed, command, unpaired = in_both(x, x_changed, command)
         ratio = paired_ratio(x, x_changed, command)
     except (OSError, ValueError, RuntimeError) as e:
@@ -94,7 +98,9 @@ def main():
     print(f"{a.config}: {1000 * added_kg:.3g} g more ({a.share:g} of {mass_kg:.3g} kg), seed {a.seed}: "
           f"paired difference / spread: {cells}; "
           f"largest {ratio.max():.3f} (0: recordings pair; 1.41: every execution decorrelated)" +
-          (f"; {unpaired} executions of placements where either fell left out" if unpaired else ""))
+          (f"; {unpaired} executions of placements where either fell left out" if unpaired else "") +
+          (f"; falls {falls} and {falls_changed}: after a fall dgmm simulate draws later placements' sensor noise "
+           "afresh, so the ratio may overstate the walk's chaos" if falls or falls_changed else ""))
     return 0
 
 
