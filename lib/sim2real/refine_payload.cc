@@ -331,15 +331,12 @@ SearchSpan AsWell(const AnalysisInputs& in, const std::vector<PayloadPoint>& gri
 
 // The recorded points through the best on its sideways way along one line, each place once: the
 // masses at its forward offset (`along_mass`) or the forward offsets at its mass.
-std::vector<const PayloadPoint*> LineThrough(const std::vector<PayloadPoint>& grid, const PayloadPoint& best,
-                                             bool along_mass) {
-  std::vector<const PayloadPoint*> line;
+std::vector<PayloadPoint> LineThrough(const std::vector<PayloadPoint>& grid, const PayloadPoint& best,
+                                      bool along_mass) {
+  std::vector<PayloadPoint> line;
   for (const auto& p : grid) {
     const bool on = p.moment == best.moment && (along_mass ? p.x == best.x : p.mass == best.mass);
-    const bool again = std::any_of(line.begin(), line.end(), [&](const PayloadPoint* q) {
-      return q->mass == p.mass && q->x == p.x && q->y == p.y;
-    });
-    if (on && !again) line.push_back(&p);
+    if (on && !SamePlace(line, p)) line.push_back(p);
   }
   return line;
 }
@@ -355,8 +352,8 @@ std::string Rugged(const AnalysisInputs& in, const std::vector<PayloadPoint>& gr
   for (const bool along_mass : {true, false}) {
     std::vector<Eigen::VectorXd> rows;
     std::vector<double> v;
-    for (const PayloadPoint* p : LineThrough(grid, best, along_mass)) {
-      rows.push_back(p->rows), v.push_back(along_mass ? p->mass : p->x);
+    for (const PayloadPoint& p : LineThrough(grid, best, along_mass)) {
+      rows.push_back(p.rows), v.push_back(along_mass ? p.mass : p.x);
     }
     const ScoreDip dip = DeepestDip(rows, v, in.real.episode, z);
     if (!dip.Found() || (deepest.Found() && dip.Depth() <= deepest.Depth())) continue;
