@@ -15,13 +15,62 @@ constexpr int kTailsBootstrap = 200;  // placement resamples of the tails test's
 
 std::string Value(double v, const std::string& unit) { return Fmt("%.4g", v) + (unit.empty() ? "" : " " + unit); }
 
-KnobCheck CheckKnob(const CandidateSet& set, const Refinement& r, int pos, const AdequacyOptions& options) {
+// The median chance share of the simulator's knobs' candidates (NaN: not measured).
+double MedianChanceShare(const CandidateSet& set) {
+  std::vector<double> shares;
+  for (double s : set.chance_share) {
+    if (!std::isnan(s)) shares.push_back(s);
+  }
+  if (shares.empty()) return NAN;
+  std::nth_element(shares.begin(), shares.begin() + shares.size() / 2, shares.end());
+  return shares[shares.size() / 2];
+}
+
+// "a payload 0.001 kg heavier moves paired executions by 1.38 of their spread in dyaw"
+std::string ChanceWords(const AnalysisInputs& in, const WalkChance& chance) {
+  const auto& names = in.sim_set.x_names;
+  const int j = chance.largest_axis;
+  return "a payload " + Fmt("%.3g kg", chance.added_kg) +
+         Fmt(" heavier moves paired executions by %.2f", chance.largest_ratio) +
+         " of their spread" + (j >= 0 && j < static_cast<int>(names.size()) ? " in " + names[j] : "");
+}
+
+// Is the selection's entry `pos` largely chance: a simulator knob's fitted effect, or for a measurement
+// effect the median simulator knob's probe?
+void CheckChance(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, int pos,
+                 const AdequacyOptions& options, KnobCheck* check) {
+  const int k = r.selection.selected[pos];
+  const KnobCandidate& c = set.candidates[k];
+  if (c.simulated) {
+    check->chance_share = FittedChanceShare(set.chance, r.problem.d[k], r.selection.fit.theta[pos], in.real);
+  }
+  const double own = check->chance_share;
+  if (c.simulated && own > options.max_chance_share) {
+    check->chaotic = true;
+    check->doubts.push_back(c.knob + Fmt(": the walk's own chance makes %.2f of its fitted effect (", own) +
+                            ChanceWords(in, set.chance) +
+                            "): the simulated walk is chaotic, and its value is read from chance as much as from "
+                            "physics");
+  }
+  const double median = MedianChanceShare(set);
+  if (!c.simulated && median > options.max_chance_share) {
+    check->chaotic = true;
+    check->doubts.push_back(c.knob +
+                            Fmt(": the simulated walk is chaotic (its own chance makes a median %.2f", median) +
+                            " of the simulator's knobs' signatures; " + ChanceWords(in, set.chance) +
+                            "): a measurement effect may stand in for physics whose signature chance hides");
+  }
+}
+
+KnobCheck CheckKnob(const AnalysisInputs& in, const CandidateSet& set, const Refinement& r, int pos,
+                    const AdequacyOptions& options) {
   KnobCheck check;
   const int k = r.selection.selected[pos];
   const KnobCandidate& c = set.candidates[k];
   check.candidate = k;
   check.fitted = CandidateValue(set, r, k, r.selection.fit.theta[pos]);
   check.value = check.fitted;
+  CheckChance(in, set, r, pos, options, &check);
   if (!c.simulated && c.family != "tracker_noise") return check;  // a measurement offset has no range
   const double lo = c.family == "tracker_noise" && c.lo == c.hi ? -INFINITY : c.lo;
   const double hi = c.family == "tracker_noise" && c.lo == c.hi ? INFINITY : c.hi;
@@ -161,8 +210,9 @@ void TestFit(const AnalysisInputs& in, const Baseline& base, const NullShortfall
 }  // namespace
 
 bool AdequacyOptions::IsValid(std::string* error) const {
-  if (!(shortfall_z > 0) || !(min_shortfall_nats >= 0) || !(pinned_within >= 0 && pinned_within < 0.5)) {
-    if (error) *error = "shortfall_z > 0, min_shortfall_nats >= 0, 0 <= pinned_within < 0.5";
+  if (!(shortfall_z > 0) || !(min_shortfall_nats >= 0) || !(pinned_within >= 0 && pinned_within < 0.5) ||
+      !(max_chance_share > 0)) {
+    if (error) *error = "shortfall_z > 0, min_shortfall_nats >= 0, 0 <= pinned_within < 0.5, max_chance_share > 0";
     return false;
   }
   return locate.IsValid(error) && residual.IsValid(error) && drift.IsValid(error) && null_shortfall.IsValid(error);
@@ -203,7 +253,7 @@ Adequacy AssessAdequacy(const AnalysisInputs& in, const Baseline& base, const Nu
   TestResidual(in, base, r, options, &out);
   TestFit(in, base, null, r, options, &out);
   for (size_t pos = 0; pos < r.selection.selected.size(); ++pos) {
-    out.checks.push_back(CheckKnob(set, r, static_cast<int>(pos), options));
+    out.checks.push_back(CheckKnob(in, set, r, static_cast<int>(pos), options));
   }
   return out;
 }

@@ -11,9 +11,11 @@
 //     is a doubt;
 //   - each selected knob: its value (the fit's own reading) inside the knob's range, not pinned at
 //     a limit, physically possible (>= physical_min; a gain or friction at 0 is not), its
-//     refinement converged, and its likelihood search rose to one peak (refine.h);
+//     refinement converged, its likelihood search rose to one peak (refine.h), and its signature
+//     is not largely the simulated walk's own chance (walk_chance.h);
 //   - the residual: structure within placements or in the tails (residual_structure.h), and
 //     whether each effect is constant over the session and the execution index (drift.h).
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -31,6 +33,9 @@ struct AdequacyOptions {
   double shortfall_z = 3.0;           // SEs below the ceiling that make a doubt ...
   double min_shortfall_nats = 0.05;   // ... when also this far below (nats per real sample)
   double pinned_within = 1e-3;        // share of the knob's range counted as "at the limit"
+  // A named knob whose fitted effect the walk's own chance makes this much of is doubted
+  // (walk_chance.h); so is a named measurement effect when the median simulator knob's probe's is.
+  double max_chance_share = 0.5;
   NullShortfallOptions null_shortfall;  // seeded from seed + 11 (0 draws: the null is 0)
   bool IsValid(std::string* error) const;
 };
@@ -42,6 +47,8 @@ struct KnobCheck {
   bool outside_range = false, pinned_low = false, pinned_high = false, impossible = false;
   bool unconverged = false;
   bool rugged = false;      // its likelihood search does not rise to one peak (KnobRefinement::rugged)
+  bool chaotic = false;     // its signature is largely the walk's chance (AdequacyOptions::max_chance_share)
+  double chance_share = NAN;  // of a simulator knob's fitted effect (walk_chance.h, FittedChanceShare)
   std::vector<std::string> doubts;  // in words, naming the knob
 };
 

@@ -1,6 +1,7 @@
 #include "sim2real/candidates.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "sim2real/sentence_format.h"
 #include "util/error.h"
@@ -42,7 +43,9 @@ std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& 
   std::vector<std::vector<KnobValue>> requests;
   std::vector<Probe> probes;
   const bool need_nominal = set->nominal.size() == 0;
+  const std::vector<KnobValue> replica = need_nominal ? ChanceRequest(sim, options.chance) : std::vector<KnobValue>{};
   if (need_nominal) requests.emplace_back();
+  if (!replica.empty()) requests.push_back(replica);
   for (int k : knobs) {
     for (double v : sim.knobs()[k].probes) {
       requests.push_back({KnobValue{k, v}});
@@ -53,7 +56,15 @@ std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& 
   set->requests += static_cast<int>(requests.size());
   set->seconds += batch.wall_seconds;
   if (need_nominal) set->nominal = std::move(batch.sets[0]);
-  for (size_t p = 0; p < probes.size(); ++p) probes[p].set = std::move(batch.sets[p + (need_nominal ? 1 : 0)]);
+  if (!replica.empty()) {
+    set->chance = MeasureWalkChance(set->nominal, batch.sets[1], in.sim_set,
+                                    replica[0].value - sim.knobs()[replica[0].knob].nominal, options.slope_ridge);
+  } else if (need_nominal) {
+    set->chance.why_not = options.chance.share > 0 ? "the simulator has no payload to add a negligible mass to"
+                                                   : "not asked for (share 0)";
+  }
+  const size_t first = (need_nominal ? 1 : 0) + (replica.empty() ? 0 : 1);
+  for (size_t p = 0; p < probes.size(); ++p) probes[p].set = std::move(batch.sets[p + first]);
   return probes;
 }
 
@@ -157,6 +168,12 @@ void BuildLibrary(const KnobSimulator& sim, const AnalysisInputs& in, std::vecto
   AddKnobCandidates(sim, in, probes, options.slope_ridge, set);
   AddPayload(sim, set);
   AddImuAndHeading(in, options.imu_offset, set);
+  set->chance_share.assign(set->candidates.size(), NAN);
+  for (size_t k = 0; k < set->candidates.size(); ++k) {
+    if (set->candidates[k].simulated) {
+      set->chance_share[k] = ChanceShare(set->chance, set->shifts, set->externals[k].shifts, in.real);
+    }
+  }
 }
 
 // The first pass: forward selection with the backward pass over every candidate but the legs.
@@ -250,7 +267,7 @@ bool CandidateOptions::IsValid(std::string* error) const {
     if (error) *error = "only_knobs: knob indices >= 0";
     return false;
   }
-  return recording.IsValid(error) && first_pass.IsValid(error);
+  return recording.IsValid(error) && first_pass.IsValid(error) && chance.IsValid(error);
 }
 
 Eigen::VectorXd CandidateLogVariance(const CandidateSet& set, int k) {
@@ -283,6 +300,7 @@ void KeepCandidate(const CandidateSet& first_look, int k, const std::vector<int>
   set->candidates.push_back(first_look.candidates[k]);
   set->library.push_back(first_look.library[k]);
   set->externals.push_back(std::move(e));
+  set->chance_share.push_back(k < static_cast<int>(first_look.chance_share.size()) ? first_look.chance_share[k] : NAN);
 }
 
 }  // namespace

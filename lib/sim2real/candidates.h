@@ -22,6 +22,7 @@
 #include "sim2real/selection.h"
 #include "sim2real/signatures.h"
 #include "sim2real/simulation_cache.h"
+#include "sim2real/walk_chance.h"
 
 namespace dgmm::sim2real {
 
@@ -49,6 +50,9 @@ struct CandidateOptions {
   // The IMU's pitch/roll offset is a candidate (false: the analysis again without it, when the
   // torso's posture contradicted the one a first fit named; PostureOptions::refit_without_imu).
   bool imu_offset = true;
+  // The nominal is recorded once more with a payload this much heavier (walk_chance.h): how much of
+  // each candidate's signature the walk's own chance makes.
+  WalkChanceOptions chance;
   bool IsValid(std::string* error) const;
 };
 
@@ -73,6 +77,8 @@ struct CandidateSet {
   std::vector<ExternalCandidate> externals;
   std::vector<PairedShift> shifts;          // the probes' paired shifts (refinement appends)
   SampleSet nominal;                        // the nominal re-recording
+  WalkChance chance;                        // its replica a negligible payload heavier
+  std::vector<double> chance_share;         // per candidate (NaN: a measurement effect or not measured)
   Recording recording;                      // what every signature recording repeats
   int payload_knob[3] = {-1, -1, -1};       // mass, x, y knob indices
   int payload_shift[3] = {-1, -1, -1};      // their probes' shifts

@@ -192,6 +192,12 @@ std::string PhysicsSection(const Analysis& a) {
     << Escape(a.candidates.legs_note) << ". A candidate is named when selected by held-out real likelihood, constant "
     << "over the session, and its family's bootstrap inclusion is at least "
     << F("%.0f%%", 100 * a.verdict.min_inclusion) << ".</p>\n";
+  if (a.candidates.chance.measured) {
+    const WalkChance& w = a.candidates.chance;
+    o << "<p>The walk's own chance: the nominal recorded again with a payload " << F("%.3g kg", w.added_kg)
+      << F(" heavier moves paired executions by up to %.2f of their spread", w.largest_ratio)
+      << " (0: they pair; 1.41: as unrelated as two draws).</p>\n";
+  }
   if (const LegSearch* own = NamedByOwnModels(a)) {
     const bool payload = own->by == "payload_search", leg = own->by == "leg_search";
     o << SearchIntro(own->by)

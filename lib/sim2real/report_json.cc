@@ -67,6 +67,23 @@ json StepsJson(const Analysis& a) {
   return steps;
 }
 
+// The walk's own chance (walk_chance.h): the replica's paired ratio per axis, each candidate's share.
+json WalkChanceJson(const Analysis& a) {
+  const WalkChance& w = a.candidates.chance;
+  if (!w.measured) return {{"measured", false}, {"why_not", w.why_not}};
+  json ratio = json::object(), share = json::object();
+  const auto& names = a.inputs.sim_set.x_names;
+  for (int j = 0; j < w.paired_ratio.size(); ++j) {
+    ratio[j < static_cast<int>(names.size()) ? names[j] : std::to_string(j)] = JsonNumber(w.paired_ratio(j));
+  }
+  for (size_t k = 0; k < a.candidates.chance_share.size(); ++k) {
+    const double v = a.candidates.chance_share[k];
+    if (!std::isnan(v)) share[a.candidates.candidates[k].key] = JsonNumber(v);
+  }
+  return {{"measured", true}, {"added_payload_kg", w.added_kg}, {"paired_ratio", ratio},
+          {"largest_ratio", JsonNumber(w.largest_ratio)}, {"chance_share", share}};
+}
+
 json KnobsJson(const Analysis& a) {
   const CandidateSet& set = a.candidates;
   const Refinement& r = a.refinement;
@@ -99,7 +116,7 @@ json KnobsJson(const Analysis& a) {
   json out = {{"candidates", cands}, {"selection_steps", StepsJson(a)}, {"removed_by_backward_pass", removed},
           {"refinement", trace}, {"refined", refined}, {"family_inclusion", family},
           {"bootstrap_resamples", a.confidence.resamples}, {"inert_knobs", set.inert_knobs},
-          {"unwalkable_probes", set.unwalkable_probes},
+          {"unwalkable_probes", set.unwalkable_probes}, {"walk_chance", WalkChanceJson(a)},
           {"per_leg_probes", {{"recorded", set.legs_probed}, {"why", set.legs_note}}}, {"spread", spread},
           {"recordings", {{"signatures", set.recorded}, {"signatures_from_cache", set.from_cache},
                           {"signature_requests", set.requests}, {"refinement", r.recorded},
@@ -135,7 +152,8 @@ json AdequacyJson(const Analysis& a) {
     checks.push_back({{"key", a.candidates.candidates[c.candidate].key}, {"fitted_value", JsonNumber(c.fitted)},
                       {"value", JsonNumber(c.value)}, {"outside_range", c.outside_range}, {"pinned_low", c.pinned_low},
                       {"pinned_high", c.pinned_high}, {"impossible", c.impossible}, {"unconverged", c.unconverged},
-                      {"not_single_peaked", c.rugged}, {"doubts", c.doubts}});
+                      {"not_single_peaked", c.rugged}, {"chaotic_walk", c.chaotic},
+                      {"chance_share", JsonNumber(c.chance_share)}, {"doubts", c.doubts}});
   }
   return {{"regions_after", Regions(q.after.regions)}, {"conditional_flagged_regions_after", q.after.conditional_flagged},
           {"heat_map_after", HeatMap(a, q.after.heat)},

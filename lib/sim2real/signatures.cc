@@ -62,14 +62,23 @@ Pairs<P> PairUp(const SampleSet& nominal, const SampleSet& perturbed, const Samp
 }
 
 // The fit of PairedShift::Fit in phi of size `size` (P: at compile time, or Eigen::Dynamic).
+struct ShiftFit {
+  Eigen::MatrixXd pooled;
+  std::vector<Eigen::MatrixXd> b;
+  Eigen::VectorXd log_var, paired_rms, nominal_sd;
+  int pairs = 0;
+};
+
 template <int P>
-void FitShift(const SampleSet& nominal, const SampleSet& perturbed, const SampleSet& table, double slope_ridge,
-              int size, Eigen::MatrixXd* pooled, std::vector<Eigen::MatrixXd>* b, Eigen::VectorXd* log_var,
-              int* pairs_out) {
+ShiftFit FitShift(const SampleSet& nominal, const SampleSet& perturbed, const SampleSet& table, double slope_ridge,
+                  int size) {
   const Pairs<P> pairs = PairUp<P>(nominal, perturbed, table, size);
   const int n = static_cast<int>(pairs.phi.size()), dx = nominal.pose_dim();
   if (n < 10) throw MakeInputError("signature", "", "fewer than 10 paired simulated samples");
-  *pairs_out = n;
+  ShiftFit out;
+  out.pairs = n;
+  Eigen::MatrixXd* pooled = &out.pooled;
+  std::vector<Eigen::MatrixXd>* b = &out.b;
   // Pooled fit (intercept, slopes, first flag) over all commands; the scale of z for the ridge.
   const Mat<P> zero = Mat<P>::Zero(size, size), eye = Mat<P>::Identity(size, size);
   Mat<P> gram = zero;
@@ -112,13 +121,17 @@ void FitShift(const SampleSet& nominal, const SampleSet& perturbed, const Sample
     bn[c] = solver.solve(rn[c]);
     bp[c] = solver.solve(rp[c]);
   }
-  Eigen::VectorXd ss_n = Eigen::VectorXd::Zero(dx), ss_p = Eigen::VectorXd::Zero(dx);
+  Eigen::VectorXd ss_n = Eigen::VectorXd::Zero(dx), ss_p = Eigen::VectorXd::Zero(dx), ss_d = ss_n;
   for (int i = 0; i < n; ++i) {
     const int c = pairs.command[i];
     ss_n += (pairs.xn[i] - bn[c].transpose() * pairs.phi[i]).cwiseAbs2();
     ss_p += (pairs.xp[i] - bp[c].transpose() * pairs.phi[i]).cwiseAbs2();
+    ss_d += (pairs.xp[i] - pairs.xn[i]).cwiseAbs2();
   }
-  *log_var = (ss_p.array() + 1e-30).log() - (ss_n.array() + 1e-30).log();
+  out.log_var = (ss_p.array() + 1e-30).log() - (ss_n.array() + 1e-30).log();
+  out.paired_rms = (ss_d / n).cwiseSqrt();
+  out.nominal_sd = (ss_n / n).cwiseSqrt();
+  return out;
 }
 
 }  // namespace
@@ -127,12 +140,10 @@ PairedShift PairedShift::Fit(const SampleSet& nominal, const SampleSet& perturbe
                              double slope_ridge) {
   PairedShift out;
   out.phi_size_ = 2 + std::max(2, nominal.terrain_dim());
-  if (out.phi_size_ == 4) {
-    FitShift<4>(nominal, perturbed, table, slope_ridge, 4, &out.pooled_, &out.b_, &out.log_var_, &out.pairs_);
-  } else {
-    FitShift<Eigen::Dynamic>(nominal, perturbed, table, slope_ridge, out.phi_size_, &out.pooled_, &out.b_,
-                             &out.log_var_, &out.pairs_);
-  }
+  ShiftFit f = out.phi_size_ == 4 ? FitShift<4>(nominal, perturbed, table, slope_ridge, 4)
+                                   : FitShift<Eigen::Dynamic>(nominal, perturbed, table, slope_ridge, out.phi_size_);
+  out.pooled_ = std::move(f.pooled), out.b_ = std::move(f.b), out.log_var_ = std::move(f.log_var);
+  out.paired_rms_ = std::move(f.paired_rms), out.nominal_sd_ = std::move(f.nominal_sd), out.pairs_ = f.pairs;
   return out;
 }
 

@@ -26,13 +26,18 @@ class PairedShift {
   // log(var_perturbed / var_nominal) per dimension of x: residuals about each command's linear
   // fit in phi (the spread the sim model's covariance describes), pooled over commands.
   const Eigen::VectorXd& log_variance_ratio() const { return log_var_; }
+  // Per dimension of x: RMS over the pairs of x_probe - x_nominal, and the nominal's spread about each
+  // command's linear fit in phi. Their ratio says how far apart paired executions walk (0: the probe
+  // moved nothing; sqrt 2: paired executions as unrelated as two draws, walk_chance.h).
+  const Eigen::VectorXd& paired_rms() const { return paired_rms_; }
+  const Eigen::VectorXd& nominal_sd() const { return nominal_sd_; }
   int pairs() const { return pairs_; }
 
  private:
   std::vector<Eigen::MatrixXd> b_;  // per sim command: phi x dx (empty: not simulated, use pooled)
   Eigen::MatrixXd pooled_;          // phi x dx
   int phi_size_ = 4;                // 2 + max(2, conditioning dims)
-  Eigen::VectorXd log_var_;
+  Eigen::VectorXd log_var_, paired_rms_, nominal_sd_;
   int pairs_ = 0;
 };
 

@@ -52,7 +52,8 @@ VerdictNamed Named(const CandidateSet& set, const Refinement& r, const Confidenc
   const std::pair<bool, const char*> flags[] = {{check.pinned_low, "pinned_low"},     {check.pinned_high, "pinned_high"},
                                                 {check.outside_range, "outside_range"}, {check.impossible, "impossible"},
                                                 {check.unconverged, "unconverged"},
-                                                {check.rugged, "not_single_peaked"}};
+                                                {check.rugged, "not_single_peaked"},
+                                                {check.chaotic, "chaotic_walk"}};
   for (const auto& [on, name] : flags) {
     if (on) n.flags.push_back(name);
   }

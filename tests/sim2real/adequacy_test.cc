@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include "sim2real/sentence_format.h"
 #include "tests/sim2real/stage_fixture.h"
 
 namespace dgmm::sim2real {
@@ -25,6 +26,55 @@ TEST(Adequacy, APlantedKnobInsideItsRangeLeavesNoDoubt) {
   EXPECT_TRUE(s.adequacy.doubts.empty()) << s.adequacy.doubts.front();
   EXPECT_TRUE(s.adequacy.remaining.empty());
   EXPECT_FALSE(s.adequacy.below_ceiling);
+}
+
+// A named knob whose fitted effect is largely the walk's own chance (walk_chance.h) is doubted with
+// the flag; on a walk that pairs it is not. The chance here is the chaotic fake's, and the share
+// it makes of the fake friction's effect decides against the threshold.
+TEST(Adequacy, ANamedKnobWhoseEffectIsLargelyChanceIsDoubted) {
+  test::Stages s = test::RunStages({{test::kFriction, 0.6}}, 6);
+  const KnobCheck* clear = CheckOf(s, "friction");
+  ASSERT_NE(clear, nullptr);
+  const size_t at = clear - s.adequacy.checks.data();
+  EXPECT_FALSE(clear->chaotic);
+  EXPECT_LT(clear->chance_share, 0.05);
+  test::FakeSimulator chaotic;
+  chaotic.walk_chaos = 1;
+  const std::vector<KnobValue> gram = {{test::kPayloadMass, 0.003}};
+  s.set.chance = MeasureWalkChance(chaotic.Record(s.set.recording, {}, 1), chaotic.Record(s.set.recording, gram, 1),
+                                   s.in.sim_set, 0.003, 5.0);
+  ASSERT_TRUE(s.set.chance.measured);
+  const double share = FittedChanceShare(s.set.chance, s.refinement.problem.d[clear->candidate],
+                                         s.refinement.selection.fit.theta[at], s.in.real);
+  ASSERT_GT(share, 0.05);
+  AdequacyOptions options = s.options.adequacy;
+  options.max_chance_share = 1.1 * share;
+  EXPECT_FALSE(AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, options).checks[at].chaotic);
+  options.max_chance_share = 0.9 * share;
+  const KnobCheck c = AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, options).checks[at];
+  EXPECT_TRUE(c.chaotic);
+  EXPECT_NEAR(c.chance_share, share, 1e-12);
+  ASSERT_EQ(c.doubts.size(), 1u);
+  EXPECT_NE(c.doubts[0].find(Fmt("makes %.2f of its fitted effect", share)), std::string::npos) << c.doubts[0];
+  EXPECT_NE(c.doubts[0].find(Fmt("by %.2f of their spread in ", s.set.chance.largest_ratio)), std::string::npos)
+      << c.doubts[0];
+}
+
+// On a chaotic walk a measurement effect's signature is exact while the simulator's knobs' are
+// chance: a named tracker offset may stand in for physics, and says so.
+TEST(Adequacy, AMeasurementEffectNamedOnAChaoticWalkIsDoubted) {
+  test::FakeExtras extras;
+  extras.tracker_bias = Eigen::Vector3d(0.01, 0, 0);
+  test::Stages s = test::RunStages({}, 6, extras);
+  const KnobCheck* bias = CheckOf(s, "tracker_bias");
+  ASSERT_NE(bias, nullptr);
+  EXPECT_FALSE(bias->chaotic);
+  for (double& share : s.set.chance_share) share = std::isnan(share) ? share : 0.9;
+  const Adequacy a = AssessAdequacy(s.in, s.base, s.null, s.set, s.refinement, s.options.adequacy);
+  const KnobCheck& c = a.checks[bias - s.adequacy.checks.data()];
+  EXPECT_TRUE(c.chaotic);
+  ASSERT_FALSE(c.doubts.empty());
+  EXPECT_NE(c.doubts.back().find("may stand in for physics"), std::string::npos) << c.doubts.back();
 }
 
 // A search whose scores dipped (refine_search.h, DeepestDip): the knob's check carries its words as

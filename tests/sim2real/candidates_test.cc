@@ -22,8 +22,8 @@ TEST(Candidates, TheLibraryOfAFakeWithoutAnImplicatedSide) {
   EXPECT_LT(test::CandidateOf(set, "actuators.leg0.gain@0.5"), 0);
   EXPECT_GE(set.tracker_shift, 0);
   EXPECT_EQ(set.library[test::CandidateOf(set, "payload")].num_params(), 3);
-  // nominal + the probes of every knob but the legs
-  EXPECT_EQ(set.requests, 1 + test::kNumFakeKnobs - 4);
+  // nominal, its replica a negligible payload heavier (walk_chance.h) + the probes of every knob but the legs
+  EXPECT_EQ(set.requests, 2 + test::kNumFakeKnobs - 4);
   EXPECT_EQ(set.candidates.size(), set.library.size());
   EXPECT_EQ(set.candidates.size(), set.externals.size());
 }
@@ -58,7 +58,7 @@ TEST(Candidates, OnlyTheScreenedKnobsAreRecorded) {
   options.only_knobs = std::vector<int>{test::kPayloadY, test::kFriction, test::kPayloadMass, test::kPayloadX,
                                         test::kLeg1Gain, test::kFriction};
   const CandidateSet set = BuildCandidates(test::SharedFake(), s.in, s.base, options);
-  EXPECT_EQ(set.requests, 1 + 5) << "the nominal and five knobs' probes, each once";
+  EXPECT_EQ(set.requests, 2 + 5) << "the nominal, its replica and five knobs' probes, each once";
   for (const std::string key : {"tracker_bias", "tracker_noise", "floor.friction@0.6", "payload",
                                 "actuators.leg1.gain@0.5"}) {
     EXPECT_GE(test::CandidateOf(set, key), 0) << key;
@@ -93,6 +93,9 @@ TEST(Candidates, TheFirstLooksOtherCandidatesAreKept) {
   EXPECT_EQ(kept_shift.pairs(), first_shift.pairs());
   EXPECT_EQ(again.candidates.size(), again.library.size());
   EXPECT_EQ(again.candidates.size(), again.externals.size());
+  ASSERT_EQ(again.chance_share.size(), again.candidates.size());
+  EXPECT_EQ(again.chance_share[payload], s.set.chance_share[test::CandidateOf(s.set, "payload")])
+      << "a kept candidate keeps its first look's share of chance";
 }
 
 // A screen of no knob (a first look whose finding was a measurement effect, on a robot without a
@@ -103,7 +106,7 @@ TEST(Candidates, AnEmptyScreenRecordsTheNominalAlone) {
   CandidateOptions options = s.options.candidates;
   options.only_knobs = std::vector<int>{};
   CandidateSet again = BuildCandidates(test::SharedFake(), s.in, s.base, options);
-  EXPECT_EQ(again.requests, 1) << "the nominal";
+  EXPECT_EQ(again.requests, 2) << "the nominal and its replica";
   for (const KnobCandidate& c : again.candidates) EXPECT_FALSE(c.simulated) << c.key;
   EXPECT_GE(test::CandidateOf(again, "tracker_bias"), 0);
   EXPECT_FALSE(again.legs_probed);

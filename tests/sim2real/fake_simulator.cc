@@ -112,6 +112,18 @@ void Placement(std::uint64_t seed, int p, std::mt19937_64* rng, int* command, do
   *heading = (p / 12) % 6 * M_PI / 3 + std::uniform_real_distribution<double>(-0.2, 0.2)(*rng);
 }
 
+// The seed of a chaotic walk's own way at knob values k (0 at the nominal: it walks as always).
+std::uint64_t WalkOfValues(const std::vector<Knob>& knobs, const Values& k, std::uint64_t seed) {
+  std::uint64_t h = 0;
+  for (int j = 0; j < kNumFakeKnobs; ++j) {
+    if (k.v[j] == knobs[j].nominal) continue;
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &k.v[j], sizeof bits);
+    h = (h ^ (bits + 0x9e3779b97f4a7c15ULL * (j + 1))) * 0x100000001b3ULL;
+  }
+  return h == 0 ? 0 : h ^ (seed * 0xbf58476d1ce4e5b9ULL);
+}
+
 }  // namespace
 
 FakeSimulator::FakeSimulator() {
@@ -167,6 +179,8 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
   s.x.resize(n, 3), s.z.resize(n, 2);
   std::mt19937_64 rng;
   std::normal_distribution<double> unit(0, 1);
+  const std::uint64_t way = walk_chaos != 0 ? WalkOfValues(knobs_, k, recording.seed) : 0;
+  std::mt19937_64 own_way(way);
   for (int p = 0; p < placements; ++p) {
     int c;
     double heading;
@@ -185,6 +199,10 @@ SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vecto
       const double pitch = tilt(0) + z_sd * unit(rng);
       const double roll = tilt(1) + z_sd * unit(rng);
       Eigen::Vector3d noise(unit(rng), unit(rng), unit(rng));
+      if (way != 0) {  // the walk's own way: as much noise, a share walk_chaos of it unpaired
+        const Eigen::Vector3d chance(unit(own_way), unit(own_way), unit(own_way));
+        noise = std::sqrt(1 - walk_chaos * walk_chaos) * noise + walk_chaos * chance;
+      }
       s.command(i) = c, s.episode(i) = p, s.step(i) = e;
       s.z.row(i) << pitch + extras.imu_offset(0), roll + extras.imu_offset(1);
       const Eigen::Vector2d felt = Eigen::Vector2d(pitch, roll) + extras.motion_tilt;

@@ -85,7 +85,8 @@ class FakeSimulator : public KnobSimulator {
            (payload.chaos != 0 ? "-chaos-" + std::to_string(payload.chaos) : "") + (level ? "-level" : "") +
            (sloped_plane ? "-sloped-plane" : "") +
            (level_z_sd != 0.02 ? "-z-sd-" + std::to_string(level_z_sd) : "") +
-           (tilt_steers != 0 ? "-tilt-steers-" + std::to_string(tilt_steers) : "");
+           (tilt_steers != 0 ? "-tilt-steers-" + std::to_string(tilt_steers) : "") +
+           (walk_chaos != 0 ? "-walk-chaos-" + std::to_string(walk_chaos) : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -122,6 +123,10 @@ class FakeSimulator : public KnobSimulator {
   double tilt_steers = 0;
   // How the payload acts (FakePayload); the default is linear in its mass and moments.
   FakePayload payload;
+  // A chaotic walk (0 to 1): a recording at any other knob values than the nominal walks its own
+  // way, its noise e replaced by sqrt(1 - a^2) e + a e', e' ~ N(0, 1) drawn from the recording's seed
+  // and knob values: the same spread, paired executions sqrt(2 - 2 sqrt(1 - a^2)) sds apart.
+  double walk_chaos = 0;
   // Record as many executions per placement as the recording asks for (else always 5, the
   // protocol's own number, whatever it asks for).
   bool honour_executions = false;

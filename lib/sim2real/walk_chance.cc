@@ -1,0 +1,81 @@
+#include "sim2real/walk_chance.h"
+
+#include <cmath>
+
+#include "util/error.h"
+
+namespace dgmm::sim2real {
+
+bool WalkChanceOptions::IsValid(std::string* error) const {
+  if (!(share >= 0 && share < 0.1)) {
+    if (error) *error = "walk chance: 0 <= share < 0.1 of the robot's mass";
+    return false;
+  }
+  return true;
+}
+
+std::vector<KnobValue> ChanceRequest(const KnobSimulator& simulator, const WalkChanceOptions& options) {
+  if (options.share <= 0) return {};
+  const auto& knobs = simulator.knobs();
+  for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
+    if (knobs[k].role == Knob::Role::kPayloadMass) {
+      return {KnobValue{k, knobs[k].nominal + options.share * simulator.total_mass_kg()}};
+    }
+  }
+  return {};
+}
+
+WalkChance MeasureWalkChance(const SampleSet& nominal, const SampleSet& replica, const SampleSet& table,
+                             double added_kg, double slope_ridge) {
+  WalkChance out;
+  out.added_kg = added_kg;
+  try {
+    out.shift = PairedShift::Fit(nominal, replica, table, slope_ridge);
+  } catch (const InputError&) {
+    out.why_not = "the robot fell in most placements of the nominal's replica";
+    return out;
+  }
+  const Eigen::VectorXd sd = out.shift->nominal_sd().cwiseMax(1e-300);
+  out.paired_ratio = out.shift->paired_rms().cwiseQuotient(sd);
+  out.largest_ratio = out.paired_ratio.maxCoeff(&out.largest_axis);
+  out.measured = true;
+  return out;
+}
+
+double SignatureSize(const std::vector<PairedShift>& shifts, const std::vector<int>& of, const Samples& real,
+                     const Eigen::VectorXd& sd) {
+  double largest = 0;
+  for (int s : of) {
+    double sum = 0;
+    for (int i = 0; i < real.size(); ++i) {
+      const Eigen::VectorXd v = shifts[s].Shift(real.command[i], real.z.row(i).transpose(), real.first_execution[i]);
+      sum += v.cwiseQuotient(sd).squaredNorm();
+    }
+    largest = std::max(largest, std::sqrt(sum / std::max(1, real.size())));
+  }
+  return largest;
+}
+
+double ChanceShare(const WalkChance& chance, const std::vector<PairedShift>& shifts, const std::vector<int>& of,
+                   const Samples& real) {
+  if (!chance.measured || of.empty()) return NAN;
+  const Eigen::VectorXd sd = chance.shift->nominal_sd().cwiseMax(1e-300);
+  const double own = SignatureSize(shifts, of, real, sd);
+  const double luck = SignatureSize({*chance.shift}, {0}, real, sd);
+  return own > 0 ? luck / own : INFINITY;
+}
+
+double FittedChanceShare(const WalkChance& chance, const Eigen::MatrixXd& design, const Eigen::VectorXd& theta,
+                         const Samples& real) {
+  if (!chance.measured || real.size() == 0 || design.cols() != theta.size()) return NAN;
+  const Eigen::VectorXd sd = chance.shift->nominal_sd().cwiseMax(1e-300);
+  const int dx = static_cast<int>(sd.size());
+  const Eigen::VectorXd effect = design * theta;
+  double sum = 0;
+  for (int i = 0; i < real.size(); ++i) sum += effect.segment(i * dx, dx).cwiseQuotient(sd).squaredNorm();
+  const double own = std::sqrt(sum / real.size());
+  const double luck = SignatureSize({*chance.shift}, {0}, real, sd) * theta.norm();
+  return own > 0 ? luck / own : INFINITY;
+}
+
+}  // namespace dgmm::sim2real
