@@ -1,10 +1,22 @@
 #include "sim2real/walk_chance.h"
 
 #include <cmath>
+#include <limits>
 
 #include "util/error.h"
 
 namespace dgmm::sim2real {
+
+namespace {
+
+// The nominal's spread per axis, floored at a billionth of its largest axis (a pose entry that never
+// moves divides by that, not by 0).
+Eigen::VectorXd Spread(const PairedShift& shift) {
+  const Eigen::VectorXd& sd = shift.nominal_sd();
+  return sd.cwiseMax(1e-9 * sd.maxCoeff()).cwiseMax(std::numeric_limits<double>::min());
+}
+
+}  // namespace
 
 bool WalkChanceOptions::IsValid(std::string* error) const {
   if (!(share >= 0 && share < 0.1)) {
@@ -35,7 +47,7 @@ WalkChance MeasureWalkChance(const SampleSet& nominal, const SampleSet& replica,
     out.why_not = "the robot fell in most placements of the nominal's replica";
     return out;
   }
-  const Eigen::VectorXd sd = out.shift->nominal_sd().cwiseMax(1e-300);
+  const Eigen::VectorXd sd = Spread(*out.shift);
   out.paired_ratio = out.shift->paired_rms().cwiseQuotient(sd);
   out.largest_ratio = out.paired_ratio.maxCoeff(&out.largest_axis);
   out.measured = true;
@@ -59,7 +71,7 @@ double SignatureSize(const std::vector<PairedShift>& shifts, const std::vector<i
 double ChanceShare(const WalkChance& chance, const std::vector<PairedShift>& shifts, const std::vector<int>& of,
                    const Samples& real) {
   if (!chance.measured || of.empty()) return NAN;
-  const Eigen::VectorXd sd = chance.shift->nominal_sd().cwiseMax(1e-300);
+  const Eigen::VectorXd sd = Spread(*chance.shift);
   const double own = SignatureSize(shifts, of, real, sd);
   const double luck = SignatureSize({*chance.shift}, {0}, real, sd);
   return own > 0 ? luck / own : INFINITY;
@@ -68,7 +80,7 @@ double ChanceShare(const WalkChance& chance, const std::vector<PairedShift>& shi
 double FittedChanceShare(const WalkChance& chance, const Eigen::MatrixXd& design, const Eigen::VectorXd& theta,
                          const Samples& real) {
   if (!chance.measured || real.size() == 0 || design.cols() != theta.size()) return NAN;
-  const Eigen::VectorXd sd = chance.shift->nominal_sd().cwiseMax(1e-300);
+  const Eigen::VectorXd sd = Spread(*chance.shift);
   const int dx = static_cast<int>(sd.size());
   const Eigen::VectorXd effect = design * theta;
   double sum = 0;
