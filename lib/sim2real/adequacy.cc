@@ -42,18 +42,19 @@ void CheckChance(const AnalysisInputs& in, const CandidateSet& set, const Refine
   const int k = r.selection.selected[pos];
   const KnobCandidate& c = set.candidates[k];
   if (c.simulated) {
-    check->chance_share = FittedChanceShare(set.chance, r.problem.d[k], r.selection.fit.theta[pos], in.real);
-  }
-  const double own = check->chance_share;
-  if (c.simulated && own > options.max_chance_share) {
-    check->chaotic = true;
-    check->doubts.push_back(c.knob + Fmt(": the walk's own chance makes %.2f of its fitted effect (", own) +
-                            ChanceWords(in, set.chance) +
-                            "): the simulated walk is chaotic, and its value is read from chance as much as from "
-                            "physics");
+    const double own = FittedChanceShare(set.chance, r.problem.d[k], r.selection.fit.theta[pos], in.real);
+    check->chance_share = own;
+    if (own > options.max_chance_share) {
+      check->chaotic = true;
+      check->doubts.push_back(c.knob + Fmt(": the walk's own chance makes %.2f of its fitted effect (", own) +
+                              ChanceWords(in, set.chance) +
+                              "): the simulated walk is chaotic, and its value is read from chance as much as "
+                              "from physics");
+    }
+    return;
   }
   const double median = MedianChanceShare(set);
-  if (!c.simulated && median > options.max_chance_share) {
+  if (median > options.max_chance_share) {
     check->chaotic = true;
     check->doubts.push_back(c.knob +
                             Fmt(": the simulated walk is chaotic (its own chance makes a median %.2f", median) +

@@ -57,7 +57,7 @@ std::vector<Probe> RecordProbes(const KnobSimulator& sim, const AnalysisInputs& 
   set->seconds += batch.wall_seconds;
   if (need_nominal) set->nominal = std::move(batch.sets[0]);
   if (!replica.empty()) {
-    set->chance = MeasureWalkChance(set->nominal, batch.sets[1], in.sim_set,
+    set->chance = MeasureWalkChance(set->nominal, batch.sets[1], in.sim_set, in.real,
                                     replica[0].value - sim.knobs()[replica[0].knob].nominal, options.slope_ridge);
   } else if (need_nominal) {
     set->chance.why_not = options.chance.share > 0 ? "the simulator has no payload to add a negligible mass to"

@@ -38,7 +38,7 @@ std::vector<KnobValue> ChanceRequest(const KnobSimulator& simulator, const WalkC
 }
 
 WalkChance MeasureWalkChance(const SampleSet& nominal, const SampleSet& replica, const SampleSet& table,
-                             double added_kg, double slope_ridge) {
+                             const Samples& real, double added_kg, double slope_ridge) {
   WalkChance out;
   out.added_kg = added_kg;
   try {
@@ -47,8 +47,9 @@ WalkChance MeasureWalkChance(const SampleSet& nominal, const SampleSet& replica,
     out.why_not = "the robot fell in most placements of the nominal's replica";
     return out;
   }
-  const Eigen::VectorXd sd = Spread(*out.shift);
-  out.paired_ratio = out.shift->paired_rms().cwiseQuotient(sd);
+  out.spread = Spread(*out.shift);
+  out.size = SignatureSize({*out.shift}, {0}, real, out.spread);
+  out.paired_ratio = out.shift->paired_rms().cwiseQuotient(out.spread);
   out.largest_ratio = out.paired_ratio.maxCoeff(&out.largest_axis);
   out.measured = true;
   return out;
@@ -71,23 +72,20 @@ double SignatureSize(const std::vector<PairedShift>& shifts, const std::vector<i
 double ChanceShare(const WalkChance& chance, const std::vector<PairedShift>& shifts, const std::vector<int>& of,
                    const Samples& real) {
   if (!chance.measured || of.empty()) return NAN;
-  const Eigen::VectorXd sd = Spread(*chance.shift);
-  const double own = SignatureSize(shifts, of, real, sd);
-  const double luck = SignatureSize({*chance.shift}, {0}, real, sd);
-  return own > 0 ? luck / own : INFINITY;
+  const double own = SignatureSize(shifts, of, real, chance.spread);
+  return own > 0 ? chance.size / own : INFINITY;
 }
 
 double FittedChanceShare(const WalkChance& chance, const Eigen::MatrixXd& design, const Eigen::VectorXd& theta,
                          const Samples& real) {
   if (!chance.measured || real.size() == 0 || design.cols() != theta.size()) return NAN;
-  const Eigen::VectorXd sd = Spread(*chance.shift);
+  const Eigen::VectorXd& sd = chance.spread;
   const int dx = static_cast<int>(sd.size());
   const Eigen::VectorXd effect = design * theta;
   double sum = 0;
   for (int i = 0; i < real.size(); ++i) sum += effect.segment(i * dx, dx).cwiseQuotient(sd).squaredNorm();
   const double own = std::sqrt(sum / real.size());
-  const double luck = SignatureSize({*chance.shift}, {0}, real, sd) * theta.norm();
-  return own > 0 ? luck / own : INFINITY;
+  return own > 0 ? chance.size * theta.norm() / own : INFINITY;
 }
 
 }  // namespace dgmm::sim2real

@@ -30,6 +30,8 @@ struct WalkChance {
   std::string why_not;            // when not measured, in words
   double added_kg = 0;            // the payload's change recorded
   std::optional<PairedShift> shift;  // the replica's paired shift from the nominal
+  Eigen::VectorXd spread;         // the nominal's sd per pose axis (floored relative to its largest)
+  double size = 0;                // |S_chance| over the real samples, in units of `spread`
   Eigen::VectorXd paired_ratio;   // per pose axis
   int largest_axis = -1;
   double largest_ratio = 0;
@@ -39,10 +41,10 @@ struct WalkChance {
 // empty when the simulator has no payload mass knob or the share is 0.
 std::vector<KnobValue> ChanceRequest(const KnobSimulator& simulator, const WalkChanceOptions& options);
 
-// The chance measured from the nominal recording and its replica (at ChanceRequest's values);
-// not measured, with the reason, when too few executions pair up.
+// The chance measured from the nominal recording and its replica (at ChanceRequest's values), its
+// size over the real samples; not measured, with the reason, when too few executions pair up.
 WalkChance MeasureWalkChance(const SampleSet& nominal, const SampleSet& replica, const SampleSet& table,
-                             double added_kg, double slope_ridge);
+                             const Samples& real, double added_kg, double slope_ridge);
 
 // |S| of the shifts `of` (the largest of them) over the real samples, per axis in units of `sd`.
 double SignatureSize(const std::vector<PairedShift>& shifts, const std::vector<int>& of, const Samples& real,

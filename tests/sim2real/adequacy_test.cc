@@ -42,7 +42,7 @@ TEST(Adequacy, ANamedKnobWhoseEffectIsLargelyChanceIsDoubted) {
   chaotic.walk_chaos = 1;
   const std::vector<KnobValue> gram = {{test::kPayloadMass, 0.003}};
   s.set.chance = MeasureWalkChance(chaotic.Record(s.set.recording, {}, 1), chaotic.Record(s.set.recording, gram, 1),
-                                   s.in.sim_set, 0.003, 5.0);
+                                   s.in.sim_set, s.in.real, 0.003, 5.0);
   ASSERT_TRUE(s.set.chance.measured);
   const double share = FittedChanceShare(s.set.chance, s.refinement.problem.d[clear->candidate],
                                          s.refinement.selection.fit.theta[at], s.in.real);

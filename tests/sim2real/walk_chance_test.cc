@@ -62,7 +62,7 @@ TEST(WalkChance, NotMeasuredWhenAskedNotAndTooFewPairsSaySo) {
   EXPECT_NE(set.chance.why_not, "");
   for (double share : set.chance_share) EXPECT_TRUE(std::isnan(share));
   const SampleSet few = set.nominal.Subset({0, 1, 2});
-  const WalkChance w = MeasureWalkChance(set.nominal, few, s.in.sim_set, 0.003, 5.0);
+  const WalkChance w = MeasureWalkChance(set.nominal, few, s.in.sim_set, s.in.real, 0.003, 5.0);
   EXPECT_FALSE(w.measured);
   EXPECT_NE(w.why_not.find("fell"), std::string::npos) << w.why_not;
   options.chance.share = -1;
