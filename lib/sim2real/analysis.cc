@@ -115,6 +115,7 @@ LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
   o.model = options.locate.model;
   o.misfit_elsewhere = options.locate.uneven_ground;
   o.elsewhere_seed = options.seed + 17;
+  o.chance = options.candidates.chance;
   return o;
 }
 

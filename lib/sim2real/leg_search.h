@@ -25,6 +25,7 @@
 #include "sim2real/sag_mode.h"
 #include "sim2real/search_span.h"
 #include "sim2real/verdict.h"
+#include "sim2real/walk_chance.h"
 
 namespace dgmm::sim2real {
 
@@ -112,7 +113,29 @@ struct LegSearchOptions {
   bool null_corrected_gain = false;
   std::uint64_t elsewhere_seed = 1;
   LinearGaussianOptions model;   // each recording's own model (the analysis copies the baseline's)
+  // The nominal is recorded twice, the second time a negligible payload heavier (walk_chance.h's
+  // replica: 0.03% of the robot's mass), and the draw whose model fits the real samples better is
+  // the search's nominal: a point must beat the better of two draws of the same physics. Where the
+  // walk pairs the two draws score alike; where it is chaotic one draw can fit the real samples
+  // worse by chance, and then every point beats it (the planar quadruped, docs/sim2real.md, "The
+  // nominal drawn twice"). share 0: recorded once.
+  WalkChanceOptions chance;
   bool IsValid(std::string* error) const;
+};
+
+// The nominal's two draws of a search (LegSearchOptions::chance): each one's score per real sample,
+// the second's gain over the first in SEs (placements as units), which one is the search's nominal,
+// and the walk's own chance in the search's score: how far two draws of one physics score apart
+// beyond what the real samples' SE allows, per real sample,
+//   chance = sqrt(max(0, D^2 - SE_D^2)) / n,  D = sum_i (second_i - first_i).
+// A point's gain over the nominal is counted in SEs that include it (LegSearch::z_vs_nominal).
+struct NominalDraws {
+  bool recorded = false;
+  double first = NAN, second = NAN;  // mean score per real sample: as is, a negligible payload heavier
+  double z_second = NAN;             // D / SE_D
+  double chance = 0;                 // per real sample (0: within the SE, or not measured)
+  bool second_is_nominal = false;    // the second fits better and is the nominal
+  double added_kg = NAN;             // the second draw's payload
 };
 
 struct LegSearchPoint {
@@ -131,6 +154,7 @@ struct LegSearch {
   std::string why;                    // why it did not run, or what it found, in words
   std::vector<LegSearchPoint> points; // every leg and gain scored
   double nominal_score = NAN;         // the nominal re-recording's own model, per real sample
+  NominalDraws draws;                 // the nominal's two draws (LegSearchOptions::chance)
   double best_plain = NAN;            // the best's plain (not robust) log-likelihood per real sample,
                                       // comparable with locate's sim model and ceiling
   double nominal_misfit = NAN, best_misfit = NAN;  // own unseen samples minus real, per sample (leg_search.cc)
@@ -148,7 +172,8 @@ struct LegSearch {
   SearchSpan as_well;                 // the named leg's gains that fit as well as the best
   std::vector<std::string> legs_as_well;  // other legs with a point within z SE of the best
   double gap_closed = NAN;            // 1 - best_misfit / nominal_misfit
-  double z_vs_nominal = 0;            // the best's gain over the nominal in SEs (placements)
+  double z_vs_nominal = 0;            // the best's gain over the nominal in SEs (placements), the
+                                      // walk's own chance included: D / sqrt(SE^2 + (n chance)^2)
   LinearGaussianModel nominal_model, best_model;  // the correction's two ends
   Eigen::VectorXd best_rows;          // the best point's score per real sample
   Eigen::VectorXd log_var;            // per axis log(residual variance best / nominal)

@@ -191,6 +191,16 @@ json FitJson(const Analysis& a) {
           {"gap_closed_se", !leg && a.knobs_analysed ? JsonNumber(a.adequacy.gap_closed_se) : json(nullptr)}};
 }
 
+// The nominal's two draws (null when recorded once): scores per real sample, the second's gain in
+// SEs, which is the search's nominal.
+json NominalDrawsJson(const NominalDraws& d) {
+  if (!d.recorded) return nullptr;
+  return {{"first_score", JsonNumber(d.first)}, {"second_score", JsonNumber(d.second)},
+          {"second_added_kg", JsonNumber(d.added_kg)}, {"z_second_vs_first", JsonNumber(d.z_second)},
+          {"chance", JsonNumber(d.chance)},
+          {"nominal", d.second_is_nominal ? "second" : "first"}};
+}
+
 json LegSearchJson(const LegSearch& l) {
   if (!l.ran) return nullptr;
   json points = json::array();
@@ -200,8 +210,8 @@ json LegSearchJson(const LegSearch& l) {
   }
   return {{"named", l.named}, {"score", l.score}, {"why", l.why}, {"leg", l.best >= 0 ? json(l.leg) : json(nullptr)},
           {"knob", l.best >= 0 ? json(l.knob) : json(nullptr)}, {"value", JsonNumber(l.value)},
-          {"nominal_score", JsonNumber(l.nominal_score)}, {"nominal_misfit", JsonNumber(l.nominal_misfit)},
-          {"best_misfit", JsonNumber(l.best_misfit)}, {"best_misfit_se", JsonNumber(l.best_misfit_se)},
+          {"nominal_score", JsonNumber(l.nominal_score)}, {"nominal_draws", NominalDrawsJson(l.draws)},
+          {"nominal_misfit", JsonNumber(l.nominal_misfit)}, {"best_misfit", JsonNumber(l.best_misfit)}, {"best_misfit_se", JsonNumber(l.best_misfit_se)},
           {"misfit_against", l.misfit_elsewhere ? "other_places" : "own_executions"},
           {"real_gain", JsonNumber(l.real_gain)}, {"null_gain", JsonNumber(l.null_gain)},
           {"z_null_corrected", JsonNumber(l.z_null_corrected)}, {"null_corrected_gate", l.null_corrected_gate},

@@ -156,7 +156,11 @@ SampleSet FakeSimulator::Record(const Recording& recording, const std::vector<Kn
     std::lock_guard<std::mutex> lock(mu_);
     threads_seen_.push_back(threads);
   }
-  return RecordWith(recording, values, FakeExtras{});
+  SampleSet s = RecordWith(recording, values, FakeExtras{});
+  const bool nominal = std::all_of(values.begin(), values.end(),
+                                   [&](const KnobValue& v) { return v.value == knobs_[v.knob].nominal; });
+  if (nominal_luck != 0 && nominal) s.x.col(0).array() += nominal_luck;
+  return s;
 }
 
 SampleSet FakeSimulator::RecordWith(const Recording& recording, const std::vector<KnobValue>& values,

@@ -86,7 +86,8 @@ class FakeSimulator : public KnobSimulator {
            (sloped_plane ? "-sloped-plane" : "") +
            (level_z_sd != 0.02 ? "-z-sd-" + std::to_string(level_z_sd) : "") +
            (tilt_steers != 0 ? "-tilt-steers-" + std::to_string(tilt_steers) : "") +
-           (walk_chaos != 0 ? "-walk-chaos-" + std::to_string(walk_chaos) : "");
+           (walk_chaos != 0 ? "-walk-chaos-" + std::to_string(walk_chaos) : "") +
+           (nominal_luck != 0 ? "-nominal-luck-" + std::to_string(nominal_luck) : "");
   }
   SampleSet Record(const Recording& recording, const std::vector<KnobValue>& values, int threads) const override;
   CellRecording RecordCell(const Cell& cell, const std::vector<KnobValue>& values) const override;
@@ -127,6 +128,10 @@ class FakeSimulator : public KnobSimulator {
   // way, its noise e replaced by sqrt(1 - a^2) e + a e', e' ~ N(0, 1) drawn from the recording's seed
   // and knob values: the same spread, paired executions sqrt(2 - 2 sqrt(1 - a^2)) sds apart.
   double walk_chaos = 0;
+  // The simulator's nominal recording (every knob at its nominal value) goes this much further in
+  // dx (m) than any other: one unlucky draw of a chaotic walk that a negligibly different recording
+  // does not repeat. Record only (the planted real sets of RecordWith walk as the knobs say).
+  double nominal_luck = 0;
   // Record as many executions per placement as the recording asks for (else always 5, the
   // protocol's own number, whatever it asks for).
   bool honour_executions = false;

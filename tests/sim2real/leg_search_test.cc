@@ -77,6 +77,41 @@ TEST(LegSearch, PhysicsOfAnotherKindNamesNoLeg) {
   EXPECT_FALSE(r.named) << "named " << r.leg << " at " << r.value;
 }
 
+// A nominal recording that drew badly (a chaotic walk's luck, which a negligibly different recording
+// does not repeat) makes every leg beat it; the nominal's second draw, a negligible payload heavier,
+// becomes the nominal and no leg is named. Recorded once, the unlucky draw lets a leg through.
+TEST(LegSearch, AnUnluckyNominalDrawIsReplacedByItsSecondDraw) {
+  FakeSimulator lucky;
+  lucky.nominal_luck = 1.5 * 0.01;  // 1.5 sd of dx
+  const Stages s = RunStages(lucky, {}, 3);
+  LegSearchOptions once = Options(s);
+  once.chance.share = 0;
+  const LegSearch single = SearchLegGains(lucky, s.in, s.set, s.options.candidates, once);
+  ASSERT_TRUE(single.ran);
+  EXPECT_FALSE(single.draws.recorded);
+  EXPECT_GT(single.z_vs_nominal, 2.0) << "every leg beats the unlucky draw";
+  const LegSearch twice = SearchLegGains(lucky, s.in, s.set, s.options.candidates, Options(s));
+  ASSERT_TRUE(twice.draws.recorded);
+  EXPECT_TRUE(twice.draws.second_is_nominal);
+  EXPECT_GT(twice.draws.z_second, 2.0);
+  EXPECT_NEAR(twice.draws.added_kg, 3e-4 * lucky.total_mass_kg(), 1e-12);
+  EXPECT_DOUBLE_EQ(twice.nominal_score, twice.draws.second);
+  EXPECT_LT(twice.z_vs_nominal, 2.0);
+  EXPECT_FALSE(twice.named) << "named " << twice.leg << " at " << twice.value;
+  EXPECT_GT(twice.draws.chance, 0);
+  EXPECT_NE(twice.why.find("the walk's own chance"), std::string::npos) << twice.why;
+}
+
+// Where the walk pairs, the two draws score alike and the first stays the nominal.
+TEST(LegSearch, APairingWalksTwoNominalDrawsScoreAlike) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  const LegSearch r = Search(s);
+  ASSERT_TRUE(r.draws.recorded);
+  EXPECT_LT(std::fabs(r.draws.z_second), 2.0);
+  EXPECT_LT(std::fabs(r.draws.second - r.draws.first), 0.05 * std::fabs(r.best_plain - r.draws.first));
+  EXPECT_LT(r.draws.chance, 0.05 * std::fabs(r.best_plain - r.draws.first));
+}
+
 // A point the same-place gate refuses gets a second look at other places (second_look_elsewhere):
 // a planted weak leg is named after it, checked against a recording of the point elsewhere;
 // physics of another kind still names no leg.
