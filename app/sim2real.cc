@@ -62,6 +62,7 @@ struct Sim2RealArgs {
   bool ground_search = true;
   std::string null_corrected_gain = "off";  // auto: on a height field only (MakeOptions)
   std::string leg_search_score = "sag";
+  int search_draws = 1;
   std::string leg_search_on = "remaining";
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
   double challenge_inclusion = sim2real::LegSearchOptions{}.challenge_inclusion;
@@ -175,6 +176,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   for (sim2real::LegSearchOptions* search : {&o.legs, &o.runoff.search, &o.payload.search, &o.ground.search}) {
     search->null_corrected_gain =
         args.null_corrected_gain == "on" || (args.null_corrected_gain == "auto" && uneven_ground);
+    search->draws = args.search_draws;
   }
   o.payload.enabled = args.payload_search;
   o.payload.on_posture = args.payload_on_posture;
@@ -467,6 +469,12 @@ void Setup(CLI::App& root) {
                 "on uneven ground (locate permuted whole placements), when a mismatch is left: record the first "
                 "selection step's contending knobs again and score each recording by its own model (on by default; "
                 "docs/sim2real.md)");
+  cmd->add_option("--search-draws", args->search_draws,
+                  "experimental: recordings per point of the searches by models of their own (leg, payload, runoff, "
+                  "ground), each a negligible payload heavier, their scores averaged: on a chaotic walk the chance in "
+                  "a point's score shrinks as 1/sqrt(N), at N times the recordings (docs/sim2real.md, \"The nominal "
+                  "drawn twice\")")
+      ->capture_default_str()->check(CLI::Range(1, 16));
   cmd->add_option("--leg-search-score", args->leg_search_score,
                   "how the leg search scores a recording: sag (its sags as a mode of their own beside its core) or "
                   "robust (its own model with a broad component; docs/sim2real.md)")

@@ -177,40 +177,74 @@ void ChooseNominalDraw(Scored second, double kg, const AnalysisInputs& in, Searc
   if (d.second_is_nominal) state->nominal = std::move(second);
 }
 
-// Records the wanted (knob, value) points (and first the nominal, when `state` has none yet) and
-// scores them.
+// The j-th draw of a request: itself for j = 0, else the same physics a negligible payload j delta
+// heavier (`unit`: the payload knob at its nominal plus delta, ChanceRequest), added to the request's
+// own payload mass when it has one.
+std::vector<KnobValue> Draw(std::vector<KnobValue> request, int j, const std::vector<KnobValue>& unit,
+                            const KnobSimulator& simulator) {
+  if (j == 0 || unit.empty()) return request;
+  const double delta = unit[0].value - simulator.knobs()[unit[0].knob].nominal;
+  for (KnobValue& v : request) {
+    if (v.knob == unit[0].knob) {
+      v.value += j * delta;
+      return request;
+    }
+  }
+  request.push_back({unit[0].knob, unit[0].value + (j - 1) * delta});
+  return request;
+}
+
+// One score of `draws` recordings of one physics (LegSearchOptions::draws): the first's model and
+// samples, the real samples' rows averaged over the draws; not walkable when any draw fell.
+Scored ScoreDraws(std::vector<SampleSet>::iterator first, int draws, const AnalysisInputs& in,
+                  const LegSearchOptions& options, int nominal_size, const SagReference* ref) {
+  Scored out = ScoreRecording(*first, in, options, nominal_size > 0 ? nominal_size : first->size(), ref);
+  for (int j = 1; j < draws && out.walkable; ++j) {
+    const Scored more = ScoreRecording(*(first + j), in, options, nominal_size > 0 ? nominal_size : first->size(), ref);
+    out.walkable = more.walkable;
+    out.rows += more.rows;
+  }
+  if (out.walkable) out.rows /= draws;
+  return out;
+}
+
+// Records the wanted (knob, value) points (and first the nominal twice, when `state` has none yet),
+// each `options.draws` times, and scores them.
 void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
                   const CandidateOptions& recording, const LegSearchOptions& options,
                   const std::vector<std::pair<int, double>>& wanted, SearchState* state, LegSearch* out) {
   const bool need_nominal = state->nominal.rows.size() == 0;
-  const std::vector<KnobValue> replica = need_nominal ? ChanceRequest(simulator, options.chance) : std::vector<KnobValue>{};
+  const std::vector<KnobValue> unit = ChanceRequest(simulator, options.chance);
+  const int draws = unit.empty() ? 1 : options.draws;
+  const int nominal_draws = need_nominal ? (unit.empty() ? 1 : 2 * draws) : 0;
   std::vector<std::vector<KnobValue>> requests;
-  if (need_nominal) requests.push_back({});
-  if (!replica.empty()) requests.push_back(replica);
+  for (int j = 0; j < nominal_draws; ++j) requests.push_back(Draw({}, j, unit, simulator));
   for (const auto& [k, v] : wanted) {
-    requests.push_back({{k, v}});
+    std::vector<KnobValue> request = {{k, v}};
     if (state->also) {
       const std::vector<KnobValue> extra = state->also(k, v);
-      requests.back().insert(requests.back().end(), extra.begin(), extra.end());
+      request.insert(request.end(), extra.begin(), extra.end());
     }
+    for (int j = 0; j < draws; ++j) requests.push_back(Draw(request, j, unit, simulator));
   }
   RecordingBatch batch = RecordBatch(simulator, SearchRecording(set, options), requests, recording.recording);
+  auto next = batch.sets.begin();
   if (need_nominal) {
-    state->nominal = ScoreRecording(batch.sets[0], in, options, batch.sets[0].size(), state->Ref());
-    state->nominal_size = batch.sets[0].size();
-    batch.sets.erase(batch.sets.begin());
+    state->nominal_size = next->size();
+    state->nominal = ScoreDraws(next, draws, in, options, 0, state->Ref());
+    next += draws;
   }
-  if (!replica.empty()) {
-    const double kg = replica[0].value - simulator.knobs()[replica[0].knob].nominal;
-    ChooseNominalDraw(ScoreRecording(batch.sets[0], in, options, state->nominal_size, state->Ref()), kg, in, state, out);
-    batch.sets.erase(batch.sets.begin());
+  if (nominal_draws > draws) {
+    const double kg = draws * (unit[0].value - simulator.knobs()[unit[0].knob].nominal);
+    ChooseNominalDraw(ScoreDraws(next, draws, in, options, state->nominal_size, state->Ref()), kg, in, state, out);
+    next += draws;
   }
   out->recorded += batch.recorded;
   out->from_cache += batch.from_cache;
   const auto& knobs = simulator.knobs();
-  for (size_t j = 0; j < wanted.size(); ++j) {
+  for (size_t j = 0; j < wanted.size(); ++j, next += draws) {
     const Knob& knob = knobs[wanted[j].first];
-    state->scored.push_back(ScoreRecording(batch.sets[j], in, options, state->nominal_size, state->Ref()));
+    state->scored.push_back(ScoreDraws(next, draws, in, options, state->nominal_size, state->Ref()));
     const Scored& s = state->scored.back();
     state->points.push_back({knob.leg.empty() ? knob.name : knob.leg, knob.name, wanted[j].first, wanted[j].second,
                              s.walkable ? s.rows.mean() : -INFINITY, false});
@@ -447,6 +481,10 @@ bool LegSearchOptions::IsValid(std::string* error) const {
   }
   if (!(sag.broad_share > 0 && sag.broad_share < 0.5) || !(sag.broad_scale > 1) || !(sag.floor >= 0)) {
     *error = "leg search: sag broad_share in (0, 0.5), broad_scale > 1 and floor >= 0 expected";
+    return false;
+  }
+  if (draws < 1) {
+    *error = "leg search: draws >= 1 expected";
     return false;
   }
   return model.IsValid(error) && chance.IsValid(error);

@@ -120,6 +120,12 @@ struct LegSearchOptions {
   // worse by chance, and then every point beats it (the planar quadruped, docs/sim2real.md, "The
   // nominal drawn twice"). share 0: recorded once.
   WalkChanceOptions chance;
+  // Experimental, 1 by default: recordings per point, the j-th the same physics a payload j times
+  // the chance's negligible mass heavier, the real samples' scores averaged over them (the first
+  // one's model stands for the point in the misfit and the correction); the nominal's two draws are
+  // `draws` recordings each. On a chaotic walk the chance in a point's score shrinks as 1/sqrt(draws),
+  // at that many times the recordings (docs/sim2real.md, "The nominal drawn twice").
+  int draws = 1;
   bool IsValid(std::string* error) const;
 };
 

@@ -112,6 +112,27 @@ TEST(LegSearch, APairingWalksTwoNominalDrawsScoreAlike) {
   EXPECT_LT(r.draws.chance, 0.05 * std::fabs(r.best_plain - r.draws.first));
 }
 
+// With several draws per point every point and both nominal draws are recorded that many times,
+// and a planted weak leg is still named.
+TEST(LegSearch, SeveralDrawsPerPointRecordEachThatManyTimes) {
+  FakeSimulator fake;
+  const Stages s = RunStages(fake, {{kLeg1Gain, 0.38}}, 3);
+  LegSearchOptions o = Options(s);
+  o.draws = 3;
+  o.refine_steps = 0;
+  CandidateOptions recording = s.options.candidates;
+  recording.recording.cache_dir = "-";
+  const int before = fake.records();
+  const LegSearch r = SearchLegGains(fake, s.in, s.set, recording, o);
+  ASSERT_TRUE(r.named) << r.why;
+  EXPECT_EQ(r.leg, "leg1");
+  EXPECT_NEAR(r.draws.added_kg, 3 * 3e-4 * fake.total_mass_kg(), 1e-12) << "the second nominal starts after the first's draws";
+  EXPECT_EQ(fake.records() - before, 3 * static_cast<int>(r.points.size()) + 2 * 3);
+  o.draws = 0;
+  std::string error;
+  EXPECT_FALSE(o.IsValid(&error));
+}
+
 // A point the same-place gate refuses gets a second look at other places (second_look_elsewhere):
 // a planted weak leg is named after it, checked against a recording of the point elsewhere;
 // physics of another kind still names no leg.
