@@ -205,6 +205,7 @@ Scored ScoreDraws(std::vector<SampleSet>::iterator first, int draws, const Analy
     out.rows += more.rows;
   }
   if (out.walkable) out.rows /= draws;
+  else out.rows.setConstant(-INFINITY);  // as ScoreRecording's for a recording that fell
   return out;
 }
 
