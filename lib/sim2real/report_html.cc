@@ -295,13 +295,14 @@ std::string FitSection(const Analysis& a, const ReportContext& ctx) {
   return o.str();
 }
 
-// ", the better of two draws (the second, a payload 0.00093 kg heavier: 11.0017 against the first's
-// 9.8824, z 7.78; the walk's own chance 1.11 nats per real sample, counted in the z against the nominal)".
+// ", the better of two draws, here the second (a payload 0.00093 kg heavier: 11.0017 against the
+// first's 9.8824, z 7.78; the walk's own chance 1.11 nats per real sample, counted in the z against
+// the nominal)".
 std::string DrawsPart(const NominalDraws& d) {
   if (!d.recorded) return "";
-  return std::string(", the better of two draws (") + (d.second_is_nominal ? "the second" : "the first") +
-         F(": the second, a payload %.2g kg heavier, ", d.added_kg) + F("scores %.4f", d.second) +
-         F(" against the first's %.4f, ", d.first) + F("z %.2f; ", d.z_second) + F("the walk's own chance %.3g", d.chance) +
+  return std::string(", the better of two draws, here the ") + (d.second_is_nominal ? "second" : "first") +
+         F(" (the second a payload %.2g kg heavier: ", d.added_kg) + F("%.4f against the first's ", d.second) +
+         F("%.4f, ", d.first) + F("z %.2f; ", d.z_second) + F("the walk's own chance %.3g", d.chance) +
          " nats per real sample, counted in the z against the nominal)";
 }
 
