@@ -126,10 +126,14 @@ Eigen::VectorXd ResidualVariance(const Scored& scored) {
   return (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, r.rows() - 1.0);
 }
 
-// (sum of a - b) / SE, per-placement sums as the independent units (refine_search.h).
-double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement) {
+// (sum of a - b) / sqrt(SE^2 + extra^2), per-placement sums as the independent units
+// (refine_search.h); `extra`: a spread of the sum the real samples' SE does not hold (the walk's own
+// chance, NominalDraws).
+double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement,
+               double extra = 0) {
   const PairedSum d = PairedDifference(a, b, NumberUnits(placement));
-  return d.se > 0 && std::isfinite(d.sum) ? d.sum / d.se : 0;
+  const double se = std::hypot(d.se, extra);
+  return se > 0 && std::isfinite(d.sum) ? d.sum / se : 0;
 }
 
 // The values to record for one knob: `factors` of its nominal, inside its range, distinct.
@@ -195,12 +199,13 @@ std::vector<KnobValue> Draw(std::vector<KnobValue> request, int j, const std::ve
 }
 
 // One score of `draws` recordings of one physics (LegSearchOptions::draws): the first's model and
-// samples, the real samples' rows averaged over the draws; not walkable when any draw fell.
+// samples, the real samples' rows averaged over the draws; not walkable when any draw fell
+// (ScoreRecording: kept under half of `nominal_size` samples).
 Scored ScoreDraws(std::vector<SampleSet>::iterator first, int draws, const AnalysisInputs& in,
                   const LegSearchOptions& options, int nominal_size, const SagReference* ref) {
-  Scored out = ScoreRecording(*first, in, options, nominal_size > 0 ? nominal_size : first->size(), ref);
+  Scored out = ScoreRecording(*first, in, options, nominal_size, ref);
   for (int j = 1; j < draws && out.walkable; ++j) {
-    const Scored more = ScoreRecording(*(first + j), in, options, nominal_size > 0 ? nominal_size : first->size(), ref);
+    const Scored more = ScoreRecording(*(first + j), in, options, nominal_size, ref);
     out.walkable = more.walkable;
     out.rows += more.rows;
   }
@@ -232,7 +237,7 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
   auto next = batch.sets.begin();
   if (need_nominal) {
     state->nominal_size = next->size();
-    state->nominal = ScoreDraws(next, draws, in, options, 0, state->Ref());
+    state->nominal = ScoreDraws(next, draws, in, options, state->nominal_size, state->Ref());
     next += draws;
   }
   if (nominal_draws > draws) {
@@ -293,14 +298,6 @@ std::string ChancePart(const NominalDraws& d) {
          Fmt(" (z %.2f): the walk's own chance, counted in the z", d.z_second);
 }
 
-// The best point's gain over the nominal in SEs, the walk's own chance included (NominalDraws).
-double ZVsNominal(const Eigen::VectorXd& best, const Eigen::VectorXd& nominal, const NominalDraws& draws,
-                  const std::vector<int>& placement) {
-  const PairedSum d = PairedDifference(best, nominal, NumberUnits(placement));
-  const double se = std::hypot(d.se, draws.chance * best.size());
-  return se > 0 && std::isfinite(d.sum) ? d.sum / se : 0;
-}
-
 // Names the best point's leg (or knob), or says why not.
 void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
             const LegSearchOptions& options, SearchState* state, LegSearch* out) {
@@ -324,7 +321,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
       out->legs_as_well.push_back(leg);
     }
   }
-  out->z_vs_nominal = ZVsNominal(state->scored[out->best].rows, state->nominal.rows, out->draws, in.real.episode);
+  const Eigen::VectorXd& best_rows = state->scored[out->best].rows;
+  out->z_vs_nominal = PairedZ(best_rows, state->nominal.rows, in.real.episode, out->draws.chance * best_rows.size());
   out->leg = b.leg, out->knob = b.knob, out->knob_index = b.knob_index, out->value = b.value;
   out->also = state->also ? state->also(b.knob_index, b.value) : std::vector<KnobValue>{};
   const Knob& knob = knobs[b.knob_index];
@@ -342,7 +340,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
   const bool legs = !knobs[b.knob_index].leg.empty();
   const std::string at = PointName(knobs[b.knob_index], b.value);
   if (out->z_vs_nominal < options.z) {
-    out->why = "the best point (" + at + Fmt(") fits the real samples no better than the nominal (z %.2f)", out->z_vs_nominal) +
+    out->why = "the best point (" + at +
+               Fmt(") fits the real samples no better than the nominal (z %.2f)", out->z_vs_nominal) +
                ChancePart(out->draws);
   } else if (!out->legs_as_well.empty()) {
     out->why = "the best point is " + at + (legs ? ", but weak " : ", but ") + out->legs_as_well[0] +
