@@ -54,6 +54,7 @@ struct Sim2RealArgs {
   bool leg_search = true;
   bool payload_search = sim2real::PayloadSearchOptions{}.enabled;
   bool payload_on_posture = sim2real::PayloadSearchOptions{}.on_posture;
+  bool payload_vs_leg = sim2real::PayloadSearchOptions{}.challenge_leg;
   bool payload_posture_chooses = sim2real::PayloadSearchOptions{}.posture_chooses;
   bool posture = sim2real::PostureOptions{}.enabled;
   double posture_z = sim2real::PostureOptions{}.z;
@@ -180,6 +181,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   }
   o.payload.enabled = args.payload_search;
   o.payload.on_posture = args.payload_on_posture;
+  o.payload.challenge_leg = args.payload_vs_leg;
   o.payload.posture_chooses = args.payload_posture_chooses;
   o.posture.enabled = args.posture;
   o.posture.z = args.posture_z;
@@ -441,6 +443,9 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--payload-on-posture,!--no-payload-on-posture", args->payload_on_posture,
                 "run the payload search also when the named physics leaves the torso's posture out (--posture; on "
                 "by default)");
+  cmd->add_flag("--payload-vs-leg,!--no-payload-vs-leg", args->payload_vs_leg,
+                "when the leg search names a weak leg, run the payload search too: a payload off the middle can pass "
+                "for one weak leg, and the better of the two (by 2 SE) keeps the name (on by default; docs/sim2real.md)");
   cmd->add_flag("--payload-posture-chooses,!--no-payload-posture-chooses", args->payload_posture_chooses,
                 "where several of the payload search's positions fit the real samples as well, name the one whose "
                 "payload leaves the least of the real torso's posture (--posture; on by default; docs/sim2real.md)");

@@ -119,15 +119,15 @@ LegSearchOptions OwnModels(LegSearchOptions o, const AnalysisOptions& options) {
   return o;
 }
 
-// The payload search (stage 8c) runs when enabled or the posture is left out (PostureCheck), on a
-// plane, when neither the runoff nor the leg search named anything and the stages before either
-// left a located mismatch with nothing named or named knobs the leg search was to challenge
+// The payload search (stage 8c) runs on a plane where neither the ground's search nor the runoff
+// named anything: as the challenger of a leg the leg search named (PayloadSearchOptions::
+// challenge_leg), or, enabled or where the posture is left out (PostureCheck), when the stages before
+// either left a located mismatch with nothing named or named knobs the leg search was to challenge
 // (`challenge`, WantChallenge before it ran).
 bool WantPayloadSearch(const Analysis& a, const PayloadSearchOptions& options, bool challenge) {
-  const bool on = options.enabled || (options.on_posture && a.posture.left_out);
-  if (!on || a.baseline.permute_placements || a.ground.search.named || a.runoff.search.named || a.leg_search.named) {
-    return false;
-  }
+  if (a.baseline.permute_placements || a.ground.search.named || a.runoff.search.named) return false;
+  if (a.leg_search.named) return options.challenge_leg;
+  if (!options.enabled && !(options.on_posture && a.posture.left_out)) return false;
   if (!a.naming.named.empty()) return options.challenge_named && challenge;
   return a.verdict.status == "unexplained" && a.verdict.named.empty();
 }
@@ -211,12 +211,12 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     if (!a->naming.named.empty()) {
       LegSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, legs, &a->leg_search);
     }
-    AddLegSearch(a->leg_search, &a->verdict);
     a->seconds.legs += Since(t);
   }
   if (WantPayloadSearch(*a, options.payload, challenge)) {
     const auto t = Clock::now();
-    stage("payload search (its mass and position)");
+    stage(a->leg_search.named ? "payload search (its mass and position, against the named leg)"
+                              : "payload search (its mass and position)");
     PayloadSearchOptions payload = options.payload;
     payload.search = OwnModels(payload.search, options);
     a->payload_search = SearchPayload(simulator, a->inputs, a->candidates, options.candidates, payload,
@@ -224,9 +224,11 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
     if (!a->naming.named.empty()) {
       PayloadSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, payload, &a->payload_search);
     }
-    AddPayloadSearch(a->payload_search, &a->verdict);
+    PayloadVersusLeg(a->inputs, payload, &a->leg_search, &a->payload_search);
     a->seconds.payload += Since(t);
   }
+  AddLegSearch(a->leg_search, &a->verdict);  // after the payload search, which can take the leg's name
+  AddPayloadSearch(a->payload_search, &a->verdict);
 }
 
 // The knobs the runoff, the leg search or the payload search recorded without naming them.

@@ -126,16 +126,6 @@ Eigen::VectorXd ResidualVariance(const Scored& scored) {
   return (r.rowwise() - r.colwise().mean()).colwise().squaredNorm() / std::max(1.0, r.rows() - 1.0);
 }
 
-// (sum of a - b) / sqrt(SE^2 + extra^2), per-placement sums as the independent units
-// (refine_search.h); `extra`: a spread of the sum the real samples' SE does not hold (the walk's own
-// chance, NominalDraws).
-double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement,
-               double extra = 0) {
-  const PairedSum d = PairedDifference(a, b, NumberUnits(placement));
-  const double se = std::hypot(d.se, extra);
-  return se > 0 && std::isfinite(d.sum) ? d.sum / se : 0;
-}
-
 // The values to record for one knob: `factors` of its nominal, inside its range, distinct.
 std::vector<double> GridValues(const Knob& k, const std::vector<double>& factors) {
   std::vector<double> out;
@@ -463,6 +453,12 @@ double GridStep(const std::vector<std::pair<int, double>>& grid, int k, double n
 }
 
 }  // namespace
+
+double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement, double extra) {
+  const PairedSum d = PairedDifference(a, b, NumberUnits(placement));
+  const double se = std::hypot(d.se, extra);
+  return se > 0 && std::isfinite(d.sum) ? d.sum / se : 0;
+}
 
 bool LegSearchOptions::IsValid(std::string* error) const {
   if (factors.empty() || std::any_of(factors.begin(), factors.end(), [](double f) { return !(f > 0); })) {

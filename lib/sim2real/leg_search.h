@@ -196,6 +196,11 @@ struct LegSearch {
   double bar_z = NAN;  // the z it would have needed to replace them (LegSearchOptions::z)
 };
 
+// (sum_i a_i - b_i) / sqrt(SE^2 + extra^2), per-placement sums as the independent units
+// (refine_search.h); `extra`: a spread of the sum the real samples' SE does not hold (the walk's own
+// chance, NominalDraws).
+double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::vector<int>& placement, double extra = 0);
+
 // The best point's mean score per real sample under the search's own score (its recording's own
 // model: with the sag mode, its sags and a broad floor included), what the reports give as the fit
 // of a search-named point; NaN without a best point.

@@ -105,10 +105,12 @@ std::string PayloadSaid(const PayloadSearch& p) { return Fmt("a payload of %.3g 
 VerdictNamed NamedPayload(const PayloadSearch& p) {
   const LegSearch& s = p.search;
   VerdictNamed n = SearchNamed(s, "payload", "kg");
-  const std::string after = s.challenged.empty()
-                                ? "after the probes' mean shifts and the leg search named nothing"
+  const std::string after =
+      !p.leg_challenged.empty() ? "after the leg search named a weak " + p.leg_challenged +
+                                      Fmt(", which it fits the real samples better than (z %.1f)", s.z_vs_named)
+      : s.challenged.empty()    ? "after the probes' mean shifts and the leg search named nothing"
                                 : "after the probes' mean shifts named " + JoinWords(s.challenged) +
-                                      Fmt(", which it fits the real samples better than (z %.1f)", s.z_vs_named);
+                                   Fmt(", which it fits the real samples better than (z %.1f)", s.z_vs_named);
   n.doubts.push_back(Fmt("found by a search of a payload's mass and position (%.0f positions, each recording scored by a ",
                          static_cast<double>(p.columns.size())) +
                      "model of its own) " + after + ": no bootstrap, its range is the masses that fit as well; it sits " +
@@ -306,6 +308,32 @@ void PayloadSearchChallenge(const AnalysisInputs& in, const std::vector<std::str
   p->why = p->search.why;
 }
 
+void PayloadVersusLeg(const AnalysisInputs& in, const PayloadSearchOptions& options, LegSearch* leg,
+                      PayloadSearch* p) {
+  LegSearch& s = p->search;
+  if (!p->ran || !s.named || !leg->named || leg->best_rows.size() != s.best_rows.size()) return;
+  const double chance = std::max(leg->draws.chance, s.draws.chance) * static_cast<double>(s.best_rows.size());
+  const std::string leg_said = leg->leg + Fmt(" leg (gain %.3g)", leg->value);
+  p->leg_challenged = leg_said;
+  s.challenged = {leg->knob};
+  s.z_vs_named = PairedZ(s.best_rows, leg->best_rows, in.real.episode, chance);
+  s.bar_z = options.search.z;
+  const std::string scores = Fmt(" (%.3g against %.3g nats per sample, z %.2f)", BestScore(s), BestScore(*leg), s.z_vs_named);
+  if (s.z_vs_named >= options.search.z) {
+    leg->named = false;
+    leg->why = "its best point (" + leg->leg + Fmt(" at gain %.3g", leg->value) + ") fits the real samples worse than " +
+               PayloadSaid(*p) + scores;
+    return;
+  }
+  s.named = false;
+  s.rivals_named = s.z_vs_named > 0;
+  p->why = "its best point (" + PayloadSaid(*p) + ") fits the real samples " +
+           (s.rivals_named ? "better than the weak " + leg_said + Fmt(" the leg search named, but by under %.3g SE", options.search.z)
+                           : "no better than the weak " + leg_said + " the leg search named") +
+           scores;
+  s.why = p->why;
+}
+
 void AddPayloadSearch(const PayloadSearch& p, Verdict* v) {
   if (!p.ran) return;
   const LegSearch& s = p.search;
@@ -318,7 +346,10 @@ void AddPayloadSearch(const PayloadSearch& p, Verdict* v) {
     return;
   }
   ReplaceNamed(s, NamedPayload(p), v);
-  const std::string than_named = s.challenged.empty() ? "" : Fmt(" and than the named knobs' correction (z %.1f)", s.z_vs_named);
+  const std::string than_named =
+      !p.leg_challenged.empty() ? " and than the weak " + p.leg_challenged + Fmt(" the leg search named (z %.1f)", s.z_vs_named)
+      : s.challenged.empty()    ? ""
+                                : Fmt(" and than the named knobs' correction (z %.1f)", s.z_vs_named);
   v->sentence += " " + what + ": " + PayloadSaid(p) +
                  Fmt(" fits the real samples %.3g nats per sample better than the nominal (z %.1f)",
                      s.points[s.best].score - s.nominal_score, s.z_vs_nominal) + than_named + "; " +

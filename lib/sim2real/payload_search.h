@@ -40,6 +40,12 @@ struct PayloadSearchOptions {
   // Run also when the torso's posture is left out by the named physics (posture.h), enabled or not.
   bool on_posture = true;
   bool challenge_named = true;  // also challenge named knobs the leg search challenged
+  // Also challenge a leg the leg search named, enabled or not (`--no-payload-vs-leg` turns it off): a
+  // payload off the middle loads the legs nearest it and can pass for one weak leg (the hexapod's
+  // 65138: 0.62 kg 4.4 cm behind the middle read as a weak rear_right leg, z 3.0 over the nominal;
+  // the payload search fitted its moment within 6%, 0.94 nats per real sample above the leg). The
+  // better of the two best points keeps its name (PayloadVersusLeg).
+  bool challenge_leg = true;
   std::vector<double> masses = {1.0, 2.0};                   // of the mass knob's probe
   std::vector<double> forward = {-1.0, -0.5, 0.0, 0.5, 1.0};  // of the x probe's offset, sideways 0
   std::vector<double> sideways = {-1.0, 1.0};                 // of the y probe's offset, forward 0
@@ -76,6 +82,7 @@ struct PayloadSearch {
   LegSearch search;                    // the best column's search (its `also`: the position)
   double x = NAN, y = NAN;             // where the named mass sits
   double x_nominal = 0, y_nominal = 0; // the knobs' nominal position (the middle)
+  std::string leg_challenged;          // the named leg it challenged ("rear_right at gain 0.35"), or empty
   double seconds = 0;
 };
 
@@ -98,6 +105,16 @@ PayloadSearch SearchPayload(const KnobSimulator& simulator, const AnalysisInputs
 // search's z; `why` then says so.
 void PayloadSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named,
                             const Eigen::VectorXd& corrected, const PayloadSearchOptions& options, PayloadSearch* search);
+
+// The search as a challenger of the leg the leg search named (PayloadSearchOptions::challenge_leg):
+// their best points' scores per real sample compared, placements as units, the walk's own chance
+// of either search counted (NominalDraws),
+//   z = sum_i (score_payload,i - score_leg,i) / sqrt(SE^2 + (n chance)^2).
+// A named payload with z >= options.search.z takes the leg's name (the leg search names nothing and
+// its `why` says so); under it the payload names nothing, a rival of the leg when z > 0. A payload
+// its own gates did not name changes nothing.
+void PayloadVersusLeg(const AnalysisInputs& in, const PayloadSearchOptions& options, LegSearch* leg,
+                      PayloadSearch* search);
 
 // The search's answer in the verdict: a named payload replaces the verdict (an `unexplained` one
 // that named nothing, or the challenged knobs; status partly_explained, with the doubts of a search

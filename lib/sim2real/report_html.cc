@@ -341,7 +341,13 @@ std::string PayloadSearchTables(const PayloadSearch& p) {
       << (std::isfinite(c.score) ? F("%.4f", c.score) : std::string("fell")) << "</td><td>" << (c.fits_as_well ? "yes" : "")
       << "</td><td>" << (std::isfinite(c.posture_z) ? F("%.1f", c.posture_z) : std::string("-")) << "</td></tr>";
   }
-  o << "</table>\n" << LegSearchTable(p.search, "The payload's mass at the best position", false);
+  o << "</table>\n";
+  if (!p.leg_challenged.empty()) {
+    o << "<p>Against the weak " << Escape(p.leg_challenged) << " the leg search named: its best point "
+      << (p.search.named ? "fits the real samples better" : "does not fit the real samples better by the bar")
+      << F(" (z %.2f, the bar ", p.search.z_vs_named) << F("%.3g).</p>\n", p.search.bar_z);
+  }
+  o << LegSearchTable(p.search, "The payload's mass at the best position", false);
   return o.str();
 }
 

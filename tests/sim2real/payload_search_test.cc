@@ -137,6 +137,96 @@ TEST(PayloadSearch, AChallengedNameGivesWayOnlyToAPayloadThatFitsBetter) {
       << kept.doubts[0];
 }
 
+// A leg the leg search named, with its best point's scores `rows` (a LegSearch as SearchLegGains
+// leaves it, the fields PayloadVersusLeg reads).
+LegSearch NamedLeg(const Eigen::VectorXd& rows) {
+  LegSearch leg;
+  leg.ran = leg.named = true;
+  leg.leg = "leg3";
+  leg.knob = "actuators.leg3.gain";
+  leg.value = 0.45;
+  leg.best_rows = rows;
+  leg.points = {{"leg3", leg.knob, kLeg3Gain, leg.value, rows.mean(), true}};
+  leg.best = 0;
+  return leg;
+}
+
+// Scores per real sample `shift` nats above `rows`, spread by a tenth of a nat across placements.
+Eigen::VectorXd Shifted(const Eigen::VectorXd& rows, const std::vector<int>& placement, double shift) {
+  Eigen::VectorXd out = rows;
+  for (int i = 0; i < out.size(); ++i) out(i) += shift + 0.1 * (placement[i] % 3 - 1);
+  return out;
+}
+
+// A payload off the middle can pass for one weak leg (PayloadVersusLeg): the payload that fits
+// better by the bar takes the leg's name, one that fits worse leaves it, one in between is a doubt.
+TEST(PayloadSearch, APayloadThatFitsBetterThanANamedLegTakesItsName) {
+  const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
+  PayloadSearchOptions o;
+  const PayloadSearch found = Search(s);
+  ASSERT_TRUE(found.search.named) << found.why;
+  const std::vector<int>& placement = s.in.real.episode;
+
+  PayloadSearch better = found;
+  LegSearch worse_leg = NamedLeg(Shifted(found.search.best_rows, placement, -1.0));
+  PayloadVersusLeg(s.in, o, &worse_leg, &better);
+  EXPECT_TRUE(better.search.named);
+  EXPECT_FALSE(worse_leg.named);
+  EXPECT_GT(better.search.z_vs_named, o.search.z);
+  EXPECT_NE(worse_leg.why.find("(leg3 at gain 0.45) fits the real samples worse than a payload of"), std::string::npos)
+      << worse_leg.why;
+  Verdict v = UnexplainedInRegions();
+  AddLegSearch(worse_leg, &v);
+  AddPayloadSearch(better, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "payload.mass_kg");
+  EXPECT_NE(v.named[0].doubts[0].find("after the leg search named a weak leg3 leg (gain 0.45), which it fits"),
+            std::string::npos)
+      << v.named[0].doubts[0];
+  EXPECT_NE(v.sentence.find("than the weak leg3 leg (gain 0.45) the leg search named (z"), std::string::npos) << v.sentence;
+
+  PayloadSearch worse = found;
+  LegSearch better_leg = NamedLeg(Shifted(found.search.best_rows, placement, 1.0));
+  PayloadVersusLeg(s.in, o, &better_leg, &worse);
+  EXPECT_TRUE(better_leg.named);
+  EXPECT_FALSE(worse.search.named);
+  EXPECT_FALSE(worse.search.rivals_named);
+  EXPECT_NE(worse.why.find("fits the real samples no better than the weak leg3 leg"), std::string::npos) << worse.why;
+
+  PayloadSearch rival = found;
+  LegSearch close_leg = NamedLeg(Shifted(found.search.best_rows, placement, -0.01));
+  PayloadVersusLeg(s.in, o, &close_leg, &rival);
+  ASSERT_GT(rival.search.z_vs_named, 0);
+  ASSERT_LT(rival.search.z_vs_named, o.search.z);
+  EXPECT_TRUE(close_leg.named);
+  EXPECT_FALSE(rival.search.named);
+  EXPECT_TRUE(rival.search.rivals_named);
+  Verdict kept = UnexplainedInRegions();
+  AddLegSearch(close_leg, &kept);
+  AddPayloadSearch(rival, &kept);
+  ASSERT_EQ(kept.named.size(), 1u);
+  EXPECT_EQ(kept.named[0].knob, "actuators.leg3.gain");
+  EXPECT_EQ(kept.status, "partly_explained");
+  bool doubted = false;
+  for (const std::string& d : kept.doubts) doubted |= d.find("fits the real samples as well as the named") != std::string::npos;
+  EXPECT_TRUE(doubted) << kept.sentence;
+}
+
+// On the fake's planted weak leg both searches run on the real samples: the leg fits better and
+// keeps its name.
+TEST(PayloadSearch, APlantedWeakLegKeepsItsNameAgainstThePayload) {
+  const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
+  LegSearchOptions lo;
+  lo.model = s.options.locate.model;
+  LegSearch leg = SearchLegGains(SharedFake(), s.in, s.set, s.options.candidates, lo);
+  ASSERT_TRUE(leg.named) << leg.why;
+  PayloadSearch p = Search(s);
+  PayloadVersusLeg(s.in, PayloadSearchOptions{}, &leg, &p);
+  EXPECT_TRUE(leg.named) << leg.why;
+  EXPECT_EQ(leg.leg, "leg1");
+  EXPECT_FALSE(p.search.named) << p.why;
+}
+
 // Where several columns fit as well, the torso's posture (PostureLeft) chooses among them; a
 // column that fits worse, or a posture that cannot be checked, changes nothing.
 TEST(PayloadSearch, ThePostureChoosesAmongTheColumnsThatFitAsWell) {

@@ -9,6 +9,7 @@
 
 #include "sim2real/ground_search.h"
 #include "sim2real/leg_search.h"
+#include "sim2real/payload_search.h"
 #include "tests/sim2real/fake_simulator.h"
 #include "tests/sim2real/stage_fixture.h"
 
@@ -136,6 +137,42 @@ TEST(Report, ALegNamedByTheLegSearchIsOneStoryInEveryOutput) {
       << summary_else;
   EXPECT_EQ(html_else.find("nan%"), std::string::npos);
   EXPECT_EQ(summary_else.find("nan%"), std::string::npos) << summary_else;
+}
+
+// A payload that took the name of a leg the leg search named (PayloadVersusLeg): every output names
+// the payload, the JSON says which leg it replaced, the HTML says it beat it.
+TEST(Report, APayloadThatTookALegsNameIsOneStoryInEveryOutput) {
+  const test::Stages s = test::RunStages({{test::kPayloadMass, 2.4}, {test::kPayloadX, -0.1}}, 3);
+  PayloadSearchOptions options;
+  options.search.model = s.options.locate.model;
+  const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
+  Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
+  a.payload_search = SearchPayload(test::SharedFake(), s.in, s.set, s.options.candidates, options);
+  ASSERT_TRUE(a.payload_search.search.named) << a.payload_search.why;
+  a.leg_search.ran = a.leg_search.named = true;
+  a.leg_search.leg = "leg3", a.leg_search.knob = "actuators.leg3.gain", a.leg_search.value = 0.45;
+  a.leg_search.best_rows = a.payload_search.search.best_rows;
+  for (int i = 0; i < a.leg_search.best_rows.size(); ++i) a.leg_search.best_rows(i) -= 1.0 + 0.1 * (s.in.real.episode[i] % 3);
+  a.leg_search.points = {{"leg3", a.leg_search.knob, test::kLeg3Gain, 0.45, a.leg_search.best_rows.mean(), true}};
+  a.leg_search.best = 0;
+  PayloadVersusLeg(s.in, options, &a.leg_search, &a.payload_search);
+  ASSERT_FALSE(a.leg_search.named);
+  a.verdict.status = "unexplained";
+  a.verdict.named.clear();
+  AddLegSearch(a.leg_search, &a.verdict);
+  AddPayloadSearch(a.payload_search, &a.verdict);
+  ReportContext ctx;
+  const auto json = nlohmann::json::parse(ReportJson(a, ctx));
+  const std::string html = ReportHtml(a, ctx, ".");
+  EXPECT_EQ(json["fit"]["corrected_by"], "payload_search");
+  EXPECT_EQ(json["verdict"]["named"][0]["knob"], "payload.mass_kg");
+  EXPECT_EQ(json["payload_search"]["leg_challenged"], "leg3 leg (gain 0.45)");
+  EXPECT_EQ(json["payload_search"]["challenged"][0], "actuators.leg3.gain");
+  EXPECT_FALSE(json["leg_search"]["named"].get<bool>());
+  EXPECT_EQ(Count(html, Escaped(a.verdict.sentence)), 1u);
+  EXPECT_NE(html.find("Against the weak leg3 leg (gain 0.45) the leg search named: its best point fits the real samples "
+                      "better (z"),
+            std::string::npos);
 }
 
 // The runoff's JSON speaks of knobs: no leg for a knob that is not a leg's, the knobs that fit as
