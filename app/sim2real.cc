@@ -434,12 +434,12 @@ void Setup(CLI::App& root) {
                 "recordings scored by their own model (three per leg and two more, 5 executions per placement; on "
                 "by default, --no-leg-search turns it off; docs/sim2real.md)");
   cmd->add_flag("--payload-search,!--no-payload-search", args->payload_search,
-                "experimental, off by default: on a plane, when nothing is named for a located mismatch after the "
-                "leg search or the leg search challenged the named knobs and kept them, search a payload's mass and "
-                "position (named only when it beats a challenged name's correction by 2 SE; 7 columns at 2 masses, a "
-                "column keeping its moment as the mass changes; then half-steps of the best column and its mass; each "
-                "recording scored by its own model, 5 executions per placement; it also runs without this flag where the "
-                "named physics leaves the torso's posture out, --payload-on-posture; docs/sim2real.md)");
+                "on a plane, when nothing is named for a located mismatch after the leg search or the leg search "
+                "challenged the named knobs and kept them, search a payload's mass and position (named only when it "
+                "beats a challenged name's correction by 2 SE; 7 columns at 2 masses, a column keeping its moment as "
+                "the mass changes; then half-steps of the best column and its mass; each recording scored by its own "
+                "model, 5 executions per placement; on by default since 2026-12-07, --no-payload-search turns it off "
+                "but for --payload-on-posture and --payload-vs-leg; docs/sim2real.md)");
   cmd->add_flag("--payload-on-posture,!--no-payload-on-posture", args->payload_on_posture,
                 "run the payload search also when the named physics leaves the torso's posture out (--posture; on "
                 "by default)");

@@ -1,5 +1,5 @@
 #pragma once
-// Stage 8c of the analysis (analysis.h, experimental, off by default): a search of a payload's mass
+// Stage 8c of the analysis (analysis.h; on by default since 2026-12-07): a search of a payload's mass
 // and position, run when the stages before (the leg search too) named nothing for a located
 // mismatch. The probes read a payload linearly from three recordings (mass at the middle, ahead,
 // to the left), but a payload off the middle can change the gait's posture far from linearly: on
@@ -36,7 +36,10 @@
 namespace dgmm::sim2real {
 
 struct PayloadSearchOptions {
-  bool enabled = false;  // `dgmm sim2real --payload-search`
+  // On by default since 2026-12-07 (`dgmm sim2real --no-payload-search` turns it off): over the
+  // hexapod's blind ranges it named payloads the probes missed and gave none to a null or an
+  // out-of-library pair (docs/sim2real.md, "The payload search on by default").
+  bool enabled = true;
   // Run also when the torso's posture is left out by the named physics (posture.h), enabled or not.
   bool on_posture = true;
   bool challenge_named = true;  // also challenge named knobs the leg search challenged

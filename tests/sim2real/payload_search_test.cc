@@ -299,7 +299,8 @@ TEST(PayloadSearch, RunsInTheAnalysisOnlyWhenEnabledAndNothingIsNamed) {
   extras.geometry = 0.03;
   const FakePair pair = MakeFakePair(SharedFake(), {}, extras);
   AnalysisOptions options = FastOptions();
-  EXPECT_FALSE(options.payload.enabled);
+  EXPECT_TRUE(options.payload.enabled) << "on by default";
+  options.payload.enabled = false;
   EXPECT_FALSE(Analyse(pair.sim, pair.real, &SharedFake(), options).payload_search.ran);
   options.payload.enabled = true;
   const Analysis a = Analyse(pair.sim, pair.real, &SharedFake(), options);
