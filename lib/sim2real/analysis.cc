@@ -231,6 +231,23 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   AddPayloadSearch(a->payload_search, &a->verdict);
 }
 
+// The leg and payload searches' best points that named nothing, for the advice of more placements.
+std::vector<SearchNearMiss> SearchNearMisses(const Analysis& a, const AnalysisOptions& options) {
+  std::vector<SearchNearMiss> near;
+  const auto add = [&near](const LegSearch& s, const std::string& by, const std::string& family,
+                           const std::string& said, double bar) {
+    if (!s.ran || s.named || s.best < 0 || !std::isfinite(s.nominal_score)) return;
+    near.push_back({by, s.knob, family, said, BestScore(s) - s.nominal_score, s.draws.chance, s.z_vs_nominal, bar,
+                    static_cast<int>(s.best_rows.size())});
+  };
+  const LegSearch& legs = a.leg_search;
+  add(legs, "the leg search", "actuator_gain", "a weak " + legs.leg + Fmt(" leg (gain %.3g)", legs.value), options.legs.z);
+  if (a.payload_search.ran) {
+    add(a.payload_search.search, "the payload search", "payload", PayloadSaid(a.payload_search), options.payload.search.z);
+  }
+  return near;
+}
+
 // The knobs the runoff, the leg search or the payload search recorded without naming them.
 std::vector<std::string> SearchedWithoutName(const Analysis& a) {
   std::vector<std::string> knobs;
@@ -517,7 +534,7 @@ Analysis Analyse(const SampleSet& sim, const SampleSet& real, const KnobSimulato
   NameAndCheck(*simulator, options, stage, &a);
   RefitWithoutContradictedImu(*simulator, options, stage, &a);
   a.more_data = AdviseMoreData(a.inputs, a.candidates, a.refinement, a.naming, a.verdict, SearchedWithoutName(a),
-                               options.more_data);
+                               options.more_data, SearchNearMisses(a, options));
   a.verdict.sentence += MoreDataSentence(a.more_data);
   a.seconds.total = Since(start);
   return a;

@@ -99,8 +99,6 @@ std::string PostureChoiceSaid(const PayloadSearch& p) {
          " over the likelihood's best, " + WhereSaid(best.best_x, best.best_y) + Fmt(" (%.1f SE).", best.posture_z);
 }
 
-// "a payload of 0.85 kg 3.4 cm ahead of the middle"
-std::string PayloadSaid(const PayloadSearch& p) { return Fmt("a payload of %.3g kg ", p.search.value) + WhereSaid(p.x, p.y); }
 
 VerdictNamed NamedPayload(const PayloadSearch& p) {
   const LegSearch& s = p.search;
@@ -227,6 +225,8 @@ void RefineRanked(const Columns& columns, const LegSearchOptions& options, const
 }
 
 }  // namespace
+
+std::string PayloadSaid(const PayloadSearch& p) { return Fmt("a payload of %.3g kg ", p.search.value) + WhereSaid(p.x, p.y); }
 
 bool PayloadSearchOptions::IsValid(std::string* error) const {
   if (masses.empty() || std::any_of(masses.begin(), masses.end(), [](double m) { return !(m > 0); })) {

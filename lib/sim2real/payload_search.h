@@ -89,6 +89,9 @@ struct PayloadSearch {
   double seconds = 0;
 };
 
+// The best point in words: "a payload of 0.85 kg 3.4 cm ahead of the middle".
+std::string PayloadSaid(const PayloadSearch& search);
+
 // The named (best) payload's moment about the knobs' nominal position, forward and left (kg m).
 std::pair<double, double> PayloadMoment(const PayloadSearch& search);
 

@@ -317,7 +317,8 @@ json MoreDataJson(const MoreData& m) {
           {"z_effective", JsonNumber(m.z_effective)}, {"placements", m.placements},
           {"executions_per_placement", m.executions_per_placement}, {"placements_are_samples", !m.sequence},
           {"placements_needed", m.placements_needed < 0 ? json(nullptr) : json(m.placements_needed)},
-          {"max_factor", JsonNumber(m.max_factor)}};
+          {"max_factor", JsonNumber(m.max_factor)}, {"said", m.said.empty() ? json(nullptr) : json(m.said)},
+          {"chance", JsonNumber(m.chance)}};
 }
 
 json Pair(const Eigen::Vector2d& v) { return json::array({JsonNumber(v(0)), JsonNumber(v(1))}); }

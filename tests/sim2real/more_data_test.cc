@@ -65,6 +65,46 @@ TEST(MoreData, ANearMissScalesWithTheSquareRootOfThePlacements) {
   EXPECT_NE(s.find("30 placements of 3 executions"), std::string::npos) << s;
 }
 
+// A search's best point that beat the nominal by z 1.6 of its bar 2 (a gain of 0.1 nats per sample
+// over 90 real samples), with the walk's own chance `chance`.
+SearchNearMiss PayloadNearMiss(double z, double chance = 0) {
+  return {"the payload search", "payload.mass_kg", "payload", "a payload of 0.5 kg 3 cm ahead of the middle", 0.1, chance,
+          z, 2.0, 90};
+}
+
+TEST(MoreData, ASearchsNearMissScalesUnlessTheWalksChanceBoundsIt) {
+  const Refinement none = FirstStep(-1, 1.0, 0.5);  // the selection came nowhere near
+  const MoreData m = AdviseMoreData(Inputs(), TwoCandidates(), none, {}, Unexplained(), {}, {}, {PayloadNearMiss(1.6)});
+  ASSERT_TRUE(m.advised);
+  EXPECT_EQ(m.reason, "search_near_miss");
+  EXPECT_EQ(m.knob, "payload.mass_kg");
+  EXPECT_EQ(m.placements_needed, 106) << "30 (3 / 1.6)^2 = 105.5";
+  const std::string s = MoreDataSentence(m);
+  EXPECT_NE(s.find("the payload search's best point (a payload of 0.5 kg 3 cm ahead of the middle) fits the real samples "
+                   "better than the nominal by z 1.60 (named from 2.00)"),
+            std::string::npos)
+      << s;
+  EXPECT_NE(s.find("at least about 106 placements would be needed"), std::string::npos) << s;
+  // A chance in the score of 0.04 nats per sample bounds z at 0.1 / 0.04 = 2.5, under the 3 aimed at.
+  const MoreData bounded =
+      AdviseMoreData(Inputs(), TwoCandidates(), none, {}, Unexplained(), {}, {}, {PayloadNearMiss(1.6, 0.04)});
+  ASSERT_TRUE(bounded.advised);
+  EXPECT_EQ(bounded.placements_needed, -1);
+  EXPECT_NE(MoreDataSentence(bounded).find("the walk's own chance in the search's score (0.04 nats per real sample)"),
+            std::string::npos)
+      << MoreDataSentence(bounded);
+  // A smaller chance only raises the placements needed.
+  const MoreData more = AdviseMoreData(Inputs(), TwoCandidates(), none, {}, Unexplained(), {}, {}, {PayloadNearMiss(1.6, 0.01)});
+  EXPECT_GT(more.placements_needed, 106);
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), none, {}, Unexplained(), {}, {}, {PayloadNearMiss(1.4)}).advised)
+      << "under three quarters of the bar";
+  EXPECT_FALSE(AdviseMoreData(Inputs(), TwoCandidates(), none, {}, Unexplained(), {}, {}, {PayloadNearMiss(2.1)}).advised)
+      << "over the bar: the search named nothing for another reason";
+  const MoreData selection =
+      AdviseMoreData(Inputs(), TwoCandidates(), FirstStep(-1, 2.4, 1.1), {}, Unexplained(), {}, {}, {PayloadNearMiss(1.6)});
+  EXPECT_EQ(selection.reason, "near_miss") << "the selection's own near miss first";
+}
+
 TEST(MoreData, AKnobTheResamplesDisagreedOnScalesFromItsInclusion) {
   Naming naming;
   naming.weak = {1};
