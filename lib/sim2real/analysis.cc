@@ -241,7 +241,7 @@ std::vector<SearchNearMiss> SearchNearMisses(const Analysis& a, const AnalysisOp
                     static_cast<int>(s.best_rows.size())});
   };
   const LegSearch& legs = a.leg_search;
-  add(legs, "the leg search", "actuator_gain", "a weak " + legs.leg + Fmt(" leg (gain %.3g)", legs.value), options.legs.z);
+  add(legs, "the leg search", "actuator_gain", "a weak " + LegSaid(legs), options.legs.z);
   if (a.payload_search.ran) {
     add(a.payload_search.search, "the payload search", "payload", PayloadSaid(a.payload_search), options.payload.search.z);
   }

@@ -206,6 +206,9 @@ double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::ve
 // of a search-named point; NaN without a best point.
 inline double BestScore(const LegSearch& s) { return s.best >= 0 ? s.points[s.best].score : NAN; }
 
+// The best point's leg in words: "rear_right leg (gain 0.35)".
+std::string LegSaid(const LegSearch& search);
+
 // The per-leg gain knobs of `simulator` (family actuator_gain, a leg's name, a shift role).
 std::vector<int> LegGainKnobs(const KnobSimulator& simulator);
 

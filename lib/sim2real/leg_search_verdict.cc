@@ -36,6 +36,8 @@ void AddRivalDoubt(const LegSearch& s, const std::string& subject, Verdict* v) {
   if (v->status == "explained") v->status = "partly_explained";
 }
 
+std::string LegSaid(const LegSearch& s) { return s.leg + Fmt(" leg (gain %.3g)", s.value); }
+
 VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const std::string& unit) {
   VerdictNamed n;
   n.family = family;
@@ -84,7 +86,7 @@ void AddLegSearch(const LegSearch& s, Verdict* v) {
     v->sentence += Fmt(" A search of every leg's gain (%.0f recordings, each scored by a model of its own) names no leg: ",
                        static_cast<double>(s.points.size())) +
                    s.why + ".";
-    if (s.rivals_named) AddRivalDoubt(s, "a weak " + s.leg + Fmt(" leg (gain %.3g)", s.value), v);
+    if (s.rivals_named) AddRivalDoubt(s, "a weak " + LegSaid(s), v);
     return;
   }
   ReplaceNamed(s, NamedLeg(s), v);

@@ -99,7 +99,6 @@ std::string PostureChoiceSaid(const PayloadSearch& p) {
          " over the likelihood's best, " + WhereSaid(best.best_x, best.best_y) + Fmt(" (%.1f SE).", best.posture_z);
 }
 
-
 VerdictNamed NamedPayload(const PayloadSearch& p) {
   const LegSearch& s = p.search;
   VerdictNamed n = SearchNamed(s, "payload", "kg");
@@ -313,7 +312,7 @@ void PayloadVersusLeg(const AnalysisInputs& in, const PayloadSearchOptions& opti
   LegSearch& s = p->search;
   if (!p->ran || !s.named || !leg->named || leg->best_rows.size() != s.best_rows.size()) return;
   const double chance = std::max(leg->draws.chance, s.draws.chance) * static_cast<double>(s.best_rows.size());
-  const std::string leg_said = leg->leg + Fmt(" leg (gain %.3g)", leg->value);
+  const std::string leg_said = LegSaid(*leg);
   p->leg_challenged = leg_said;
   s.challenged = {leg->knob};
   s.z_vs_named = PairedZ(s.best_rows, leg->best_rows, in.real.episode, chance);

@@ -1,7 +1,7 @@
 #pragma once
 // Stage 8c of the analysis (analysis.h; on by default since 2026-12-07): a search of a payload's mass
 // and position, run when the stages before (the leg search too) named nothing for a located
-// mismatch. The probes read a payload linearly from three recordings (mass at the middle, ahead,
+// mismatch, or as the challenger of a leg the leg search named (PayloadVersusLeg). The probes read a payload linearly from three recordings (mass at the middle, ahead,
 // to the left), but a payload off the middle can change the gait's posture far from linearly: on
 // the hexapod on its 10° slope 0.88 kg 2.2 cm behind the middle sits the robot back 74 mrad in
 // pitch, 75 nats per real sample below the real-trained ceiling, which the probes' reading
@@ -85,7 +85,7 @@ struct PayloadSearch {
   LegSearch search;                    // the best column's search (its `also`: the position)
   double x = NAN, y = NAN;             // where the named mass sits
   double x_nominal = 0, y_nominal = 0; // the knobs' nominal position (the middle)
-  std::string leg_challenged;          // the named leg it challenged ("rear_right at gain 0.35"), or empty
+  std::string leg_challenged;          // the named leg it challenged ("rear_right leg (gain 0.35)"), or empty
   double seconds = 0;
 };
 
