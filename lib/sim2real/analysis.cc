@@ -45,9 +45,13 @@ bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
   });
   const bool short_of_it =
       a.adequacy.below_ceiling || a.adequacy.gap_closed < options.challenge_gap_closed || unsure || a.posture.left_out;
-  if ((a.verdict.status == "explained" && !a.posture.left_out) || !short_of_it) return false;
-  return std::none_of(a.naming.named.begin(), a.naming.named.end(),
-                      [&](int c) { return !a.candidates.candidates[c].leg.empty(); });
+  const auto named_where = [&](auto part) {
+    return std::any_of(a.naming.named.begin(), a.naming.named.end(),
+                       [&](int c) { return !(a.candidates.candidates[c].*part).empty(); });
+  };
+  if (named_where(&KnobCandidate::leg)) return false;
+  if (options.challenge_side && named_where(&KnobCandidate::side)) return true;
+  return !(a.verdict.status == "explained" && !a.posture.left_out) && short_of_it;
 }
 
 }  // namespace

@@ -78,6 +78,10 @@ struct LegSearchOptions {
   // the leg, 6% from the truth, and changed nothing else; on the octopod's blind pairs 56000-56019
   // no named family was under 80% (docs/sim2real.md). 0 until then.
   double challenge_inclusion = 0.8;
+  // Also challenge a named side's gain (a per-side knob) whatever the fit: one weak leg of that side
+  // is the finer physics a side's gain stands in for (hexapod pair 65190: a weak rear_left leg, gain
+  // 0.505, named as the left side's gain 0.87 at 85% inclusion, 95% of the gap closed).
+  bool challenge_side = true;
   // The misfit's unseen samples (min_gap_closed): the recording's own odd executions at the same
   // places, or with `misfit_elsewhere` a second recording of the nominal and of the best point at
   // other places (the real set's design, seed `elsewhere_seed`), where the real samples stand too.

@@ -86,6 +86,7 @@ struct PayloadSearch {
   double x = NAN, y = NAN;             // where the named mass sits
   double x_nominal = 0, y_nominal = 0; // the knobs' nominal position (the middle)
   std::string leg_challenged;          // the named leg it challenged ("rear_right leg (gain 0.35)"), or empty
+  bool refused_fits_better = false;    // refused by its own gates, yet better than the named leg by the bar
   double seconds = 0;
 };
 
@@ -118,14 +119,16 @@ void PayloadSearchChallenge(const AnalysisInputs& in, const std::vector<std::str
 //   z = sum_i (score_payload,i - score_leg,i) / sqrt(SE^2 + (n chance)^2).
 // A named payload with z >= options.search.z takes the leg's name (the leg search names nothing and
 // its `why` says so); under it the payload names nothing, a rival of the leg when z > 0. A payload
-// its own gates did not name changes nothing.
+// its own gates refused takes nothing, but where it fits better by the bar (`refused_fits_better`)
+// the verdict doubts the leg (AddPayloadSearch).
 void PayloadVersusLeg(const AnalysisInputs& in, const PayloadSearchOptions& options, LegSearch* leg,
                       PayloadSearch* search);
 
 // The search's answer in the verdict: a named payload replaces the verdict (an `unexplained` one
 // that named nothing, or the challenged knobs; status partly_explained, with the doubts of a search
 // without bootstrap); otherwise the sentence says what the search found and why it names nothing,
-// and a doubt when its payload fits as well as the challenged knobs.
+// and a doubt when its payload fits as well as the challenged knobs, or when its gates refused a
+// payload that fits better than the named leg.
 void AddPayloadSearch(const PayloadSearch& search, Verdict* verdict);
 
 }  // namespace dgmm::sim2real

@@ -344,7 +344,9 @@ std::string PayloadSearchTables(const PayloadSearch& p) {
   o << "</table>\n";
   if (!p.leg_challenged.empty()) {
     o << "<p>Against the weak " << Escape(p.leg_challenged) << " the leg search named: its best point "
-      << (p.search.named ? "fits the real samples better" : "does not fit the real samples better by the bar")
+      << (p.search.named           ? "fits the real samples better"
+          : p.refused_fits_better ? "fits the real samples better, but its own gates refused it"
+                                  : "does not fit the real samples better by the bar")
       << F(" (z %.2f, the bar ", p.search.z_vs_named) << F("%.3g).</p>\n", p.search.bar_z);
   }
   o << LegSearchTable(p.search, "The payload's mass at the best position", false);
@@ -460,6 +462,10 @@ std::string ReportHtml(const Analysis& a, const ReportContext& ctx, const std::f
 std::string ReportSummary(const Analysis& a, const ReportContext& ctx, const std::string& report_path) {
   std::ostringstream o;
   o << "verdict: " << a.verdict.status << "\n" << a.verdict.sentence << "\n";
+  // Doubts added after the sentence was written (a search's rival, a refused payload that fits better)
+  for (const std::string& d : a.verdict.doubts) {
+    if (a.verdict.sentence.find(d) == std::string::npos) o << "doubt: " << d << "\n";
+  }
   const LocateSummary& s = a.baseline.before;
   o << "located: " << s.conditional_flagged << " terrain, sequence or command region(s) significant";
   if (!s.significant.empty()) o << " (worst: " << s.significant.front().label << ")";

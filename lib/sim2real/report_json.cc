@@ -305,6 +305,7 @@ json PayloadSearchJson(const PayloadSearch& p) {
   out["likelihood_best_position"] = p.likelihood_best;  // index into positions: the best by likelihood alone
   out["named_position"] = p.best_column;  // the position named (the posture's choice where it differs)
   out["leg_challenged"] = p.leg_challenged.empty() ? json(nullptr) : json(p.leg_challenged);
+  out["refused_fits_better_than_leg"] = p.refused_fits_better;
   out["seconds"] = p.seconds;
   return out;
 }

@@ -161,6 +161,30 @@ TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
   EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
 }
 
+// A side's gain named is challenged by the leg search whatever its fit and status (hexapod pair
+// 65190: a weak rear_left leg read as the left side's gain at 85% inclusion, 95% of the gap closed);
+// `challenge_side` false leaves it to the other rules, and a named leg is never challenged.
+TEST(Analysis, TheLegSearchChallengesANamedSidesGain) {
+  Analysis a;
+  a.candidates.candidates.resize(2);
+  a.candidates.candidates[0].side = "left";
+  a.candidates.candidates[1].leg = "rear_left";
+  a.naming.named = {0};
+  a.verdict.status = "explained";
+  a.verdict.named.resize(1);
+  a.verdict.named[0].inclusion = 0.85;
+  a.adequacy.gap_closed = 0.95;
+  LegSearchOptions options;
+  EXPECT_TRUE(WantLegSearch(a, options)) << "a side's gain, explained and closing the gap";
+  options.challenge_side = false;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "turned off: the other rules see nothing short";
+  options.challenge_side = true;
+  a.naming.named = {0, 1};
+  EXPECT_FALSE(WantLegSearch(a, options)) << "a leg is named too";
+  a.naming.named = {0}, a.baseline.permute_placements = true;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
+}
+
 // With challenge_inclusion a name the resamples seldom agree on is challenged even at the ceiling
 // (sprawled quadruped 54202: a weak front leg read as soft servos, inclusion 75%, and a tracker
 // offset, 60%); at 80% by default, 0 turns it off.

@@ -55,6 +55,8 @@ TEST(LegSearch, NamesAPlantedWeakLegWithItsGain) {
   EXPECT_LE(r.as_well.lower, r.value);
   EXPECT_GE(r.as_well.upper, r.value);
   EXPECT_GT(r.points.size(), 12u) << "four legs at three gains, then half-steps around the best";
+  // The near miss's gain (SearchNearMisses) is the best score minus the nominal's, its z from these rows.
+  EXPECT_NEAR(r.best_rows.mean(), BestScore(r), 1e-9 * std::abs(BestScore(r)));
   const Correction c = LegSearchCorrection(r);
   ASSERT_TRUE(static_cast<bool>(c.shift));
   EXPECT_GT(c.Shift(0, s.in.real.z.row(0).transpose(), 0, s.in.real.pose_dim()).norm(), 0);

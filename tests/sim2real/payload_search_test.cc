@@ -212,6 +212,53 @@ TEST(PayloadSearch, APayloadThatFitsBetterThanANamedLegTakesItsName) {
   EXPECT_TRUE(doubted) << kept.sentence;
 }
 
+// A payload its own gates refused takes no name from a leg, but where it fits the real samples
+// better by the bar the leg's name is doubted in the verdict; one that fits worse changes nothing.
+TEST(PayloadSearch, ARefusedPayloadThatFitsBetterDoubtsTheNamedLeg) {
+  const Stages s = RunStages({{kPayloadMass, 2.4}, {kPayloadX, -0.1}}, 3);
+  PayloadSearchOptions o;
+  PayloadSearch refused = Search(s);
+  ASSERT_TRUE(refused.search.named) << refused.why;
+  refused.search.named = false;
+  refused.why = "its best mass sits at the search's upper limit";
+  const std::vector<int>& placement = s.in.real.episode;
+
+  PayloadSearch better = refused;
+  LegSearch worse_leg = NamedLeg(Shifted(refused.search.best_rows, placement, -1.0));
+  PayloadVersusLeg(s.in, o, &worse_leg, &better);
+  EXPECT_TRUE(worse_leg.named);
+  EXPECT_FALSE(better.search.named);
+  EXPECT_TRUE(better.refused_fits_better);
+  EXPECT_GT(better.search.z_vs_named, o.search.z);
+  Verdict v = UnexplainedInRegions();
+  AddLegSearch(worse_leg, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  v.status = "explained";
+  AddPayloadSearch(better, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "actuators.leg3.gain");
+  EXPECT_EQ(v.status, "partly_explained");
+  bool doubted = false;
+  for (const std::string& d : v.doubts) {
+    doubted |= d.find("better than the weak leg3 leg (gain 0.45) the leg search named") != std::string::npos &&
+               d.find("though its own gates refused it (its best mass sits at the search's upper limit)") != std::string::npos;
+  }
+  EXPECT_TRUE(doubted) << v.sentence;
+
+  PayloadSearch worse = refused;
+  LegSearch better_leg = NamedLeg(Shifted(refused.search.best_rows, placement, 1.0));
+  PayloadVersusLeg(s.in, o, &better_leg, &worse);
+  EXPECT_FALSE(worse.refused_fits_better);
+  EXPECT_TRUE(worse.leg_challenged.empty());
+  Verdict kept = UnexplainedInRegions();
+  AddLegSearch(better_leg, &kept);
+  kept.status = "explained";
+  const std::size_t doubts = kept.doubts.size();
+  AddPayloadSearch(worse, &kept);
+  EXPECT_EQ(kept.status, "explained");
+  EXPECT_EQ(kept.doubts.size(), doubts);
+}
+
 // On the fake's planted weak leg both searches run on the real samples: the leg fits better and
 // keeps its name.
 TEST(PayloadSearch, APlantedWeakLegKeepsItsNameAgainstThePayload) {

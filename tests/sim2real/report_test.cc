@@ -139,28 +139,39 @@ TEST(Report, ALegNamedByTheLegSearchIsOneStoryInEveryOutput) {
   EXPECT_EQ(summary_else.find("nan%"), std::string::npos) << summary_else;
 }
 
-// A payload that took the name of a leg the leg search named (PayloadVersusLeg): every output names
-// the payload, the JSON says which leg it replaced, the HTML says it beat it.
-TEST(Report, APayloadThatTookALegsNameIsOneStoryInEveryOutput) {
+// The fake pair's analysis with a payload search (planted 2.4 kg 10 cm behind) against a named weak
+// leg3 that fits `leg_below` nats per real sample worse; `refused`: the payload's own gates refused
+// it. PayloadVersusLeg, then the searches in the verdict as the analysis adds them.
+Analysis PayloadAgainstLeg(double leg_below, bool refused) {
   const test::Stages s = test::RunStages({{test::kPayloadMass, 2.4}, {test::kPayloadX, -0.1}}, 3);
   PayloadSearchOptions options;
   options.search.model = s.options.locate.model;
   const test::FakePair pair = test::MakeFakePair(test::SharedFake(), {}, {});
   Analysis a = Analyse(pair.sim, pair.real, &test::SharedFake(), test::FastOptions());
   a.payload_search = SearchPayload(test::SharedFake(), s.in, s.set, s.options.candidates, options);
-  ASSERT_TRUE(a.payload_search.search.named) << a.payload_search.why;
+  EXPECT_TRUE(a.payload_search.search.named) << a.payload_search.why;
+  if (refused) a.payload_search.search.named = false, a.payload_search.why = "its walk did not converge";
   a.leg_search.ran = a.leg_search.named = true;
   a.leg_search.leg = "leg3", a.leg_search.knob = "actuators.leg3.gain", a.leg_search.value = 0.45;
   a.leg_search.best_rows = a.payload_search.search.best_rows;
-  for (int i = 0; i < a.leg_search.best_rows.size(); ++i) a.leg_search.best_rows(i) -= 1.0 + 0.1 * (s.in.real.episode[i] % 3);
+  for (int i = 0; i < a.leg_search.best_rows.size(); ++i) {
+    a.leg_search.best_rows(i) -= leg_below + 0.1 * (s.in.real.episode[i] % 3);
+  }
   a.leg_search.points = {{"leg3", a.leg_search.knob, test::kLeg3Gain, 0.45, a.leg_search.best_rows.mean(), true}};
   a.leg_search.best = 0;
   PayloadVersusLeg(s.in, options, &a.leg_search, &a.payload_search);
-  ASSERT_FALSE(a.leg_search.named);
   a.verdict.status = "unexplained";
   a.verdict.named.clear();
   AddLegSearch(a.leg_search, &a.verdict);
   AddPayloadSearch(a.payload_search, &a.verdict);
+  return a;
+}
+
+// A payload that took the name of a leg the leg search named (PayloadVersusLeg): every output names
+// the payload, the JSON says which leg it replaced, the HTML says it beat it.
+TEST(Report, APayloadThatTookALegsNameIsOneStoryInEveryOutput) {
+  const Analysis a = PayloadAgainstLeg(1.0, false);
+  ASSERT_FALSE(a.leg_search.named);
   ReportContext ctx;
   const auto json = nlohmann::json::parse(ReportJson(a, ctx));
   const std::string html = ReportHtml(a, ctx, ".");
@@ -168,11 +179,33 @@ TEST(Report, APayloadThatTookALegsNameIsOneStoryInEveryOutput) {
   EXPECT_EQ(json["verdict"]["named"][0]["knob"], "payload.mass_kg");
   EXPECT_EQ(json["payload_search"]["leg_challenged"], "leg3 leg (gain 0.45)");
   EXPECT_EQ(json["payload_search"]["challenged"][0], "actuators.leg3.gain");
+  EXPECT_FALSE(json["payload_search"]["refused_fits_better_than_leg"].get<bool>());
   EXPECT_FALSE(json["leg_search"]["named"].get<bool>());
   EXPECT_EQ(Count(html, Escaped(a.verdict.sentence)), 1u);
   EXPECT_NE(html.find("Against the weak leg3 leg (gain 0.45) the leg search named: its best point fits the real samples "
                       "better (z"),
             std::string::npos);
+}
+
+// A payload its gates refused that fits better than the named leg: every output keeps the leg, and
+// the JSON, the HTML and the summary carry the one doubt.
+TEST(Report, ARefusedPayloadThatFitsBetterIsTheLegsDoubtInEveryOutput) {
+  const Analysis a = PayloadAgainstLeg(1.0, true);
+  ASSERT_TRUE(a.leg_search.named);
+  ReportContext ctx;
+  const auto json = nlohmann::json::parse(ReportJson(a, ctx));
+  const std::string html = ReportHtml(a, ctx, ".");
+  const std::string summary = ReportSummary(a, ctx, "report.html");
+  EXPECT_EQ(json["verdict"]["named"][0]["knob"], "actuators.leg3.gain");
+  EXPECT_EQ(json["verdict"]["status"], "partly_explained");
+  EXPECT_TRUE(json["payload_search"]["refused_fits_better_than_leg"].get<bool>());
+  const std::string doubt = "though its own gates refused it (its walk did not converge)";
+  int in_json = 0;
+  for (const auto& d : json["verdict"]["doubts"]) in_json += d.get<std::string>().find(doubt) != std::string::npos;
+  EXPECT_EQ(in_json, 1);
+  EXPECT_NE(html.find(Escaped(doubt)), std::string::npos);
+  EXPECT_NE(summary.find(doubt), std::string::npos) << summary;
+  EXPECT_NE(html.find("its best point fits the real samples better, but its own gates refused it (z"), std::string::npos);
 }
 
 // The runoff's JSON speaks of knobs: no leg for a knob that is not a leg's, the knobs that fit as
