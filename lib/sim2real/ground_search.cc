@@ -359,10 +359,8 @@ void AddGroundSearch(const KnobSimulator& simulator, const GroundSearch& g, Verd
       Fmt(" ratio %.2f, z %.1f)", g.ratio, g.z_moved);
   if (!g.search.named) {
     const std::string doubt = tilt + ": " + g.why;
-    v->doubts.push_back(doubt);
+    AddVerdictDoubt(doubt, v);
     if (!v->named.empty()) v->named.front().doubts.push_back(doubt);
-    if (v->status == "explained") v->status = "partly_explained";
-    if (v->status == "clean") v->status = "unexplained";
     v->unexplained_present = true;
     AddUnique(&v->structured_in, "ground");
     v->sentence += " The ground: " + doubt + ".";

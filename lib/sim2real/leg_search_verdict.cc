@@ -28,12 +28,12 @@ VerdictNamed NamedLeg(const LegSearch& s) {
 // A challenger that fits the real samples at least as well as the named knobs: the data do not tell
 // them apart, so the named knobs are not the only reading.
 void AddRivalDoubt(const LegSearch& s, const std::string& subject, Verdict* v) {
-  v->doubts.push_back(subject +
-                      Fmt(" fits the real samples as well as the named knobs (better by z %.2f, under the search's bar of "
-                          "%.3g):",
-                          s.z_vs_named, s.bar_z) +
-                      " these data do not tell the two apart");
-  if (v->status == "explained") v->status = "partly_explained";
+  AddVerdictDoubt(subject +
+                  Fmt(" fits the real samples as well as the named knobs (better by z %.2f, under the search's bar of "
+                      "%.3g):",
+                      s.z_vs_named, s.bar_z) +
+                  " these data do not tell the two apart",
+                  v);
 }
 
 std::string LegSaid(const LegSearch& s) { return s.leg + Fmt(" leg (gain %.3g)", s.value); }

@@ -313,16 +313,16 @@ void PayloadVersusLeg(const AnalysisInputs& in, const PayloadSearchOptions& opti
   if (!p->ran || s.best < 0 || !leg->named || leg->best_rows.size() != s.best_rows.size()) return;
   const double chance = std::max(leg->draws.chance, s.draws.chance) * static_cast<double>(s.best_rows.size());
   const double z = PairedZ(s.best_rows, leg->best_rows, in.real.episode, chance);
+  if (!s.named && z < options.search.z) return;  // refused by its own gates, and no better than the leg
   const std::string leg_said = LegSaid(*leg);
-  if (!s.named) {  // refused by its own gates: the leg stays, doubted where the payload fits better by the bar
-    p->refused_fits_better = z >= options.search.z;
-    if (p->refused_fits_better) p->leg_challenged = leg_said, s.z_vs_named = z, s.bar_z = options.search.z;
-    return;
-  }
   p->leg_challenged = leg_said;
-  s.challenged = {leg->knob};
   s.z_vs_named = z;
   s.bar_z = options.search.z;
+  if (!s.named) {  // refused by its own gates: the leg stays, doubted (AddPayloadSearch)
+    p->refused_fits_better = true;
+    return;
+  }
+  s.challenged = {leg->knob};
   const std::string scores = Fmt(" (%.3g against %.3g nats per sample, z %.2f)", BestScore(s), BestScore(*leg), s.z_vs_named);
   if (s.z_vs_named >= options.search.z) {
     leg->named = false;
@@ -343,11 +343,11 @@ namespace {
 // A payload its own gates refused that fits the real samples better than the named leg by the bar:
 // the leg's name is not the best fit the searches found, so it is doubted.
 void AddRefusedPayloadDoubt(const PayloadSearch& p, Verdict* v) {
-  v->doubts.push_back(PayloadSaid(p) + " fits the real samples better than the weak " + p.leg_challenged +
-                      Fmt(" the leg search named (z %.2f, over the bar of %.3g), though its own gates refused it (",
-                          p.search.z_vs_named, p.search.bar_z) +
-                      p.why + "): neither may be the physics these data show");
-  if (v->status == "explained") v->status = "partly_explained";
+  AddVerdictDoubt(PayloadSaid(p) + " fits the real samples better than the weak " + p.leg_challenged +
+                  Fmt(" the leg search named (z %.2f, over the bar of %.3g), though its own gates refused it (",
+                      p.search.z_vs_named, p.search.bar_z) +
+                  p.why + "): neither may be the physics these data show",
+                  v);
 }
 }  // namespace
 

@@ -357,9 +357,7 @@ namespace {
 // A posture left out in the verdict: a doubt, `explained` becomes `partly_explained` and `clean`
 // becomes `unexplained`.
 void AddDoubt(const std::string& doubt, Verdict* v) {
-  v->doubts.push_back(doubt);
-  if (v->status == "explained") v->status = "partly_explained";
-  if (v->status == "clean") v->status = "unexplained";
+  AddVerdictDoubt(doubt, v);
   v->unexplained_present = true;
   AddUnique(&v->structured_in, "posture");
   v->sentence += " The posture: " + doubt + ".";

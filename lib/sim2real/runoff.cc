@@ -102,8 +102,7 @@ void AddRunoff(const KnobSimulator& simulator, Runoff* runoff, Verdict* v) {
     const std::string doubt = "on this uneven ground a runoff (" + list + ") names no knob: " + s.why;
     if (!v->named.empty()) {
       v->named.front().doubts.push_back(doubt);
-      v->doubts.push_back(doubt);
-      if (v->status == "explained") v->status = "partly_explained";
+      AddVerdictDoubt(doubt, v);
     }
     v->sentence += " On this uneven ground a runoff (" + list + ") names no knob: " + s.why + ".";
     return;

@@ -103,4 +103,10 @@ std::string VerdictJson(const Verdict& v) {
   return out.dump();
 }
 
+void AddVerdictDoubt(const std::string& doubt, Verdict* v) {
+  v->doubts.push_back(doubt);
+  if (v->status == "explained") v->status = "partly_explained";
+  if (v->status == "clean") v->status = "unexplained";
+}
+
 }  // namespace dgmm::sim2real

@@ -100,4 +100,8 @@ std::string DescribeExperiment(const VerdictExperiment& e);
 // JSON text of the verdict object (contract of docs/sim2real.md).
 std::string VerdictJson(const Verdict& v);
 
+// A doubt a later stage adds to the verdict: `explained` becomes `partly_explained`, `clean`
+// becomes `unexplained` (the sentence is left as it is).
+void AddVerdictDoubt(const std::string& doubt, Verdict* v);
+
 }  // namespace dgmm::sim2real
