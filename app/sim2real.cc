@@ -450,7 +450,7 @@ void Setup(CLI::App& root) {
                 "for one weak leg, and the better of the two (by 2 SE) keeps the name (on by default; docs/sim2real.md)");
   cmd->add_flag("--payload-posture-chooses,!--no-payload-posture-chooses", args->payload_posture_chooses,
                 "where several of the payload search's positions fit the real samples as well, name the one whose "
-                "payload leaves the least of the real torso's posture (--posture; on by default; docs/sim2real.md)");
+                "payload leaves the least of the real torso's posture (--posture; off by default; docs/sim2real.md)");
   cmd->add_flag("--posture,!--no-posture", args->posture,
                 "on a plane (level, or a slope: the radial part of pitch and roll), check that the named physics "
                 "gives the real torso's mean pitch and roll (its recording at the sim set's places); a posture it "

@@ -1,9 +1,17 @@
 #include "sim2real/confidence.h"
 
 #include <algorithm>
+#include <map>
 #include <set>
+#include <string>
 
 namespace dgmm::sim2real {
+namespace {
+
+// A candidate's family at its scope: "actuator_gain/whole" or "actuator_gain/part".
+std::string ScopeOf(const KnobCandidate& c) { return c.family + (c.leg.empty() && c.side.empty() ? "/whole" : "/part"); }
+
+}  // namespace
 
 Confidence AssessConfidence(const CandidateSet& set, const Refinement& r, std::mt19937_64& rng) {
   Confidence out;
@@ -13,16 +21,20 @@ Confidence AssessConfidence(const CandidateSet& set, const Refinement& r, std::m
   if (!out.computed) options.bootstrap_selection = 0;
   const BootstrapResult boot = Bootstrap(r.problem, r.selection, options, rng);
   out.inclusion.assign(set.candidates.size(), -1.0);
+  out.scope_inclusion.assign(set.candidates.size(), -1.0);
   if (out.computed) {
     for (size_t k = 0; k < boot.inclusion.size(); ++k) out.inclusion[k] = std::clamp(boot.inclusion[k], 0.0, 1.0);
-    std::map<std::string, int> count;
+    std::map<std::string, int> count, scope_count;
     for (const auto& selected : boot.selections) {
-      std::set<std::string> families;
-      for (int e : selected) families.insert(set.candidates[e].family);
+      std::set<std::string> families, scopes;
+      for (int e : selected) families.insert(set.candidates[e].family), scopes.insert(ScopeOf(set.candidates[e]));
       for (const auto& f : families) ++count[f];
+      for (const auto& f : scopes) ++scope_count[f];
     }
-    for (const auto& c : set.candidates) {
+    for (size_t k = 0; k < set.candidates.size(); ++k) {
+      const KnobCandidate& c = set.candidates[k];
       out.family_inclusion[c.family] = static_cast<double>(count[c.family]) / out.resamples;
+      out.scope_inclusion[k] = static_cast<double>(scope_count[ScopeOf(c)]) / out.resamples;
     }
   }
   for (size_t j = 0; j < r.selection.selected.size(); ++j) {

@@ -20,6 +20,10 @@ struct Confidence {
   int resamples = 0;
   std::vector<double> inclusion;               // per candidate, in [0, 1]
   std::map<std::string, double> family_inclusion;
+  // Per candidate: the share of resamples selecting any candidate of its family at its scope, the
+  // whole robot (no side, no leg) or a part of it (a side or a leg): every servo's gain and one
+  // side's are one family but two claims.
+  std::vector<double> scope_inclusion;
   // Per entry of the final selection (its order): the value's 95% interval in the knob's unit.
   std::vector<double> value_lower, value_upper;
 };

@@ -57,7 +57,9 @@ struct PayloadSearchOptions {
   // Among the columns that fit as well as the best, name the one whose best point leaves the least
   // of the real torso's posture (PostureLeft), where the analysis can check the posture; one that,
   // refined, fits no better than the nominal gives way to the next, the likelihood's best last.
-  bool posture_chooses = true;
+  // Off by default since 2026-12-08: on fresh pairs it changed two names, both for the worse
+  // (docs/sim2real.md, "The posture chooses along the moment").
+  bool posture_chooses = false;
   LegSearchOptions search;  // the scoring and naming rules (its factors unused; the analysis's model)
   PayloadSearchOptions() { search.refine_steps = 2; }  // the best column's mass, to a quarter of a step
   bool IsValid(std::string* error) const;

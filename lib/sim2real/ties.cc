@@ -87,7 +87,7 @@ bool TieOptions::IsValid(std::string* error) const {
 }
 
 std::vector<int> TiedCandidates(const FitProblem& fp, const SelectionStep& step, int chosen,
-                                const std::vector<std::string>& family, double tie_correlation,
+                                const std::vector<TieScope>& scope, double tie_correlation,
                                 const EffectFitOptions& fit_options, std::vector<double>* correlation) {
   std::vector<int> out;
   if (step.candidates.empty()) return out;
@@ -96,7 +96,7 @@ std::vector<int> TiedCandidates(const FitProblem& fp, const SelectionStep& step,
   if (!fp.library[chosen].is_noise) shift_a = WhitenedShift(fp, FitEffects(fp, {chosen}, {}, fit_options), 0);
   for (const auto& cand : step.candidates) {
     const int o = cand.effect;
-    if (o == chosen || family[o] == family[chosen]) continue;
+    if (o == chosen || !scope[o].Distinct(scope[chosen])) continue;
     const bool flagged = std::find(step.confusable.begin(), step.confusable.end(), o) != step.confusable.end();
     double r = 0;
     if (!fp.library[o].is_noise && shift_a.size() > 0) {
@@ -118,23 +118,26 @@ TieResult FindTies(const KnobSimulator* simulator, const AnalysisInputs& in, con
   if (!options.IsValid(&error)) throw MakeInputError("", "tie options", error);
   const auto start = std::chrono::steady_clock::now();
   TieResult out;
-  std::vector<std::string> family_of;
-  for (const auto& c : set.candidates) family_of.push_back(c.family);
+  std::vector<TieScope> scope;
+  for (const auto& c : set.candidates) scope.push_back({c.family, c.leg.empty() && c.side.empty()});
   const EffectFitOptions& fit = r.selection_options.fit;
   for (const int chosen : named) {
     const auto step = std::find_if(r.selection.steps.begin(), r.selection.steps.end(),
                                    [&](const SelectionStep& st) { return st.chosen == chosen; });
     if (step == r.selection.steps.end()) continue;
     std::vector<double> corr;
-    const std::vector<int> tied = TiedCandidates(r.problem, *step, chosen, family_of, options.tie_correlation, fit, &corr);
+    const std::vector<int> tied = TiedCandidates(r.problem, *step, chosen, scope, options.tie_correlation, fit, &corr);
     CandidateTie ct{chosen, {}};
     VerdictTie& tie = ct.tie;
-    tie.families.push_back(family_of[chosen]);
+    tie.families.push_back(set.candidates[chosen].family);
     Proposal best;
     for (size_t q = 0; q < tied.size(); ++q) {
       const int o = tied[q];
-      if (std::find(tie.families.begin(), tie.families.end(), family_of[o]) != tie.families.end()) continue;
-      tie.families.push_back(family_of[o]);
+      const KnobCandidate& c = set.candidates[o];
+      // Its own family at another scope is named by its knob: "actuator_gain (actuators.left_side.gain)".
+      const std::string label = c.family == tie.families[0] ? c.family + " (" + c.knob + ")" : c.family;
+      if (std::find(tie.families.begin(), tie.families.end(), label) != tie.families.end()) continue;
+      tie.families.push_back(label);
       double gain_o = 0;
       for (const auto& c : step->candidates) gain_o = c.effect == o ? c.gain : gain_o;
       if (tie.why.empty()) {

@@ -40,6 +40,7 @@ std::string VerdictJson(const Verdict& v) {
                      {"fits_as_well", SearchSpanJson(n.as_well)},
                      {"inclusion", n.inclusion < 0 ? json(nullptr) : json(n.inclusion)},
                      {"candidate_inclusion", n.candidate_inclusion < 0 ? json(nullptr) : json(n.candidate_inclusion)},
+                     {"scope_inclusion", n.scope_inclusion < 0 ? json(nullptr) : json(n.scope_inclusion)},
                      {"tie_group", n.tie_group < 0 ? json(nullptr) : json(n.tie_group)},
                      {"flags", n.flags}, {"doubts", n.doubts}});
   }

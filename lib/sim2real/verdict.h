@@ -40,6 +40,8 @@ struct VerdictExperiment {
 };
 
 struct VerdictTie {
+  // The named candidate's family first, then the tied ones'; one of its own family at another scope
+  // as "family (knob)" (ties.h, TieScope).
   std::vector<std::string> families;
   std::string why;
   VerdictExperiment experiment;
@@ -54,6 +56,7 @@ struct VerdictNamed {
   SearchSpan as_well;     // the likelihood search's values that fit as well as the named one
   double inclusion = -1;  // of the family, in [0, 1]; < 0: not computed (--bootstrap 0), written as null
   double candidate_inclusion = -1;       // of this candidate alone
+  double scope_inclusion = -1;           // of its family at its scope (confidence.h)
   int tie_group = -1;     // index into ties, -1: null
   // "pinned_low", "pinned_high", "outside_range", "impossible", "unconverged", "not_single_peaked"
   std::vector<std::string> flags;

@@ -48,6 +48,7 @@ VerdictNamed Named(const CandidateSet& set, const Refinement& r, const Confidenc
   if (confidence.computed) {
     n.inclusion = std::clamp(confidence.family_inclusion.at(c.family), 0.0, 1.0);
     n.candidate_inclusion = confidence.inclusion[k];
+    n.scope_inclusion = confidence.scope_inclusion[k];
   }
   const std::pair<bool, const char*> flags[] = {{check.pinned_low, "pinned_low"},     {check.pinned_high, "pinned_high"},
                                                 {check.outside_range, "outside_range"}, {check.impossible, "impossible"},
@@ -59,6 +60,29 @@ VerdictNamed Named(const CandidateSet& set, const Refinement& r, const Confidenc
   }
   n.doubts = check.doubts;
   return n;
+}
+
+// The doubt of a family the resamples hold but at two scopes: every servo's gain named where a
+// side's gain was chosen in a quarter of them ("" when the named scope itself is held).
+std::string ScopeDoubt(const CandidateSet& set, const Confidence& confidence, int k, double sure) {
+  const KnobCandidate& c = set.candidates[k];
+  if (!confidence.computed || confidence.family_inclusion.at(c.family) < sure || confidence.scope_inclusion[k] >= sure) {
+    return "";
+  }
+  const auto whole = [](const KnobCandidate& d) { return d.leg.empty() && d.side.empty(); };
+  int other = -1;
+  for (size_t o = 0; o < set.candidates.size(); ++o) {
+    const KnobCandidate& d = set.candidates[o];
+    if (d.family != c.family || whole(d) == whole(c)) continue;
+    if (other < 0 || confidence.inclusion[o] > confidence.inclusion[other]) other = static_cast<int>(o);
+  }
+  if (other < 0) return "";
+  const char* here = whole(c) ? "as the whole robot's knob" : "as a side's or a leg's knob";
+  const char* there = whole(c) ? "as a side's or a leg's" : "as the whole robot's";
+  return c.family + Fmt(" held in %.0f%% of the resamples, but ", 100 * confidence.family_inclusion.at(c.family)) + here +
+         " (" + c.knob + Fmt(") in only %.0f%% and ", 100 * confidence.scope_inclusion[k]) + there + " (" +
+         set.candidates[other].knob + Fmt(") in %.0f%%", 100 * confidence.scope_inclusion[other]) +
+         ": these data do not tell whether the whole robot or a part of it differs";
 }
 
 VerdictDrifting Drifting(const CandidateSet& set, const Refinement& r, const Confidence& confidence,
@@ -158,6 +182,10 @@ Verdict ComposeVerdict(const Baseline& base, const CandidateSet& set, const Refi
     if (n.inclusion < 0 || n.inclusion >= options.sure_inclusion) continue;
     v.doubts.push_back(n.family + " (" + n.knob + Fmt(") held in %.0f%% of the resamples, under ", 100 * n.inclusion) +
                        Fmt("%.0f%%: these data are often read otherwise", 100 * options.sure_inclusion));
+  }
+  for (int k : naming.named) {
+    const std::string doubt = ScopeDoubt(set, confidence, k, options.sure_inclusion);
+    if (!doubt.empty()) v.doubts.push_back(doubt);
   }
   v.structured_in = adequacy.residual.structured_in;
   const bool session_drift = adequacy.total_drift.drifting, step_varies = adequacy.total_step_variation.drifting;

@@ -1,4 +1,4 @@
-// Stage 5: inclusion per candidate and per family in [0, 1], the value's interval around it.
+// Stage 5: inclusion per candidate, per family and per family at a scope in [0, 1], the value's interval around it.
 #include "sim2real/confidence.h"
 
 #include <gtest/gtest.h>
@@ -19,6 +19,9 @@ TEST(Confidence, FamilyInclusionCoversItsCandidatesAndTheValueItsInterval) {
   }
   for (size_t k = 0; k < s.set.candidates.size(); ++k) {
     EXPECT_GE(c.family_inclusion.at(s.set.candidates[k].family) + 1e-12, c.inclusion[k]) << s.set.candidates[k].key;
+    // Its family at its scope (the whole robot, or a side or leg) lies between the two.
+    EXPECT_GE(c.scope_inclusion[k] + 1e-12, c.inclusion[k]) << s.set.candidates[k].key;
+    EXPECT_GE(c.family_inclusion.at(s.set.candidates[k].family) + 1e-12, c.scope_inclusion[k]) << s.set.candidates[k].key;
   }
   EXPECT_GE(c.family_inclusion.at("friction"), 0.8);
   ASSERT_EQ(c.value_lower.size(), s.refinement.selection.selected.size());

@@ -290,6 +290,7 @@ TEST(PayloadSearch, ThePostureChoosesAmongTheColumnsThatFitAsWell) {
   auto search_with = [&](int pick, double at_pick) {
     PayloadSearchOptions o;
     o.search.model = s.options.locate.model;
+    o.posture_chooses = true;  // off by default
     const PayloadColumn& c = alone.columns[pick];
     const PostureLeft posture = [&c, at_pick](const std::vector<KnobValue>& values) {
       for (const KnobValue& v : values) {
@@ -310,6 +311,14 @@ TEST(PayloadSearch, ThePostureChoosesAmongTheColumnsThatFitAsWell) {
   EXPECT_NE(v.sentence.find("the torso's posture chose"), std::string::npos) << v.sentence;
   EXPECT_EQ(search_with(worse[0], 0.5).best_column, alone.best_column) << "a column that fits worse";
   EXPECT_EQ(search_with(as_well[0], NAN).best_column, alone.best_column) << "a posture not checked";
+  PayloadSearchOptions by_default;
+  by_default.search.model = s.options.locate.model;
+  EXPECT_FALSE(by_default.posture_chooses) << "off by default since 2026-12-08";
+  EXPECT_EQ(SearchPayload(SharedFake(), s.in, s.set, s.options.candidates, by_default,
+                          [](const std::vector<KnobValue>&) { return 0.5; })
+                .best_column,
+            alone.best_column)
+      << "off, the posture checks nothing";
   Verdict plain = UnexplainedInRegions();
   AddPayloadSearch(alone, &plain);
   EXPECT_EQ(plain.sentence.find("posture chose"), std::string::npos) << plain.sentence;
@@ -327,6 +336,7 @@ TEST(PayloadSearch, APostureChoiceThatNamesNothingGivesWayToTheLikelihoodsBest) 
   ASSERT_GE(other, 0);
   PayloadSearchOptions o;
   o.search.model = s.options.locate.model;
+  o.posture_chooses = true;
   const double x = alone.columns[other].best_x, y = alone.columns[other].best_y;
   const PayloadSearch p = SearchPayload(SharedFake(), s.in, s.set, s.options.candidates, o,
                                         [x, y](const std::vector<KnobValue>& values) {

@@ -10,8 +10,9 @@
 namespace dgmm::sim2real {
 namespace {
 
-// Two candidates with the same design (perfectly collinear signatures) from different families
-// must be reported as a tie; a third, orthogonal one must not.
+// Two candidates with the same design (perfectly collinear signatures) from different families, or
+// from one family at two scopes (the whole robot and one side), must be reported as a tie; a third,
+// orthogonal one must not.
 TEST(TiedCandidates, CollinearSignaturesTie) {
   const int n = 300, dx = 2;
   FitProblem fp = test::ToyProblem(n, dx);
@@ -40,13 +41,21 @@ TEST(TiedCandidates, CollinearSignaturesTie) {
   const int chosen = sel.selected[0];
   ASSERT_NE(chosen, 2);
   std::vector<double> corr;
-  const std::vector<int> tied = TiedCandidates(fp, sel.steps[0], chosen, {"friction", "payload", "contact"}, 0.9,
-                                               so.fit, &corr);
+  const std::vector<int> tied =
+      TiedCandidates(fp, sel.steps[0], chosen, {{"friction"}, {"payload"}, {"contact"}}, 0.9, so.fit, &corr);
   ASSERT_EQ(tied.size(), 1u);
   EXPECT_EQ(tied[0], chosen == 0 ? 1 : 0);
   EXPECT_NEAR(corr[0], 1.0, 1e-6);
-  // The same family is never a tie with itself.
-  EXPECT_TRUE(TiedCandidates(fp, sel.steps[0], chosen, {"friction", "friction", "contact"}, 0.9, so.fit).empty());
+  // The same family at the same scope is never a tie with itself: two whole-robot knobs, or two
+  // sides (or legs) of it.
+  EXPECT_TRUE(TiedCandidates(fp, sel.steps[0], chosen, {{"gain"}, {"gain"}, {"contact"}}, 0.9, so.fit).empty());
+  EXPECT_TRUE(
+      TiedCandidates(fp, sel.steps[0], chosen, {{"gain", false}, {"gain", false}, {"contact"}}, 0.9, so.fit).empty());
+  // Every servo's gain against one side's: the same family at another scope ties.
+  const std::vector<int> scoped =
+      TiedCandidates(fp, sel.steps[0], chosen, {{"gain", chosen != 0}, {"gain", chosen == 0}, {"contact"}}, 0.9, so.fit);
+  ASSERT_EQ(scoped.size(), 1u);
+  EXPECT_EQ(scoped[0], chosen == 0 ? 1 : 0);
 }
 
 }  // namespace
