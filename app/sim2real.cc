@@ -68,6 +68,7 @@ struct Sim2RealArgs {
   double challenge_gap_closed = sim2real::LegSearchOptions{}.challenge_gap_closed;
   double challenge_inclusion = sim2real::LegSearchOptions{}.challenge_inclusion;
   bool leg_vs_side = sim2real::LegSearchOptions{}.challenge_side;
+  bool leg_vs_whole = sim2real::LegSearchOptions{}.challenge_whole;
   bool leg_second_look = true;
   std::string null_source = "auto";
   int null_recordings = sim2real::RecordedNullOptions{}.draws;
@@ -194,6 +195,7 @@ sim2real::AnalysisOptions MakeOptions(const Sim2RealArgs& args, bool uneven_grou
   o.legs.challenge_gap_closed = args.challenge_gap_closed;
   o.legs.challenge_inclusion = args.challenge_inclusion;
   o.legs.challenge_side = args.leg_vs_side;
+  o.legs.challenge_whole = args.leg_vs_whole;
   o.legs.second_look_elsewhere = args.leg_second_look;
   o.payload.search.second_look_elsewhere = args.leg_second_look;
   o.candidates.recording.cache_dir = args.cache;
@@ -503,6 +505,9 @@ void Setup(CLI::App& root) {
   cmd->add_flag("--leg-vs-side,!--no-leg-vs-side", args->leg_vs_side,
                 "... and always when a side's gain is named: one weak leg of that side is the finer physics it "
                 "stands in for (on by default; docs/sim2real.md)");
+  cmd->add_flag("--side-vs-whole,!--no-side-vs-whole", args->leg_vs_whole,
+                "when every servo's gain is named, search every side's gain with every leg's: a whole side's weak "
+                "servos read as a weak robot; a side or leg that fits better by 2 SE replaces it (on by default)");
   cmd->add_flag("--leg-second-look,!--no-leg-second-look", args->leg_second_look,
                "on a plane, a point the leg or payload search's misfit gate refuses is looked at again against "
                "recordings at other places, the uneven ground's gate (on by default since 2026-12-05; "

@@ -38,6 +38,14 @@ std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement
 // runoff scores contenders by their own models), knobs named, none of them a leg's, and the
 // corrected model still below the real-trained ceiling, closing little of the gap, or named with
 // little agreement between the resamples.
+// A named gain of every servo (family actuator_gain, no leg, no side), which a side's could stand in for.
+bool NamesAWholeRobotGain(const Analysis& a) {
+  return std::any_of(a.naming.named.begin(), a.naming.named.end(), [&](int k) {
+    const KnobCandidate& c = a.candidates.candidates[k];
+    return c.simulated && c.family == "actuator_gain" && c.leg.empty() && c.side.empty();
+  });
+}
+
 bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
   if (!options.challenge_named || a.baseline.permute_placements) return false;
   const bool unsure = std::any_of(a.verdict.named.begin(), a.verdict.named.end(), [&](const VerdictNamed& n) {
@@ -51,6 +59,7 @@ bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
   };
   if (named_where(&KnobCandidate::leg)) return false;
   if (options.challenge_side && named_where(&KnobCandidate::side)) return true;
+  if (options.challenge_whole && NamesAWholeRobotGain(a)) return true;
   return !(a.verdict.status == "explained" && !a.posture.left_out) && short_of_it;
 }
 
@@ -209,9 +218,10 @@ void SearchByOwnModels(const KnobSimulator& simulator, const AnalysisOptions& op
   }
   if (!a->ground.search.named && !a->runoff.search.named && WantLegSearch(*a, options.legs)) {
     const auto t = Clock::now();
-    stage("leg search (every leg's gain)");
     const LegSearchOptions legs = OwnModels(options.legs, options);
-    a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs);
+    const bool sides = options.legs.challenge_whole && NamesAWholeRobotGain(*a);
+    stage(sides ? "leg search (every leg's and every side's gain)" : "leg search (every leg's gain)");
+    a->leg_search = SearchLegGains(simulator, a->inputs, a->candidates, options.candidates, legs, sides);
     if (!a->naming.named.empty()) {
       LegSearchChallenge(a->inputs, named, a->refinement.selection.heldout_corrected, legs, &a->leg_search);
     }

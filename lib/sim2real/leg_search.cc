@@ -18,6 +18,13 @@
 namespace dgmm::sim2real {
 namespace {
 
+// A leg's or a side's gain (actuator_gain with a leg or a side), named by its part: "rear_left",
+// "left side"; any other knob by its name.
+bool IsPart(const Knob& k) { return k.family == "actuator_gain" && (!k.leg.empty() || !k.side.empty()); }
+std::string PartName(const Knob& k) {
+  return !IsPart(k) ? k.name : !k.leg.empty() ? k.leg : k.side + " side";
+}
+
 using Clock = std::chrono::steady_clock;
 
 // log(exp(a) + exp(b)) without overflow.
@@ -242,7 +249,7 @@ void RecordPoints(const KnobSimulator& simulator, const AnalysisInputs& in, cons
     const Knob& knob = knobs[wanted[j].first];
     state->scored.push_back(ScoreDraws(next, draws, in, options, state->nominal_size, state->Ref()));
     const Scored& s = state->scored.back();
-    state->points.push_back({knob.leg.empty() ? knob.name : knob.leg, knob.name, wanted[j].first, wanted[j].second,
+    state->points.push_back({PartName(knob), knob.name, wanted[j].first, wanted[j].second,
                              s.walkable ? s.rows.mean() : -INFINITY, false});
   }
 }
@@ -274,9 +281,16 @@ std::vector<std::pair<int, double>> HalfSteps(const SearchState& state, int best
   return out;
 }
 
-// "leg3 at gain 0.3" or "floor.friction.sliding at 0.4".
+// Whether any point is a side's gain.
+bool SidesAmong(const std::vector<Knob>& knobs, const std::vector<LegSearchPoint>& points) {
+  return std::any_of(points.begin(), points.end(), [&](const LegSearchPoint& p) {
+    return IsPart(knobs[p.knob_index]) && knobs[p.knob_index].leg.empty();
+  });
+}
+
+// "leg3 at gain 0.3", "left side at gain 0.5" or "floor.friction.sliding at 0.4".
 std::string PointName(const Knob& k, double value) {
-  return k.leg.empty() ? k.name + Fmt(" at %.3g", value) : k.leg + Fmt(" at gain %.3g", value);
+  return IsPart(k) ? PartName(k) + Fmt(" at gain %.3g", value) : k.name + Fmt(" at %.3g", value);
 }
 
 // "; two draws of the nominal (the second a payload 0.00093 kg heavier) score 1.12 nats per real
@@ -327,7 +341,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
     leg_rows.push_back(rows[j]);
   }
   out->as_well = FitAsWellSpan(leg_rows, leg_best, values, {}, in.real.episode, options.z);
-  const bool legs = !knobs[b.knob_index].leg.empty();
+  out->side = knobs[b.knob_index].leg.empty() && !knobs[b.knob_index].side.empty();
+  const bool legs = IsPart(knobs[b.knob_index]);
   const std::string at = PointName(knobs[b.knob_index], b.value);
   if (out->z_vs_nominal < options.z) {
     out->why = "the best point (" + at +
@@ -336,7 +351,8 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
   } else if (!out->legs_as_well.empty()) {
     out->why = "the best point is " + at + (legs ? ", but weak " : ", but ") + out->legs_as_well[0] +
                (out->legs_as_well.size() > 1 ? Fmt(" (and %.0f more legs)", out->legs_as_well.size() - 1.0) : "") +
-               " fits the real samples as well: these data do not tell " + (legs ? "which leg" : "which knob");
+               " fits the real samples as well: these data do not tell " +
+               (!legs ? "which knob" : SidesAmong(knobs, state->points) ? "which leg or side" : "which leg");
   } else {
     out->named = true;
     out->why = "";
@@ -486,12 +502,15 @@ bool LegSearchOptions::IsValid(std::string* error) const {
   return model.IsValid(error) && chance.IsValid(error);
 }
 
-std::vector<int> LegGainKnobs(const KnobSimulator& simulator) {
+std::vector<int> LegGainKnobs(const KnobSimulator& simulator, bool sides) {
   std::vector<int> out;
   const auto& knobs = simulator.knobs();
-  for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
-    if (knobs[k].family == "actuator_gain" && !knobs[k].leg.empty() && knobs[k].role == Knob::Role::kShift) {
-      out.push_back(k);
+  for (const bool side : {false, true}) {
+    if (side && !sides) break;
+    for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
+      const Knob& knob = knobs[k];
+      const bool part = side ? knob.leg.empty() && !knob.side.empty() : !knob.leg.empty();
+      if (knob.family == "actuator_gain" && part && knob.role == Knob::Role::kShift) out.push_back(k);
     }
   }
   return out;
@@ -531,8 +550,8 @@ LegSearch SearchOwnModels(const KnobSimulator& simulator, const AnalysisInputs& 
 }
 
 LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
-                         const CandidateOptions& recording, const LegSearchOptions& options) {
-  const std::vector<int> legs = LegGainKnobs(simulator);
+                         const CandidateOptions& recording, const LegSearchOptions& options, bool sides) {
+  const std::vector<int> legs = LegGainKnobs(simulator, sides);
   if (legs.empty()) {
     LegSearch out;
     out.why = "the simulator has no per-leg gain knobs";
@@ -542,7 +561,9 @@ LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& i
   for (int k : legs) {
     for (double v : GridValues(simulator.knobs()[k], options.factors)) grid.push_back({k, v});
   }
-  return SearchOwnModels(simulator, in, set, recording, options, grid);
+  LegSearch out = SearchOwnModels(simulator, in, set, recording, options, grid);
+  out.sides_searched = sides && legs.size() > LegGainKnobs(simulator).size();
+  return out;
 }
 
 void LegSearchChallenge(const AnalysisInputs& in, const std::vector<std::string>& named, const Eigen::VectorXd& corrected,

@@ -82,6 +82,10 @@ struct LegSearchOptions {
   // is the finer physics a side's gain stands in for (hexapod pair 65190: a weak rear_left leg, gain
   // 0.505, named as the left side's gain 0.87 at 85% inclusion, 95% of the gap closed).
   bool challenge_side = true;
+  // Also challenge a named whole-robot gain (every servo's, actuators.kp_scale) with every side's
+  // gain beside every leg's: a whole side's weak servos read as a weak robot (hexapod pairs 65203,
+  // 65217: a left side at 0.62 and 0.54 named kp_scale 0.64 and 0.60, `explained`).
+  bool challenge_whole = true;
   // The misfit's unseen samples (min_gap_closed): the recording's own odd executions at the same
   // places, or with `misfit_elsewhere` a second recording of the nominal and of the best point at
   // other places (the real set's design, seed `elsewhere_seed`), where the real samples stand too.
@@ -198,6 +202,8 @@ struct LegSearch {
   // data do not tell the leg from the named knobs (a doubt of the verdict, AddLegSearch).
   bool rivals_named = false;
   double bar_z = NAN;  // the z it would have needed to replace them (LegSearchOptions::z)
+  bool sides_searched = false;  // the sides' gains were searched with the legs' (challenge_whole)
+  bool side = false;            // the best point is a side's gain (`leg` is then "left side")
 };
 
 // (sum_i a_i - b_i) / sqrt(SE^2 + extra^2), per-placement sums as the independent units
@@ -210,14 +216,17 @@ double PairedZ(const Eigen::VectorXd& a, const Eigen::VectorXd& b, const std::ve
 // of a search-named point; NaN without a best point.
 inline double BestScore(const LegSearch& s) { return s.best >= 0 ? s.points[s.best].score : NAN; }
 
-// The best point's leg in words: "rear_right leg (gain 0.35)".
+// The best point's leg in words: "rear_right leg (gain 0.35)", or a side's: "left side (gain 0.5)".
 std::string LegSaid(const LegSearch& search);
 
-// The per-leg gain knobs of `simulator` (family actuator_gain, a leg's name, a shift role).
-std::vector<int> LegGainKnobs(const KnobSimulator& simulator);
+// The per-leg gain knobs of `simulator` (family actuator_gain, a leg's name, a shift role); with
+// `sides`, the per-side gain knobs after them.
+std::vector<int> LegGainKnobs(const KnobSimulator& simulator, bool sides = false);
 
+// Every leg's gain at `options.factors` of its nominal (with `sides`, every side's too), each
+// recording scored by a model of its own (SearchOwnModels).
 LegSearch SearchLegGains(const KnobSimulator& simulator, const AnalysisInputs& in, const CandidateSet& set,
-                         const CandidateOptions& recording, const LegSearchOptions& options);
+                         const CandidateOptions& recording, const LegSearchOptions& options, bool sides = false);
 
 // Other knob values recorded with a point (knob, value): the payload search's position, which
 // depends on the payload's mass (payload_search.h).

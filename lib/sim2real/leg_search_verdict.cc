@@ -10,16 +10,21 @@ namespace {
 // Under this share of the nominal's misfit removed, some mismatch remains.
 constexpr double kMostOfTheMisfit = 0.9;
 
+// "every leg's gain", or "every leg's and every side's gain" (LegSearch::sides_searched).
+std::string Searched(const LegSearch& s) {
+  return s.sides_searched ? "every leg's and every side's gain" : "every leg's gain";
+}
+
 VerdictNamed NamedLeg(const LegSearch& s) {
   VerdictNamed n = SearchNamed(s, "actuator_gain", "");
   const std::string after = s.challenged.empty()
                                 ? "after the probes' mean shifts named nothing"
                                 : "after the probes' mean shifts named " + JoinWords(s.challenged) +
                                       Fmt(", which it fits the real samples better than (z %.1f)", s.z_vs_named);
-  n.doubts.push_back(Fmt("found by a search of every leg's gain (%.0f recordings, each scored by a model of its own, ",
-                         static_cast<double>(s.points.size())) +
+  n.doubts.push_back("found by a search of " + Searched(s) +
+                     Fmt(" (%.0f recordings, each scored by a model of its own, ", static_cast<double>(s.points.size())) +
                      "its spread and falls included) " + after + ": no bootstrap, its range is the gains that fit as well");
-  AddRemainingMismatchDoubt(s, "the weak leg", &n);
+  AddRemainingMismatchDoubt(s, s.side ? "the weak side" : "the weak leg", &n);
   return n;
 }
 
@@ -36,7 +41,7 @@ void AddRivalDoubt(const LegSearch& s, const std::string& subject, Verdict* v) {
                   v);
 }
 
-std::string LegSaid(const LegSearch& s) { return s.leg + Fmt(" leg (gain %.3g)", s.value); }
+std::string LegSaid(const LegSearch& s) { return s.leg + Fmt(s.side ? " (gain %.3g)" : " leg (gain %.3g)", s.value); }
 
 VerdictNamed SearchNamed(const LegSearch& s, const std::string& family, const std::string& unit) {
   VerdictNamed n;
@@ -83,17 +88,17 @@ void ReplaceNamed(const LegSearch& s, const VerdictNamed& n, Verdict* v) {
 void AddLegSearch(const LegSearch& s, Verdict* v) {
   if (!s.ran) return;
   if (!s.named) {
-    v->sentence += Fmt(" A search of every leg's gain (%.0f recordings, each scored by a model of its own) names no leg: ",
-                       static_cast<double>(s.points.size())) +
-                   s.why + ".";
+    v->sentence += " A search of " + Searched(s) +
+                   Fmt(" (%.0f recordings, each scored by a model of its own) names ", static_cast<double>(s.points.size())) +
+                   (s.sides_searched ? "no leg or side: " : "no leg: ") + s.why + ".";
     if (s.rivals_named) AddRivalDoubt(s, "a weak " + LegSaid(s), v);
     return;
   }
   ReplaceNamed(s, NamedLeg(s), v);
-  v->sentence += " The weak " + s.leg +
-                 Fmt(" leg fits the real samples %.3g nats per sample better than the nominal (z %.1f); ",
+  v->sentence += " The weak " + s.leg + (s.side ? "" : " leg") +
+                 Fmt(" fits the real samples %.3g nats per sample better than the nominal (z %.1f); ",
                      s.points[s.best].score - s.nominal_score, s.z_vs_nominal) +
-                 "no other leg's gain fits as well.";
+                 (s.sides_searched ? "no other leg's or side's gain fits as well." : "no other leg's gain fits as well.");
 }
 
 }  // namespace dgmm::sim2real

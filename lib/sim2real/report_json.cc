@@ -219,6 +219,7 @@ json LegSearchJson(const LegSearch& l) {
           {"best_plain_score", JsonNumber(l.best_plain)}, {"z_vs_nominal", JsonNumber(l.z_vs_nominal)},
           {"gap_closed", JsonNumber(l.gap_closed)}, {"challenged", l.challenged},
           {"z_vs_named", JsonNumber(l.z_vs_named)}, {"rivals_named", l.rivals_named}, {"legs_as_well", l.legs_as_well},
+          {"sides_searched", l.sides_searched}, {"side", l.side},
           {"fits_as_well", SearchSpanJson(l.as_well)}, {"points", points},
           {"recorded", l.recorded}, {"from_cache", l.from_cache}, {"seconds", l.seconds}};
 }

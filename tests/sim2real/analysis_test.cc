@@ -161,19 +161,25 @@ TEST(Analysis, TheLegSearchChallengesANameThatClosesLittleOfTheGap) {
   EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
 }
 
+// An analysis that named the first of `candidates`, explained, at that inclusion and gap closed.
+Analysis ExplainedNamingTheFirst(const std::vector<KnobCandidate>& candidates, double inclusion, double gap_closed) {
+  Analysis a;
+  a.candidates.candidates = candidates;
+  a.naming.named = {0};
+  a.verdict.status = "explained";
+  a.verdict.named.resize(1);
+  a.verdict.named[0].inclusion = inclusion;
+  a.adequacy.gap_closed = gap_closed;
+  return a;
+}
+
 // A side's gain named is challenged by the leg search whatever its fit and status (hexapod pair
 // 65190: a weak rear_left leg read as the left side's gain at 85% inclusion, 95% of the gap closed);
 // `challenge_side` false leaves it to the other rules, and a named leg is never challenged.
 TEST(Analysis, TheLegSearchChallengesANamedSidesGain) {
-  Analysis a;
-  a.candidates.candidates.resize(2);
-  a.candidates.candidates[0].side = "left";
-  a.candidates.candidates[1].leg = "rear_left";
-  a.naming.named = {0};
-  a.verdict.status = "explained";
-  a.verdict.named.resize(1);
-  a.verdict.named[0].inclusion = 0.85;
-  a.adequacy.gap_closed = 0.95;
+  KnobCandidate side, leg;
+  side.side = "left", leg.leg = "rear_left";
+  Analysis a = ExplainedNamingTheFirst({side, leg}, 0.85, 0.95);
   LegSearchOptions options;
   EXPECT_TRUE(WantLegSearch(a, options)) << "a side's gain, explained and closing the gap";
   options.challenge_side = false;
@@ -181,6 +187,24 @@ TEST(Analysis, TheLegSearchChallengesANamedSidesGain) {
   options.challenge_side = true;
   a.naming.named = {0, 1};
   EXPECT_FALSE(WantLegSearch(a, options)) << "a leg is named too";
+  a.naming.named = {0}, a.baseline.permute_placements = true;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
+}
+
+// A named gain of every servo is challenged by every side's and leg's gain, whatever the fit (hexapod
+// 65217: a left side at 0.54 named kp_scale 0.60, explained at 100%); a friction is not.
+TEST(Analysis, TheLegSearchChallengesANamedWholeRobotGain) {
+  KnobCandidate whole, friction;
+  whole.family = "actuator_gain", friction.family = "friction";
+  whole.simulated = friction.simulated = true;
+  Analysis a = ExplainedNamingTheFirst({whole, friction}, 1.0, 0.97);
+  LegSearchOptions options;
+  EXPECT_TRUE(WantLegSearch(a, options)) << "every servo's gain, explained and closing the gap";
+  options.challenge_whole = false;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "turned off: the other rules see nothing short";
+  options.challenge_whole = true;
+  a.naming.named = {1};
+  EXPECT_FALSE(WantLegSearch(a, options)) << "a friction, explained";
   a.naming.named = {0}, a.baseline.permute_placements = true;
   EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
 }

@@ -40,6 +40,34 @@ TEST(LegSearch, FindsOnlyThePerLegGainKnobs) {
   EXPECT_EQ(legs, (std::vector<int>{kLeg0Gain, kLeg1Gain, kLeg2Gain, kLeg3Gain}));
 }
 
+TEST(LegSearch, FindsTheSidesGainKnobsWhenAsked) {
+  EXPECT_EQ(LegGainKnobs(SharedFake(), true),
+            (std::vector<int>{kLeg0Gain, kLeg1Gain, kLeg2Gain, kLeg3Gain, kLeftGain, kRightGain}));
+}
+
+// With the sides searched beside the legs (a named whole-robot gain challenged), a weak side is
+// named as a side, by its side, and the verdict says a side was searched and found.
+TEST(LegSearch, WithTheSidesAWeakSideIsNamedAsASide) {
+  const Stages s = RunStages({{kLeftGain, 0.45}}, 3);
+  const LegSearch r = SearchLegGains(SharedFake(), s.in, s.set, s.options.candidates, Options(s), true);
+  ASSERT_TRUE(r.ran);
+  EXPECT_TRUE(r.sides_searched);
+  ASSERT_TRUE(r.named) << r.why;
+  EXPECT_TRUE(r.side);
+  EXPECT_EQ(r.leg, "left side");
+  EXPECT_EQ(r.knob_index, kLeftGain);
+  EXPECT_NEAR(r.value, 0.45, 0.25 * 0.45);
+  EXPECT_EQ(LegSaid(r).rfind("left side (gain ", 0), 0u) << LegSaid(r);
+  Verdict v = UnexplainedInRegions();
+  AddLegSearch(r, &v);
+  ASSERT_EQ(v.named.size(), 1u);
+  EXPECT_EQ(v.named[0].knob, "actuators.side.left.gain");
+  EXPECT_NE(v.sentence.find("search of every leg's and every side's gain"), std::string::npos) << v.sentence;
+  EXPECT_NE(v.sentence.find("The weak left side fits"), std::string::npos) << v.sentence;
+  EXPECT_EQ(v.sentence.find("left side leg"), std::string::npos) << v.sentence;
+  EXPECT_FALSE(Search(s).sides_searched) << "the legs alone by default";
+}
+
 TEST(LegSearch, NamesAPlantedWeakLegWithItsGain) {
   const Stages s = RunStages({{kLeg1Gain, 0.38}}, 3);
   const LegSearch r = Search(s);
