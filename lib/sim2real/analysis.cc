@@ -34,18 +34,19 @@ std::vector<KnobValue> NamedKnobValues(const CandidateSet& set, const Refinement
   return out;
 }
 
-// A challenge of named knobs (LegSearchOptions::challenge_named): on a plane (on uneven ground the
-// runoff scores contenders by their own models), knobs named, none of them a leg's, and the
-// corrected model still below the real-trained ceiling, closing little of the gap, or named with
-// little agreement between the resamples.
 // A named gain of every servo (family actuator_gain, no leg, no side), which a side's could stand in for.
 bool NamesAWholeRobotGain(const Analysis& a) {
   return std::any_of(a.naming.named.begin(), a.naming.named.end(), [&](int k) {
     const KnobCandidate& c = a.candidates.candidates[k];
-    return c.simulated && c.family == "actuator_gain" && c.leg.empty() && c.side.empty();
+    return c.simulated && c.family == "actuator_gain" && c.WholeRobot();
   });
 }
 
+// A challenge of named knobs (LegSearchOptions::challenge_named): on a plane (on uneven ground the
+// runoff scores contenders by their own models), knobs named, none of them a leg's, and the
+// corrected model still below the real-trained ceiling, closing little of the gap, or named with
+// little agreement between the resamples; a named side's or every servo's gain always
+// (challenge_side, challenge_whole).
 bool WantChallenge(const Analysis& a, const LegSearchOptions& options) {
   if (!options.challenge_named || a.baseline.permute_placements) return false;
   const bool unsure = std::any_of(a.verdict.named.begin(), a.verdict.named.end(), [&](const VerdictNamed& n) {

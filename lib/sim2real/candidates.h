@@ -69,6 +69,8 @@ struct KnobCandidate {
   double physical_min = -1e300;
   bool simulated = false;  // a simulator knob (else a measurement effect)
   std::string leg, side;
+  // Acts on the whole robot (no leg, no side): every servo's gain, not one side's or leg's.
+  bool WholeRobot() const { return leg.empty() && side.empty(); }
 };
 
 struct CandidateSet {

@@ -9,7 +9,7 @@ namespace dgmm::sim2real {
 namespace {
 
 // A candidate's family at its scope: "actuator_gain/whole" or "actuator_gain/part".
-std::string ScopeOf(const KnobCandidate& c) { return c.family + (c.leg.empty() && c.side.empty() ? "/whole" : "/part"); }
+std::string ScopeOf(const KnobCandidate& c) { return c.family + (c.WholeRobot() ? "/whole" : "/part"); }
 
 }  // namespace
 

@@ -21,6 +21,7 @@ namespace {
 // A leg's or a side's gain (actuator_gain with a leg or a side), named by its part: "rear_left",
 // "left side"; any other knob by its name.
 bool IsPart(const Knob& k) { return k.family == "actuator_gain" && (!k.leg.empty() || !k.side.empty()); }
+bool IsSideGain(const Knob& k) { return IsPart(k) && k.leg.empty(); }
 std::string PartName(const Knob& k) {
   return !IsPart(k) ? k.name : !k.leg.empty() ? k.leg : k.side + " side";
 }
@@ -284,7 +285,7 @@ std::vector<std::pair<int, double>> HalfSteps(const SearchState& state, int best
 // Whether any point is a side's gain.
 bool SidesAmong(const std::vector<Knob>& knobs, const std::vector<LegSearchPoint>& points) {
   return std::any_of(points.begin(), points.end(), [&](const LegSearchPoint& p) {
-    return IsPart(knobs[p.knob_index]) && knobs[p.knob_index].leg.empty();
+    return IsSideGain(knobs[p.knob_index]);
   });
 }
 
@@ -341,7 +342,7 @@ void Decide(const AnalysisInputs& in, const std::vector<Knob>& knobs,
     leg_rows.push_back(rows[j]);
   }
   out->as_well = FitAsWellSpan(leg_rows, leg_best, values, {}, in.real.episode, options.z);
-  out->side = knobs[b.knob_index].leg.empty() && !knobs[b.knob_index].side.empty();
+  out->side = IsSideGain(knobs[b.knob_index]);
   const bool legs = IsPart(knobs[b.knob_index]);
   const std::string at = PointName(knobs[b.knob_index], b.value);
   if (out->z_vs_nominal < options.z) {
@@ -509,8 +510,8 @@ std::vector<int> LegGainKnobs(const KnobSimulator& simulator, bool sides) {
     if (side && !sides) break;
     for (int k = 0; k < static_cast<int>(knobs.size()); ++k) {
       const Knob& knob = knobs[k];
-      const bool part = side ? knob.leg.empty() && !knob.side.empty() : !knob.leg.empty();
-      if (knob.family == "actuator_gain" && part && knob.role == Knob::Role::kShift) out.push_back(k);
+      const bool part = side ? IsSideGain(knob) : IsPart(knob) && !knob.leg.empty();
+      if (part && knob.role == Knob::Role::kShift) out.push_back(k);
     }
   }
   return out;

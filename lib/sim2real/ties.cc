@@ -119,7 +119,7 @@ TieResult FindTies(const KnobSimulator* simulator, const AnalysisInputs& in, con
   const auto start = std::chrono::steady_clock::now();
   TieResult out;
   std::vector<TieScope> scope;
-  for (const auto& c : set.candidates) scope.push_back({c.family, c.leg.empty() && c.side.empty()});
+  for (const auto& c : set.candidates) scope.push_back({c.family, c.WholeRobot()});
   const EffectFitOptions& fit = r.selection_options.fit;
   for (const int chosen : named) {
     const auto step = std::find_if(r.selection.steps.begin(), r.selection.steps.end(),

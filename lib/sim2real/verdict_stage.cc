@@ -69,16 +69,15 @@ std::string ScopeDoubt(const CandidateSet& set, const Confidence& confidence, in
   if (!confidence.computed || confidence.family_inclusion.at(c.family) < sure || confidence.scope_inclusion[k] >= sure) {
     return "";
   }
-  const auto whole = [](const KnobCandidate& d) { return d.leg.empty() && d.side.empty(); };
   int other = -1;
   for (size_t o = 0; o < set.candidates.size(); ++o) {
     const KnobCandidate& d = set.candidates[o];
-    if (d.family != c.family || whole(d) == whole(c)) continue;
+    if (d.family != c.family || d.WholeRobot() == c.WholeRobot()) continue;
     if (other < 0 || confidence.inclusion[o] > confidence.inclusion[other]) other = static_cast<int>(o);
   }
   if (other < 0) return "";
-  const char* here = whole(c) ? "as the whole robot's knob" : "as a side's or a leg's knob";
-  const char* there = whole(c) ? "as a side's or a leg's" : "as the whole robot's";
+  const char* here = c.WholeRobot() ? "as the whole robot's knob" : "as a side's or a leg's knob";
+  const char* there = c.WholeRobot() ? "as a side's or a leg's" : "as the whole robot's";
   return c.family + Fmt(" held in %.0f%% of the resamples, but ", 100 * confidence.family_inclusion.at(c.family)) + here +
          " (" + c.knob + Fmt(") in only %.0f%% and ", 100 * confidence.scope_inclusion[k]) + there + " (" +
          set.candidates[other].knob + Fmt(") in %.0f%%", 100 * confidence.scope_inclusion[other]) +

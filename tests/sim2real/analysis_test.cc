@@ -173,22 +173,29 @@ Analysis ExplainedNamingTheFirst(const std::vector<KnobCandidate>& candidates, d
   return a;
 }
 
+// `a` (ExplainedNamingTheFirst) is challenged while `rule` is on, not when it is off, not with
+// `instead` named (`why`), and not on uneven ground.
+void ExpectChallengedByRule(Analysis a, bool LegSearchOptions::*rule, const std::vector<int>& instead,
+                            const std::string& why) {
+  LegSearchOptions options;
+  EXPECT_TRUE(WantLegSearch(a, options)) << "named, explained and closing the gap";
+  options.*rule = false;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "turned off: the other rules see nothing short";
+  options.*rule = true;
+  a.naming.named = instead;
+  EXPECT_FALSE(WantLegSearch(a, options)) << why;
+  a.naming.named = {0}, a.baseline.permute_placements = true;
+  EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
+}
+
 // A side's gain named is challenged by the leg search whatever its fit and status (hexapod pair
 // 65190: a weak rear_left leg read as the left side's gain at 85% inclusion, 95% of the gap closed);
 // `challenge_side` false leaves it to the other rules, and a named leg is never challenged.
 TEST(Analysis, TheLegSearchChallengesANamedSidesGain) {
   KnobCandidate side, leg;
   side.side = "left", leg.leg = "rear_left";
-  Analysis a = ExplainedNamingTheFirst({side, leg}, 0.85, 0.95);
-  LegSearchOptions options;
-  EXPECT_TRUE(WantLegSearch(a, options)) << "a side's gain, explained and closing the gap";
-  options.challenge_side = false;
-  EXPECT_FALSE(WantLegSearch(a, options)) << "turned off: the other rules see nothing short";
-  options.challenge_side = true;
-  a.naming.named = {0, 1};
-  EXPECT_FALSE(WantLegSearch(a, options)) << "a leg is named too";
-  a.naming.named = {0}, a.baseline.permute_placements = true;
-  EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
+  ExpectChallengedByRule(ExplainedNamingTheFirst({side, leg}, 0.85, 0.95), &LegSearchOptions::challenge_side, {0, 1},
+                         "a leg is named too");
 }
 
 // A named gain of every servo is challenged by every side's and leg's gain, whatever the fit (hexapod
@@ -197,16 +204,8 @@ TEST(Analysis, TheLegSearchChallengesANamedWholeRobotGain) {
   KnobCandidate whole, friction;
   whole.family = "actuator_gain", friction.family = "friction";
   whole.simulated = friction.simulated = true;
-  Analysis a = ExplainedNamingTheFirst({whole, friction}, 1.0, 0.97);
-  LegSearchOptions options;
-  EXPECT_TRUE(WantLegSearch(a, options)) << "every servo's gain, explained and closing the gap";
-  options.challenge_whole = false;
-  EXPECT_FALSE(WantLegSearch(a, options)) << "turned off: the other rules see nothing short";
-  options.challenge_whole = true;
-  a.naming.named = {1};
-  EXPECT_FALSE(WantLegSearch(a, options)) << "a friction, explained";
-  a.naming.named = {0}, a.baseline.permute_placements = true;
-  EXPECT_FALSE(WantLegSearch(a, options)) << "uneven ground: the runoff's";
+  ExpectChallengedByRule(ExplainedNamingTheFirst({whole, friction}, 1.0, 0.97), &LegSearchOptions::challenge_whole, {1},
+                         "a friction, explained");
 }
 
 // With challenge_inclusion a name the resamples seldom agree on is challenged even at the ceiling
